@@ -1,0 +1,1 @@
+"""weakgrid.sim"""
