@@ -1,0 +1,203 @@
+"""The trained game controller: the saddle point (u*, w*) of SPEC §2, J and ∇J, and its file.
+
+At a state ``x`` the deployed control and worst-case disturbance are the joint
+solution of the block system (SPEC §2, from (23)–(24))
+
+    [[Yu, g'∇²J h], [h'∇²J g, Yw]] · [u; w] = −[g'(∇J + ∇²J(f − x)); h'(∇J + ∇²J(f − x))]
+
+with ``Yu = g'∇²J g + 2R`` and ``Yw = h'∇²J h − 2γ²P``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .bases import PolynomialBasis
+from .cost import GameCost
+from .errors import ParameterError, ShapeError
+from .system import ControlAffineSystem, system_from_dict
+
+__all__ = ["GameController", "load_controller", "FILE_FORMAT"]
+
+FILE_FORMAT = "weakgrid-controller/1"
+
+
+def _package_version():
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("weakgrid")
+    except PackageNotFoundError:  # pragma: no cover
+        return "0.0.0+unknown"
+
+
+def write_json_atomic(path, obj) -> Path:
+    """Write JSON to ``path`` atomically (temporary file in the same folder, then rename)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w") as fh:
+            json.dump(obj, fh, indent=1)
+            fh.write("\n")
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+@dataclass(eq=False)
+class GameController:
+    """``J(x) = W'σ(x)`` and the saddle-point policies it defines.
+
+    Attributes
+    ----------
+    system : ControlAffineSystem
+    basis : PolynomialBasis
+    weights : ndarray (L,)
+    cost : GameCost
+    problem : dict
+        The description recorded in the file (model, cost, mesh, basis, …).
+    history : list of IterationRecord
+    train_seconds : float
+    """
+
+    system: ControlAffineSystem
+    basis: PolynomialBasis
+    weights: np.ndarray
+    cost: GameCost
+    problem: dict = field(default_factory=dict)
+    history: list = field(default_factory=list)
+    train_seconds: float = float("nan")
+    iterations: dict | None = None
+
+    def __post_init__(self):
+        self.weights = np.asarray(self.weights, float)
+        if self.weights.shape != (self.basis.size,):
+            raise ShapeError("weights", self.weights.shape, f"({self.basis.size},)")
+        if self.iterations is None:
+            self.iterations = {"outer": len(self.history),
+                               "inner": [r.inner for r in self.history]}
+
+    # ----------------------------------------------------------- the cost
+    def value(self, x) -> np.ndarray:
+        """``J(x)``, shape (...)."""
+        return self.basis(x) @ self.weights
+
+    def gradient(self, x) -> np.ndarray:
+        """``∇J(x)``, shape (..., n)."""
+        return np.einsum("...ln,l->...n", self.basis.gradient(x), self.weights)
+
+    def hessian(self, x) -> np.ndarray:
+        """``∇²J(x)``, shape (..., n, n)."""
+        return np.einsum("...lij,l->...ij", self.basis.hessian(x), self.weights)
+
+    # ------------------------------------------------------- saddle point
+    def _terms(self, x):
+        x = self.system.check_states(x)
+        _, dphi, d2phi = self.basis.evaluate(x)
+        gJ = np.einsum("...ln,l->...n", dphi, self.weights)
+        HJ = np.einsum("...lij,l->...ij", d2phi, self.weights)
+        f = self.system.open_loop_dynamics(x)
+        g = np.asarray(self.system.control_directions(x), float)
+        h = np.asarray(self.system.disturbance_directions(x), float)
+        return x, f, g, h, gJ, HJ
+
+    def saddle_point(self, x):
+        """Joint saddle point ``(u*, w*)`` at one state ``(n,)`` or a batch ``(..., n)``."""
+        x, f, g, h, gJ, HJ = self._terms(x)
+        m, q = g.shape[-1], h.shape[-1]
+        B = np.concatenate([g, h], axis=-1)  # (..., n, m+q)
+        M = np.einsum("...ni,...nk,...kj->...ij", B, HJ, B)
+        reg = np.zeros((m + q, m + q))
+        reg[:m, :m] = 2 * self.cost.R
+        reg[m:, m:] = -2 * self.cost.gamma**2 * self.cost.P
+        M = M + reg
+        rhs = np.einsum("...ni,...n->...i", B, gJ + np.einsum("...ij,...j->...i", HJ, f - x))
+        z = -np.linalg.solve(M, rhs[..., None])[..., 0]
+        return z[..., :m], z[..., m:]
+
+    def control(self, x) -> np.ndarray:
+        """``u*(x)``."""
+        return self.saddle_point(x)[0]
+
+    def disturbance(self, x) -> np.ndarray:
+        """Worst-case ``w*(x)``."""
+        return self.saddle_point(x)[1]
+
+    __call__ = control
+
+    def hamiltonian(self, x, u, w) -> np.ndarray:
+        """The approximate Hamiltonian (22) ``∇J'Δx + ½Δx'∇²JΔx + Q(x) + u'Ru − γ²w'Pw``."""
+        x, f, g, h, gJ, HJ = self._terms(x)
+        u = np.asarray(u, float)
+        w = np.asarray(w, float)
+        dx = (f + np.einsum("...nm,...m->...n", g, u) + np.einsum("...nq,...q->...n", h, w) - x)
+        return (np.einsum("...n,...n->...", gJ, dx)
+                + 0.5 * np.einsum("...i,...ij,...j->...", dx, HJ, dx)
+                + self.cost.stage(x, u, w))
+
+    def block_eigenvalues(self, x):
+        """Smallest eigenvalue of Yu and largest of Yw at states ``x`` (Yu ≻ 0, Yw ≺ 0 wanted)."""
+        x, f, g, h, gJ, HJ = self._terms(x)
+        Yu = np.einsum("...ni,...nk,...kj->...ij", g, HJ, g) + 2 * self.cost.R
+        Yw = np.einsum("...ni,...nk,...kj->...ij", h, HJ, h) - 2 * self.cost.gamma**2 * self.cost.P
+        return np.linalg.eigvalsh(Yu)[..., 0], np.linalg.eigvalsh(Yw)[..., -1]
+
+    # -------------------------------------------------------------- files
+    def to_dict(self) -> dict:
+        return {
+            "format": FILE_FORMAT,
+            "weakgrid_version": _package_version(),
+            "problem": self.problem,
+            "basis_labels": self.basis.labels(getattr(self.system, "state_names", None)),
+            "weights": self.weights.tolist(),
+            "iterations": self.iterations,
+            "train_seconds": self.train_seconds,
+            "history": [r.to_dict() for r in self.history],
+        }
+
+    def save(self, path) -> Path:
+        """Write the controller to a JSON file (atomically)."""
+        if self.problem.get("model", {}).get("serializable") is False:
+            raise ParameterError("system", self.system.kind,
+                                 "this system has no to_dict(): it cannot be saved to a file")
+        return write_json_atomic(path, self.to_dict())
+
+
+def controller_from_dict(d: dict, system: ControlAffineSystem | None = None) -> GameController:
+    if d.get("format") != FILE_FORMAT:
+        raise ParameterError("format", d.get("format"),
+                             f"not a weakgrid controller file (expected {FILE_FORMAT!r})")
+    problem = d["problem"]
+    system = system or system_from_dict(problem["model"])
+    basis = PolynomialBasis.from_dict(problem["basis"])
+    cost = GameCost.from_dict(problem["cost"])
+    return GameController(system=system, basis=basis, weights=np.asarray(d["weights"], float),
+                          cost=cost, problem=problem, history=[],
+                          train_seconds=d.get("train_seconds", float("nan")),
+                          iterations=d.get("iterations"))
+
+
+def load_controller(path, system: ControlAffineSystem | None = None) -> GameController:
+    """Read a controller file; the system is rebuilt from its record unless given.
+
+    Systems of :mod:`weakgrid.models` are rebuilt once that module is imported
+    (``weakgrid.models.load_controller`` does it for you).
+    """
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"controller file {path} does not exist")
+    try:
+        d = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ParameterError("controller file", str(path), f"is not valid JSON ({exc})") from None
+    return controller_from_dict(d, system)

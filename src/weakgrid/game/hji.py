@@ -1,0 +1,481 @@
+"""Two-loop policy iteration for the approximate HJI equation (paper, Section IV, Fig. 4).
+
+The cost is approximated by ``J(x) = W'σ(x)`` and the weights are fitted by
+weighted residuals on a mesh of the training region Ω (27)–(28). The outer loop
+updates the control by (24), the inner loop the disturbance by (23):
+
+    u⁽⁰⁾ = an initial stabilizing policy;  i = 0
+    repeat (outer):
+        w⁽ⁱ'⁰⁾ = 0
+        repeat (inner): fit J⁽ⁱ'ʲ⁾ from (u⁽ⁱ⁾, w⁽ⁱ'ʲ⁾);  w⁽ⁱ'ʲ⁺¹⁾ from (23)
+        until max|Δw| ≤ δw
+        u⁽ⁱ⁺¹⁾ from (24) with the last J and w
+    until max|Δu| ≤ δu
+
+Everything that does not change across iterations (f, g, h and the basis
+derivatives at the mesh) is evaluated once. Each fit solves the least-squares
+problem by a QR factorization of the regression matrix with normalized columns
+(for a monomial basis, scaling the states is a diagonal column scaling, so the
+normalization subsumes it); the normal equations are never formed (SPEC §3).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+from scipy.linalg import get_lapack_funcs
+
+from .bases import PolynomialBasis
+from .controller import GameController
+from .cost import GameCost
+from .errors import (
+    ControlHessianError,
+    ConvergenceError,
+    GammaTooSmallError,
+    InitialPolicyError,
+    NonFiniteError,
+    ParameterError,
+    ShapeError,
+)
+from .policies import describe_policy
+from .system import ControlAffineSystem
+
+__all__ = ["SolverSettings", "IterationRecord", "solve_hji", "closed_loop_spectral_radius"]
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """Tolerances and caps of the two-loop policy iteration.
+
+    Parameters
+    ----------
+    tol_u, tol_w : float
+        δu and δw: stop when ``max|Δu| ≤ δu`` (outer) and ``max|Δw| ≤ δw`` (inner),
+        the maximum over all mesh points and components.
+    max_outer, max_inner : int
+        Iteration caps (the outer loop of case 1 is not monotone: keep it generous).
+    check_initial_policy : bool
+        Refuse an initial policy whose linearized closed loop at the origin is not Schur.
+    """
+
+    tol_u: float = 1e-7
+    tol_w: float = 1e-7
+    max_outer: int = 500
+    max_inner: int = 500
+    check_initial_policy: bool = True
+
+    def __post_init__(self):
+        for nm in ("tol_u", "tol_w"):
+            v = getattr(self, nm)
+            if not (np.isfinite(v) and v > 0):
+                raise ParameterError(f"settings.{nm}", v, "tolerances must be positive")
+        for nm in ("max_outer", "max_inner"):
+            v = getattr(self, nm)
+            if int(v) != v or v < 1:
+                raise ParameterError(f"settings.{nm}", v, "iteration caps must be integers ≥ 1")
+
+    def to_dict(self):
+        return {"tol_u": self.tol_u, "tol_w": self.tol_w, "max_outer": self.max_outer,
+                "max_inner": self.max_inner}
+
+
+@dataclass
+class IterationRecord:
+    """One outer iteration of the policy iteration.
+
+    Attributes
+    ----------
+    outer : int
+        Outer iteration index (1-based).
+    inner : int
+        Inner iterations done in it.
+    max_du : float
+        ``max|u⁽ⁱ⁺¹⁾ − u⁽ⁱ⁾|`` over the mesh.
+    max_dw : list of float
+        ``max|w⁽ⁱ'ʲ⁺¹⁾ − w⁽ⁱ'ʲ⁾|`` of every inner iteration.
+    residual : float
+        Relative residual ``‖XW + Y‖ / ‖Y‖`` of the last fit.
+    weights : ndarray
+        Weights of the last fit.
+    min_J : float
+        Smallest ``J`` on the mesh (must be ≥ 0).
+    max_eig_Yw : float
+        Largest eigenvalue of ``Yw`` on the mesh (must be < 0).
+    min_eig_Yu : float
+        Smallest eigenvalue of ``Yu`` on the mesh (must be > 0).
+    """
+
+    outer: int
+    inner: int
+    max_du: float
+    max_dw: list
+    residual: float
+    weights: np.ndarray
+    min_J: float
+    max_eig_Yw: float
+    min_eig_Yu: float
+
+    def to_dict(self):
+        return {"outer": self.outer, "inner": self.inner, "max_du": self.max_du,
+                "max_dw": list(self.max_dw), "residual": self.residual,
+                "weights": self.weights.tolist(), "min_J": self.min_J,
+                "max_eig_Yw": self.max_eig_Yw, "min_eig_Yu": self.min_eig_Yu}
+
+
+def closed_loop_spectral_radius(system: ControlAffineSystem, policy, x0=None, eps=1e-6):
+    """Spectral radius of the linearization of ``x ↦ f(x) + g(x)π(x)`` at ``x0`` (default 0)."""
+    n = system.n_states
+    x0 = np.zeros(n) if x0 is None else np.asarray(x0, float)
+    d = eps * np.eye(n)
+    pts = np.concatenate([x0 + d, x0 - d])
+
+    def F(x):
+        return system.step(x, u=policy(x))
+
+    Fx = F(pts)
+    Acl = (Fx[:n] - Fx[n:]).T / (2 * eps)
+    if not np.all(np.isfinite(Acl)):
+        raise NonFiniteError("the initial policy gives NaN or inf near the origin")
+    return float(np.max(np.abs(np.linalg.eigvals(Acl))))
+
+
+def _solve_planes(A, b):
+    """Solve ``A[:, :, p] x[:, p] = b[:, p]`` for every point p; A (k, k, p), b (k, p).
+
+    1×1 and 2×2 blocks in closed form (the common case), larger ones by LAPACK.
+    """
+    k = A.shape[0]
+    if k == 1:
+        return b / A[0]
+    if k == 2:
+        det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+        return np.stack([(A[1, 1] * b[0] - A[0, 1] * b[1]) / det,
+                         (A[0, 0] * b[1] - A[1, 0] * b[0]) / det])
+    return np.linalg.solve(np.moveaxis(A, -1, 0), b.T[..., None])[..., 0].T
+
+
+def _extreme_eig(A, which):
+    """Smallest ('min') or largest ('max') eigenvalue of each symmetric block, A (k, k, p)."""
+    k = A.shape[0]
+    if k == 1:
+        return A[0, 0]
+    if k == 2:
+        mean = 0.5 * (A[0, 0] + A[1, 1])
+        rad = np.sqrt((0.5 * (A[0, 0] - A[1, 1])) ** 2 + A[0, 1] * A[1, 0])
+        return mean - rad if which == "min" else mean + rad
+    e = np.linalg.eigvalsh(np.moveaxis(A, -1, 0))
+    return e[:, 0] if which == "min" else e[:, -1]
+
+
+def _quad_planes(M, v):
+    """``v'Mv`` at every point, v (k, p)."""
+    return ((M @ v) * v).sum(0)
+
+
+class _Problem:
+    """Everything that does not change across iterations, evaluated once at the mesh.
+
+    With ``d = f(x) − x`` and ``Δx = d + g·u + h·w``, the regression row (27)
+    ``∇σ'Δx + ½Δx'∇²σΔx`` is a polynomial of degree two in (u, w) whose
+    coefficients per mesh point and basis term are fixed; so are the terms of
+    (23) and (24). Each iteration then only contracts these tables with the
+    current (u, w) and solves one least-squares problem.
+    """
+
+    def __init__(self, system, basis, cost, X):
+        self.X = X
+        F = system.open_loop_dynamics(X) - X  # f(x) − x, (p, n)
+        G = np.asarray(system.control_directions(X), float)  # (p, n, m)
+        H = np.asarray(system.disturbance_directions(X), float)  # (p, n, q)
+        for nm, v in (("open_loop_dynamics", F), ("control_directions", G),
+                      ("disturbance_directions", H)):
+            if not np.all(np.isfinite(v)):
+                raise NonFiniteError(f"{nm} gives NaN or inf on the mesh")
+        p, n = X.shape
+        if G.shape != (p, n, system.n_controls):
+            raise ShapeError("control_directions(x)", G.shape, f"({p}, {n}, m)")
+        if H.shape != (p, n, system.n_disturbances):
+            raise ShapeError("disturbance_directions(x)", H.shape, f"({p}, {n}, q)")
+        n = X.shape[1]
+        mono = basis.planes(np.ascontiguousarray(X.T))  # (K, L, p)
+        self.phi = mono[0].T
+        dphi = mono[1 : 1 + n]  # (n, L, p)
+        d2 = [[None] * n for _ in range(n)]
+        for k_, (j, k) in enumerate(basis.second_derivative_pairs()):
+            d2[j][k] = d2[k][j] = mono[1 + n + k_]
+        Ft = np.ascontiguousarray(F.T)  # (n, p)
+        Bd = np.ascontiguousarray(np.concatenate([G, H], axis=-1).transpose(1, 2, 0))  # (n, k, p)
+        live = [i for i in range(n) if np.any(Bd[i])]  # rows of B that are not zero
+        # rows of (27) as a polynomial in z = [u; w]:  X(z) = c0 + c1·z + ½ z'·c2·z,
+        # built plane by plane (L, p) — every product below is elementwise over the mesh
+        d2F = [sum(d2[i][j] * Ft[j] for j in range(n)) for i in range(n)]  # ∇²σ(f − x)
+        self.c0 = sum(dphi[i] * Ft[i] + 0.5 * d2F[i] * Ft[i] for i in range(n))
+        A = [dphi[i] + d2F[i] for i in range(n)]
+        k_in = Bd.shape[1]
+        zero = np.zeros_like(self.c0)
+        self.c1 = np.stack([sum((A[i] * Bd[i, a] for i in live), zero) for a in range(k_in)])
+        T = [[sum((Bd[i, a] * d2[i][j] for i in live), zero) for a in range(k_in)]
+             for j in range(n)]  # (∇²σ B)[j, a]
+        self.c2 = np.empty((k_in, k_in) + self.c0.shape)
+        for a in range(k_in):
+            for b in range(a, k_in):
+                self.c2[a, b] = sum((T[j][a] * Bd[j, b] for j in live), zero)
+                self.c2[b, a] = self.c2[a, b]
+        m, q = G.shape[-1], H.shape[-1]
+        self.m, self.q = m, q
+        self.Qx = _quad_planes(cost.Q, X.T)
+        self.R2 = 2.0 * cost.R[:, :, None]
+        self.g2P = 2.0 * cost.gamma**2 * cost.P[:, :, None]
+        self.p, self.L = p, basis.size
+        # products of inputs as features: X = Σ_k C_k · feature_k (one einsum per use)
+        self.u_pairs = [(a, b) for a in range(m) for b in range(a, m)]
+        self.w_pairs = [(a, b) for a in range(q) for b in range(a, q)]
+        self.Cu = np.stack([self.c0] + [self.c1[a] for a in range(m)]
+                           + [self.c2[a, b] * (0.5 if a == b else 1.0) for a, b in self.u_pairs])
+        self.Cww = np.stack([self.c2[m + a, m + b] * (0.5 if a == b else 1.0)
+                             for a, b in self.w_pairs])
+
+    def control_part(self, u):
+        """``u`` is laid out (m, p).
+
+        Per outer iteration: the coefficient planes of (27) as a polynomial in w.
+
+        Returns ``Cw`` (1 + q + q(q+1)/2, L, p) — the rows at w = 0, the linear and
+        the quadratic coefficients — and ``b1 = Cw[1:1+q]`` with
+        ``h'[∇J + ∇²J(f + g·u − x)] = W·b1``.
+        """
+        m, q = self.m, self.q
+        feats = np.empty((len(self.Cu), self.p))
+        feats[0] = 1.0
+        feats[1 : 1 + m] = u
+        for k, (a, b) in enumerate(self.u_pairs):
+            feats[1 + m + k] = u[a] * u[b]
+        Cw = np.empty((1 + q + len(self.w_pairs), self.L, self.p))
+        Cw[0] = np.einsum("klp,kp->lp", self.Cu, feats)
+        Cw[1 : 1 + q] = self.c1[m:] + np.einsum("aklp,kp->alp", self.c2[m:, :m], feats[1 : 1 + m])
+        Cw[1 + q :] = self.Cww
+        return Cw, Cw[1 : 1 + q]
+
+    def regression(self, Cw, w):
+        """Rows of (27) at (u, w) as an (L, p) array; ``w`` is (q, p)."""
+        q = self.q
+        feats = np.empty((len(Cw), self.p))
+        feats[0] = 1.0
+        feats[1 : 1 + q] = w
+        for k, (a, b) in enumerate(self.w_pairs):
+            feats[1 + q + k] = w[a] * w[b]
+        return np.einsum("klp,kp->lp", Cw, feats)
+
+    def disturbance_terms(self, W, b1):
+        """``h'[∇J + ∇²J(f + g·u − x)]`` (q, p) and ``Yw = h'∇²J h − 2γ²P`` (q, q, p)."""
+        m = self.m
+        return W @ b1, W @ self.c2[m:, m:] - self.g2P
+
+    def control_terms(self, W, w):
+        """``g'[∇J + ∇²J(f + h·w − x)]`` (m, p) and ``Yu = g'∇²J g + 2R`` (m, m, p)."""
+        m = self.m
+        rhs = W @ self.c1[:m] + ((W @ self.c2[:m, m:]) * w).sum(1)
+        return rhs, W @ self.c2[:m, :m] + self.R2
+
+
+_geqrf, _ormqr, _trtrs = get_lapack_funcs(("geqrf", "ormqr", "trtrs"), (np.zeros((2, 2)),))
+
+
+def _lstsq(At, b):
+    """Least squares ``A x ≈ b`` by Householder QR with normalized columns.
+
+    ``At`` is ``A`` transposed (L, p), so that ``At.T`` is Fortran-ordered for LAPACK.
+    Returns the solution (None if rank deficient) and the numerical rank.
+    """
+    norms = np.sqrt(np.einsum("lp,lp->l", At, At))
+    if not norms.min() > 0.0:
+        bad = np.flatnonzero(~(norms > 0)).tolist()
+        raise ParameterError("basis", bad, "these basis terms give zero (or non-finite) "
+                             "regression columns on the mesh (the mesh does not excite them): "
+                             "drop them or widen the mesh")
+    An = (At / norms[:, None]).T  # Fortran-ordered view
+    p, L = An.shape
+    qr, tau, _, info = _geqrf(An, overwrite_a=1)
+    diag = np.abs(qr.diagonal())
+    rank = int(np.count_nonzero(diag > diag.max() * p * _EPS))
+    if rank < L:
+        return None, rank
+    cq, _, info = _ormqr("L", "T", qr, tau, b[:, None], lwork=64 * L)
+    z, info = _trtrs(qr[:L, :L], cq[:L], lower=0)
+    return z[:, 0] / norms, rank
+
+
+_EPS = float(np.finfo(float).eps)
+
+
+def solve_hji(
+    system: ControlAffineSystem,
+    basis: PolynomialBasis,
+    cost: GameCost,
+    mesh,
+    initial_policy: Callable[[np.ndarray], np.ndarray],
+    settings: SolverSettings | None = None,
+    *,
+    problem: dict | None = None,
+    progress: Callable[[IterationRecord], None] | None = None,
+) -> GameController:
+    """Solve the approximate HJI equation by two-loop policy iteration.
+
+    Parameters
+    ----------
+    system : ControlAffineSystem
+    basis : PolynomialBasis
+        The cost approximation ``J = W'σ(x)``; no constant term.
+    cost : GameCost
+    mesh : GridMesh or PointMesh
+        Training points on Ω.
+    initial_policy : callable, (p, n) -> (p, m)
+        A stabilizing state feedback ``u⁽⁰⁾``.
+    settings : SolverSettings
+    problem : dict, optional
+        Extra description recorded in the controller (e.g. the preset name).
+    progress : callable, optional
+        Called with each :class:`IterationRecord` as it completes.
+
+    Returns
+    -------
+    GameController
+        With ``history`` (one :class:`IterationRecord` per outer iteration).
+
+    Raises
+    ------
+    GammaTooSmallError, ControlHessianError, ConvergenceError, InitialPolicyError,
+    NonFiniteError, ShapeError, ParameterError
+    """
+    settings = settings or SolverSettings()
+    if basis.n_states != system.n_states:
+        raise ShapeError("basis", (basis.size, basis.n_states), f"(L, {system.n_states})")
+    if mesh.n_states != system.n_states:
+        raise ShapeError("mesh", (mesh.n_states,), f"({system.n_states},) states")
+    if not isinstance(cost, GameCost):
+        raise ParameterError("cost", type(cost).__name__, "pass a GameCost")
+    X = np.asarray(mesh.points, float)
+    p = X.shape[0]
+    if p < basis.size:
+        raise ParameterError("mesh", f"{p} points", f"need at least {basis.size} points "
+                             f"(one per basis term): use a finer mesh")
+    t0 = time.perf_counter()
+    pr = _Problem(system, basis, cost, X)
+
+    u = np.asarray(initial_policy(X), float)
+    if u.shape != (p, system.n_controls):
+        raise ShapeError("initial_policy(x)", u.shape, f"({p}, {system.n_controls})")
+    if not np.all(np.isfinite(u)):
+        raise NonFiniteError("the initial policy gives NaN or inf on the mesh")
+    if settings.check_initial_policy:
+        rho = closed_loop_spectral_radius(system, initial_policy)
+        if rho >= 1.0:
+            raise InitialPolicyError(
+                f"the initial policy does not stabilize the system: the closed loop "
+                f"linearized at the origin has spectral radius {rho:.6f} ≥ 1. Policy "
+                "iteration needs a stabilizing (admissible) u⁽⁰⁾: use an LQR of the "
+                "linearization or a stabilizing nonlinear law."
+            )
+
+    m, q = system.n_controls, system.n_disturbances
+    history: list[IterationRecord] = []
+    W = np.zeros(basis.size)
+    u = np.ascontiguousarray(u.T)  # (m, p): per-point quantities are kept as planes
+    g2 = cost.gamma**2
+    for i in range(1, settings.max_outer + 1):
+        w = np.zeros((q, p))
+        base_Y = pr.Qx + _quad_planes(cost.R, u)
+        Cw, b1 = pr.control_part(u)
+        dws = []
+        for j in range(1, settings.max_inner + 1):
+            Xt = pr.regression(Cw, w)
+            Y = base_Y - g2 * _quad_planes(cost.P, w) if j > 1 else base_Y
+            W, rank = _lstsq(Xt, -Y)
+            if W is None:
+                raise ParameterError(
+                    "mesh", f"rank {rank} < {basis.size}",
+                    "the regression matrix (27) is rank deficient: the mesh cannot determine "
+                    "every weight; use a finer or wider mesh or a smaller basis")
+            # (23): Yw·w = −h'[∇J + ∇²J(f + g·u − x)]
+            rhs, Yw = pr.disturbance_terms(W, b1)
+            eYw = _extreme_eig(Yw, "max")
+            if not eYw.max() < 0:
+                k = int(np.argmax(np.nan_to_num(eYw, nan=np.inf)))
+                where = f" (outer iteration {i}, inner {j})"
+                if i == 1:
+                    where += (": the initial policy may attenuate disturbances less than "
+                              "gamma; a better initial policy may help")
+                raise GammaTooSmallError.from_mesh(
+                    cost.gamma, int((eYw >= 0).sum()), p, X[k], float(eYw[k]), where=where)
+            w_new = -_solve_planes(Yw, rhs)
+            dw = float(np.abs(w_new - w).max())
+            if not np.isfinite(dw):  # NaN anywhere in W or w propagates here
+                raise NonFiniteError(f"the weights or the disturbance became NaN/inf at outer "
+                                     f"iteration {i}, inner {j}")
+            dws.append(dw)
+            w = w_new
+            if dw <= settings.tol_w:
+                break
+        else:
+            raise ConvergenceError(
+                f"the inner (disturbance) loop did not converge in {settings.max_inner} "
+                f"iterations at outer iteration {i}: last max|Δw| = {dws[-1]:.3e} > δw = "
+                f"{settings.tol_w:g} (changes of the last iterations: "
+                f"{[f'{v:.2e}' for v in dws[-5:]]}). Raise max_inner, loosen tol_w, or "
+                "increase gamma.", history)
+        # (24) with the last J and w: Yu·u = −g'[∇J + ∇²J(f + h·w − x)]
+        rhs, Yu = pr.control_terms(W, w)
+        eYu = _extreme_eig(Yu, "min")
+        if not eYu.min() > 0:
+            k = int(np.argmin(eYu))
+            raise ControlHessianError(
+                f"Yu = g'∇²J g + 2R is not positive definite at {int((eYu <= 0).sum())} of "
+                f"{p} mesh points (worst at x = {X[k].tolist()}, eigenvalue {eYu[k]:.3g}) in "
+                f"outer iteration {i}: the fitted cost is not convex enough; increase R or "
+                "use a richer basis.")
+        u_new = -_solve_planes(Yu, rhs)
+        du = float(np.abs(u_new - u).max())
+        if not np.isfinite(du):
+            raise NonFiniteError(f"the control became NaN/inf at outer iteration {i}")
+        resid = Xt.T @ W + Y
+        rec = IterationRecord(
+            outer=i, inner=len(dws), max_du=du, max_dw=dws,
+            residual=float(np.linalg.norm(resid) / max(np.linalg.norm(Y), 1e-300)),
+            weights=W.copy(), min_J=float((pr.phi @ W).min()),
+            max_eig_Yw=float(eYw.max()), min_eig_Yu=float(eYu.min()))
+        history.append(rec)
+        if progress is not None:
+            progress(rec)
+        u = u_new
+        if du <= settings.tol_u:
+            break
+    else:
+        raise ConvergenceError(
+            f"the outer (control) loop did not converge in {settings.max_outer} iterations: "
+            f"last max|Δu| = {history[-1].max_du:.3e} > δu = {settings.tol_u:g} (changes of "
+            f"the last iterations: {[f'{r.max_du:.2e}' for r in history[-5:]]}). Raise "
+            "max_outer or loosen tol_u.", history)
+
+    elapsed = time.perf_counter() - t0
+    record = {
+        "model": _system_record(system),
+        "cost": cost.to_dict(),
+        "mesh": mesh.to_dict(),
+        "basis": basis.to_dict(),
+        "initial_policy": describe_policy(initial_policy),
+        "settings": settings.to_dict(),
+    }
+    if problem:
+        record.update(problem)
+    return GameController(system=system, basis=basis, weights=W, cost=cost, problem=record,
+                          history=history, train_seconds=elapsed)
+
+
+def _system_record(system):
+    try:
+        return system.to_dict()
+    except NotImplementedError:
+        return {"kind": system.kind, "serializable": False}
