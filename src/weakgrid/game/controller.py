@@ -152,6 +152,15 @@ class GameController:
         Yw = np.einsum("...ni,...nk,...kj->...ij", h, HJ, h) - 2 * self.cost.gamma**2 * self.cost.P
         return np.linalg.eigvalsh(Yu)[..., 0], np.linalg.eigvalsh(Yw)[..., -1]
 
+    def diagnostics(self, x) -> dict:
+        """The conditions of the method at states ``x`` (e.g. the mesh): Yu ≻ 0, Yw ≺ 0, J ≥ 0."""
+        eu, ew = self.block_eigenvalues(x)
+        J = self.value(x)
+        return {"min_eig_Yu": float(eu.min()), "max_eig_Yw": float(ew.max()),
+                "min_J": float(J.min()), "n_points": int(np.asarray(x).shape[0]),
+                "n_bad_Yu": int((eu <= 0).sum()), "n_bad_Yw": int((ew >= 0).sum()),
+                "n_negative_J": int((J < 0).sum())}
+
     # -------------------------------------------------------------- files
     def to_dict(self) -> dict:
         return {

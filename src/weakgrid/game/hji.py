@@ -257,11 +257,24 @@ class _Problem:
         Cw[0] = np.einsum("klp,kp->lp", self.Cu, feats)
         Cw[1 : 1 + q] = self.c1[m:] + np.einsum("aklp,kp->alp", self.c2[m:, :m], feats[1 : 1 + m])
         Cw[1 + q :] = self.Cww
-        return Cw, Cw[1 : 1 + q]
+        # column scales of the regression matrix for this outer iteration: the fit
+        # is done on normalized columns (for monomials this subsumes state scaling)
+        scale = np.sqrt(np.einsum("klp,klp->l", Cw, Cw))
+        if not scale.min() > 0.0:
+            bad = np.flatnonzero(~(scale > 0)).tolist()
+            raise ParameterError(
+                "basis", bad, "these basis terms give zero (or non-finite) regression columns "
+                "on the mesh (the mesh does not excite them): drop them or widen the mesh")
+        return Cw, Cw[1 : 1 + q], 1.0 / scale
 
-    def regression(self, Cw, w):
-        """Rows of (27) at (u, w) as an (L, p) array; ``w`` is (q, p)."""
+    def regression(self, Cw, w, col_scale=None):
+        """Rows of (27) at (u, w) as an (L, p) array; ``w`` is (q, p).
+
+        With ``col_scale`` (L,), column l of the result is multiplied by it.
+        """
         q = self.q
+        if col_scale is not None:
+            Cw = Cw * col_scale[:, None]
         feats = np.empty((len(Cw), self.p))
         feats[0] = 1.0
         feats[1 : 1 + q] = w
@@ -285,18 +298,13 @@ _geqrf, _ormqr, _trtrs = get_lapack_funcs(("geqrf", "ormqr", "trtrs"), (np.zeros
 
 
 def _lstsq(At, b):
-    """Least squares ``A x ≈ b`` by Householder QR with normalized columns.
+    """Least squares ``A x ≈ b`` by Householder QR (LAPACK geqrf/ormqr/trtrs).
 
-    ``At`` is ``A`` transposed (L, p), so that ``At.T`` is Fortran-ordered for LAPACK.
+    ``At`` is ``A`` transposed (L, p), C-ordered, so that ``At.T`` is Fortran-ordered
+    for LAPACK; it is overwritten. Columns should be normalized by the caller.
     Returns the solution (None if rank deficient) and the numerical rank.
     """
-    norms = np.sqrt(np.einsum("lp,lp->l", At, At))
-    if not norms.min() > 0.0:
-        bad = np.flatnonzero(~(norms > 0)).tolist()
-        raise ParameterError("basis", bad, "these basis terms give zero (or non-finite) "
-                             "regression columns on the mesh (the mesh does not excite them): "
-                             "drop them or widen the mesh")
-    An = (At / norms[:, None]).T  # Fortran-ordered view
+    An = At.T
     p, L = An.shape
     qr, tau, _, info = _geqrf(An, overwrite_a=1)
     diag = np.abs(qr.diagonal())
@@ -305,7 +313,7 @@ def _lstsq(At, b):
         return None, rank
     cq, _, info = _ormqr("L", "T", qr, tau, b[:, None], lwork=64 * L)
     z, info = _trtrs(qr[:L, :L], cq[:L], lower=0)
-    return z[:, 0] / norms, rank
+    return z[:, 0], rank
 
 
 _EPS = float(np.finfo(float).eps)
@@ -388,17 +396,19 @@ def solve_hji(
     for i in range(1, settings.max_outer + 1):
         w = np.zeros((q, p))
         base_Y = pr.Qx + _quad_planes(cost.R, u)
-        Cw, b1 = pr.control_part(u)
+        Cw, b1, cs = pr.control_part(u)
+        Cws = Cw * cs[:, None]  # planes with normalized columns
         dws = []
         for j in range(1, settings.max_inner + 1):
-            Xt = pr.regression(Cw, w)
+            Xt = pr.regression(Cws, w)  # normalized columns: weights are W/cs
             Y = base_Y - g2 * _quad_planes(cost.P, w) if j > 1 else base_Y
-            W, rank = _lstsq(Xt, -Y)
-            if W is None:
+            Ws, rank = _lstsq(Xt, -Y)
+            if Ws is None:
                 raise ParameterError(
                     "mesh", f"rank {rank} < {basis.size}",
                     "the regression matrix (27) is rank deficient: the mesh cannot determine "
                     "every weight; use a finer or wider mesh or a smaller basis")
+            W = Ws * cs
             # (23): Yw·w = −h'[∇J + ∇²J(f + g·u − x)]
             rhs, Yw = pr.disturbance_terms(W, b1)
             eYw = _extreme_eig(Yw, "max")
@@ -416,7 +426,7 @@ def solve_hji(
                 raise NonFiniteError(f"the weights or the disturbance became NaN/inf at outer "
                                      f"iteration {i}, inner {j}")
             dws.append(dw)
-            w = w_new
+            w_fit, w = w, w_new
             if dw <= settings.tol_w:
                 break
         else:
@@ -440,7 +450,7 @@ def solve_hji(
         du = float(np.abs(u_new - u).max())
         if not np.isfinite(du):
             raise NonFiniteError(f"the control became NaN/inf at outer iteration {i}")
-        resid = Xt.T @ W + Y
+        resid = pr.regression(Cw, w_fit).T @ W + Y  # of the last fit
         rec = IterationRecord(
             outer=i, inner=len(dws), max_du=du, max_dw=dws,
             residual=float(np.linalg.norm(resid) / max(np.linalg.norm(Y), 1e-300)),

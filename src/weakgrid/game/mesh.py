@@ -53,6 +53,10 @@ class GridMesh:
         object.__setattr__(self, "lower", tuple(lo.tolist()))
         object.__setattr__(self, "upper", tuple(hi.tolist()))
         object.__setattr__(self, "step", tuple(st.tolist()))
+        grids = np.meshgrid(*self.axes(), indexing="ij")
+        pts = np.stack([g.ravel() for g in grids], axis=-1)
+        pts.setflags(write=False)
+        object.__setattr__(self, "_points", pts)
 
     @property
     def n_states(self) -> int:
@@ -67,9 +71,8 @@ class GridMesh:
 
     @property
     def points(self) -> np.ndarray:
-        """All grid points, shape (p, n); the first state varies slowest."""
-        grids = np.meshgrid(*self.axes(), indexing="ij")
-        return np.stack([g.ravel() for g in grids], axis=-1)
+        """All grid points, shape (p, n); the first state varies slowest (read-only)."""
+        return self._points
 
     def corners_and_midpoints(self) -> np.ndarray:
         """The 3ⁿ − 1 corners, edge midpoints and face centres of the box (not its centre)."""

@@ -1,0 +1,98 @@
+"""``weakgrid train``: train the HJI controller of a preset or of a TOML problem file."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from ..game.hji import closed_loop_spectral_radius
+from ..models import load_preset, load_problem, preset_names
+
+NAME = "train"
+
+
+def add_parser(sub):
+    p = sub.add_parser(
+        NAME, help="train the HJI controller (two-loop policy iteration)",
+        description="Train the game-theoretic controller of a preset or a TOML problem file, "
+                    "print the iterations, the weights beside the published ones, timing and "
+                    "diagnostics, and write the controller file (JSON).",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--preset", choices=preset_names(), help="a shipped preset")
+    src.add_argument("--config", type=Path, help="a problem file (TOML), see the README")
+    p.add_argument("--output", "-o", type=Path, default=None,
+                   help="controller file to write (default: NAME.controller.json)")
+    p.add_argument("--tol", type=float, default=None,
+                   help="δu = δw (default: the problem's [solver] values)")
+    p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
+    p.set_defaults(func=run)
+    return p
+
+
+def _fmt_row(cells, widths):
+    return "  ".join(str(c).rjust(w) for c, w in zip(cells, widths))
+
+
+def run(args) -> int:
+    problem = load_preset(args.preset) if args.preset else load_problem(args.config)
+    settings = problem.settings
+    if args.tol is not None:
+        from dataclasses import replace
+
+        settings = replace(settings, tol_u=args.tol, tol_w=args.tol)
+    print(f"weakgrid train: {problem.name}  ({problem.source})")
+    print(f"  model   {problem.system!r}")
+    c = problem.cost
+    print(f"  cost    Q = {np.diag(c.Q).tolist()}, R = {np.diag(c.R).tolist()}, "
+          f"P = {np.diag(c.P).tolist()}, gamma = {c.gamma:g}")
+    mesh_n = problem.mesh.points.shape[0]
+    print(f"  mesh    {list(problem.mesh.lower)} .. {list(problem.mesh.upper)} step "
+          f"{list(problem.mesh.step)}  ({mesh_n} points);  basis {problem.basis.size} terms")
+    print(f"  solver  δu = {settings.tol_u:g}, δw = {settings.tol_w:g}")
+    if not args.quiet:
+        print("\n  outer  inner    max|Δu|     max|Δw| (last)   residual    min J     "
+              "max eig Yw  min eig Yu")
+
+    def progress(rec):
+        if not args.quiet:
+            print(f"  {rec.outer:5d}  {rec.inner:5d}  {rec.max_du:10.3e}  {rec.max_dw[-1]:12.3e}"
+                  f"     {rec.residual:9.2e}  {rec.min_J:9.3g}  {rec.max_eig_Yw:10.3g}  "
+                  f"{rec.min_eig_Yu:10.3g}")
+
+    ctl = problem.train(settings, progress=progress)
+    it = ctl.iterations
+    print(f"\n  converged: {it['outer']} outer iterations, at most {max(it['inner'])} inner "
+          f"({sum(it['inner'])} least-squares fits) in {ctl.train_seconds * 1e3:.1f} ms")
+
+    labels = ctl.basis.labels(problem.system.state_names)
+    pub = problem.published.get("weights")
+    print("\n  weights" + (f" beside the paper's {problem.published.get('equation', '')}"
+                           if pub else ""))
+    widths = (20, 12, 12, 12)
+    print("  " + _fmt_row(["term", "trained", "published", "rel.err"] if pub else
+                          ["term", "trained"], widths))
+    for k, (lab, w) in enumerate(zip(labels, ctl.weights)):
+        if pub:
+            pw = pub[k]
+            rel = f"{abs(w - pw) / abs(pw) * 100:.1f} %" if abs(pw) >= 0.01 else \
+                f"|Δ|={abs(w - pw):.4f}"
+            print("  " + _fmt_row([lab, f"{w:.4f}", f"{pw:.4f}", rel], widths))
+        else:
+            print("  " + _fmt_row([lab, f"{w:.6g}"], widths))
+
+    d = ctl.diagnostics(problem.mesh.points)
+    print("\n  diagnostics on the mesh")
+    print(f"    min eig Yu = {d['min_eig_Yu']:.4g} (> 0 {'ok' if d['min_eig_Yu'] > 0 else 'FAIL'})"
+          f";  max eig Yw = {d['max_eig_Yw']:.4g} (< 0 {'ok' if d['max_eig_Yw'] < 0 else 'FAIL'})"
+          f";  min J = {d['min_J']:.4g} (≥ 0 {'ok' if d['min_J'] >= 0 else 'FAIL'})")
+    rho = closed_loop_spectral_radius(problem.system, ctl.control)
+    print(f"    closed loop under u* linearized at 0: spectral radius {rho:.6f} "
+          f"({'stable' if rho < 1 else 'UNSTABLE'})")
+    print(f"    relative residual of the last fit: {ctl.history[-1].residual:.3e}")
+    out = args.output or Path(f"{problem.name}.controller.json")
+    ctl.save(out)
+    print(f"\n  wrote {out}")
+    return 0

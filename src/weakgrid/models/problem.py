@@ -1,0 +1,238 @@
+"""Training problems: a design model with the game settings, from a preset or a TOML file.
+
+A problem file has the tables ``[model]``, ``[cost]``, ``[mesh]``, ``[basis]``,
+``[initial_policy]`` and optionally ``[solver]``, ``[preset]`` and ``[published]``;
+see ``src/weakgrid/data/presets/case1-paper.toml`` for a complete example.
+
+``[model]`` kinds:
+
+* ``upqc-design`` — the calibrated form of (10): ``T, a, Vr_bar, phi_s0``;
+* ``gti`` — a GTI with dc link from physical data: ``C, tau, Vs, B, Vr_bar, T``,
+  ``chi`` and one of ``Pin`` / ``phi_s0`` (see :func:`gti_design_model`);
+* ``sg`` — a classical SG: ``H, E_prime, B, Vr_bar, T``, ``f_nominal`` and one of
+  ``Pm`` / ``delta0`` (see :func:`sg_design_model`);
+* ``linear`` — ``A, B, E`` matrices (for checks against the LQ game).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from ..game import (
+    GameController,
+    GameCost,
+    GridMesh,
+    LinearPolicy,
+    LinearSystem,
+    ParameterError,
+    SolverSettings,
+    even_monomials,
+    from_generator,
+    paper_basis,
+    solve_hji,
+)
+from ..game.bases import PolynomialBasis
+from .design import UPQCDesignModel, gti_design_model, sg_design_model
+from .policies import NonlinearInitialPolicy, lqr_policy
+
+__all__ = ["TrainingProblem", "preset_names", "load_preset", "load_problem", "problem_from_dict"]
+
+_SECTIONS = {"preset", "model", "cost", "mesh", "basis", "initial_policy", "solver", "published"}
+
+
+def preset_names() -> list[str]:
+    """Names of the shipped presets."""
+    folder = resources.files("weakgrid") / "data" / "presets"
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def _read_toml(path) -> dict:
+    try:
+        with open(path, "rb") as fh:
+            return tomllib.load(fh)
+    except FileNotFoundError:
+        raise FileNotFoundError(f"problem file {path} does not exist") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError("config", str(path), f"is not valid TOML ({exc})") from None
+
+
+def load_preset(name: str) -> "TrainingProblem":
+    """A shipped preset by name (``weakgrid train --preset NAME``)."""
+    names = preset_names()
+    if name not in names:
+        raise ParameterError("preset", name, f"unknown preset; choose one of {names}")
+    path = resources.files("weakgrid") / "data" / "presets" / f"{name}.toml"
+    with resources.as_file(path) as p:
+        return problem_from_dict(_read_toml(p), source=f"preset:{name}")
+
+
+def load_problem(path) -> "TrainingProblem":
+    """A user's problem from a TOML file (``weakgrid train --config FILE``)."""
+    return problem_from_dict(_read_toml(path), source=str(Path(path)))
+
+
+def _need(d: dict, key: str, section: str):
+    if key not in d:
+        raise ParameterError(f"{section}.{key}", None, f"missing: add `{key} = …` to [{section}]")
+    return d[key]
+
+
+def _num(d, key, section, default=None):
+    v = d.get(key, default) if default is not None else _need(d, key, section)
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{section}.{key}", v, "must be a number") from None
+    if not np.isfinite(v):
+        raise ParameterError(f"{section}.{key}", v, "must be finite")
+    return v
+
+
+def _check_keys(d: dict, allowed: set, section: str):
+    extra = set(d) - allowed
+    if extra:
+        raise ParameterError(f"{section}.{sorted(extra)[0]}", d[sorted(extra)[0]],
+                             f"unknown key; allowed in [{section}]: {sorted(allowed)}")
+
+
+def _model(d: dict):
+    kind = _need(d, "kind", "model")
+    if kind == "upqc-design":
+        _check_keys(d, {"kind", "T", "a", "Vr_bar", "phi_s0", "machine", "upqc", "source"},
+                    "model")
+        return UPQCDesignModel(_num(d, "T", "model"), _num(d, "a", "model"),
+                               _num(d, "Vr_bar", "model"), _num(d, "phi_s0", "model"),
+                               machine=d.get("machine", "gti"), upqc=d.get("upqc", "conventional"),
+                               source=d.get("source"))
+    if kind == "gti":
+        keys = {"C", "tau", "Vs", "B", "Vr_bar", "T", "chi", "Pin", "phi_s0"}
+        _check_keys(d, keys | {"kind", "upqc"}, "model")
+        kw = {k: _num(d, k, "model") for k in keys if k in d}
+        return gti_design_model(upqc=d.get("upqc", "conventional"), **kw)
+    if kind == "sg":
+        keys = {"H", "E_prime", "B", "Vr_bar", "T", "f_nominal", "Pm", "delta0"}
+        _check_keys(d, keys | {"kind"}, "model")
+        kw = {k: _num(d, k, "model") for k in keys if k in d}
+        return sg_design_model(**kw)
+    if kind == "linear":
+        _check_keys(d, {"kind", "A", "B", "E", "state_names"}, "model")
+        return LinearSystem(_need(d, "A", "model"), _need(d, "B", "model"),
+                            _need(d, "E", "model"), d.get("state_names"))
+    raise ParameterError("model.kind", kind, "use 'upqc-design', 'gti', 'sg' or 'linear'")
+
+
+def _basis(d: dict, n: int) -> PolynomialBasis:
+    kind = d.get("kind", "paper")
+    if kind == "paper":
+        if n != 2:
+            raise ParameterError("basis.kind", kind, "the paper's basis is for 2 states; use "
+                                 "'even' or 'generator'")
+        return paper_basis()
+    if kind == "even":
+        return even_monomials(n, int(_num(d, "degree", "basis")))
+    if kind == "generator":
+        return from_generator(n, d.get("powers", [2, 4]), d.get("coefficients"))
+    if kind == "custom":
+        return PolynomialBasis(np.asarray(_need(d, "exponents", "basis")), name="custom")
+    raise ParameterError("basis.kind", kind, "use 'paper', 'even', 'generator' or 'custom'")
+
+
+def _policy(d: dict, system):
+    kind = _need(d, "kind", "initial_policy")
+    if kind == "nonlinear-29":
+        if not isinstance(system, UPQCDesignModel):
+            raise ParameterError("initial_policy.kind", kind, "(29) needs a UPQC design model")
+        chi = float(system.source.get("chi", 0.0) or 0.0)
+        return NonlinearInitialPolicy.on_design_model(
+            system, _num(d, "gain", "initial_policy"), _num(d, "phase", "initial_policy"), chi)
+    if kind == "lqr":
+        return lqr_policy(system, _weight(d.get("Q", 0.01), system.n_states),
+                          _weight(d.get("R", 1.0), system.n_controls))
+    if kind == "linear":
+        return LinearPolicy(_need(d, "K", "initial_policy"))
+    raise ParameterError("initial_policy.kind", kind, "use 'nonlinear-29', 'lqr' or 'linear'")
+
+
+def _weight(v, k):
+    v = np.asarray(v, float)
+    return v * np.eye(k) if v.ndim == 0 else v
+
+
+@dataclass
+class TrainingProblem:
+    """Everything the solver needs, with its provenance.
+
+    Attributes
+    ----------
+    name : str
+    system : ControlAffineSystem
+    basis : PolynomialBasis
+    cost : GameCost
+    mesh : GridMesh
+    initial_policy : callable
+    settings : SolverSettings
+    published : dict
+        The paper's weights and iteration counts, if any.
+    raw : dict
+        The problem file as read.
+    """
+
+    name: str
+    system: object
+    basis: PolynomialBasis
+    cost: GameCost
+    mesh: GridMesh
+    initial_policy: object
+    settings: SolverSettings
+    published: dict = field(default_factory=dict)
+    raw: dict = field(default_factory=dict)
+    source: str = ""
+
+    def train(self, settings: SolverSettings | None = None, progress=None) -> GameController:
+        """Run the two-loop policy iteration (SPEC §3)."""
+        extra = {"name": self.name, "source": self.source}
+        if self.published:
+            extra["published"] = self.published
+        return solve_hji(self.system, self.basis, self.cost, self.mesh, self.initial_policy,
+                         settings or self.settings, problem=extra, progress=progress)
+
+    def with_gamma(self, gamma: float) -> "TrainingProblem":
+        c = self.cost
+        return TrainingProblem(self.name, self.system, self.basis,
+                               GameCost.for_system(self.system, c.Q, c.R, c.P, gamma), self.mesh,
+                               self.initial_policy, self.settings, self.published, self.raw,
+                               self.source)
+
+
+def problem_from_dict(d: dict, source: str = "") -> TrainingProblem:
+    """Build a :class:`TrainingProblem` from the tables of a problem file."""
+    extra = set(d) - _SECTIONS
+    if extra:
+        raise ParameterError(sorted(extra)[0], "…", f"unknown table; allowed: {sorted(_SECTIONS)}")
+    for sec in ("model", "cost", "mesh", "initial_policy"):
+        if sec not in d:
+            raise ParameterError(sec, None, f"missing table [{sec}]")
+    system = _model(d["model"])
+    c = d["cost"]
+    _check_keys(c, {"Q", "R", "P", "gamma"}, "cost")
+    cost = GameCost.for_system(system, _need(c, "Q", "cost"), _need(c, "R", "cost"),
+                               _need(c, "P", "cost"), _num(c, "gamma", "cost"))
+    m = d["mesh"]
+    _check_keys(m, {"lower", "upper", "step"}, "mesh")
+    mesh = GridMesh(_need(m, "lower", "mesh"), _need(m, "upper", "mesh"), _need(m, "step", "mesh"))
+    if mesh.n_states != system.n_states:
+        raise ParameterError("mesh.lower", list(mesh.lower),
+                             f"give one bound per state ({system.n_states})")
+    basis = _basis(d.get("basis", {}), system.n_states)
+    policy = _policy(d["initial_policy"], system)
+    s = d.get("solver", {})
+    _check_keys(s, {"tol_u", "tol_w", "max_outer", "max_inner"}, "solver")
+    settings = SolverSettings(**s)
+    name = d.get("preset", {}).get("name", Path(source).stem if source else "custom")
+    return TrainingProblem(name, system, basis, cost, mesh, policy, settings,
+                           d.get("published", {}), d, source)
