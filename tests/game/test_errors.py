@@ -16,9 +16,13 @@ def test_gamma_too_small_on_the_paper_model():
     with pytest.raises(GammaTooSmallError) as exc:
         p.train()
     e = exc.value
-    assert e.gamma == 0.5 and 1 <= e.n_bad <= e.n_points == 1156
-    assert e.worst_state.shape == (2,) and e.worst_eig >= 0
-    assert "of 1156 mesh points" in str(e) and "weakgrid gamma" in str(e)
+    assert e.gamma == 0.5 and "weakgrid gamma" in str(e)
+    # either Yw lost negativity (where, how many) or the inner loop stopped contracting
+    if e.n_bad is not None:
+        assert 1 <= e.n_bad <= e.n_points == 1156 and e.worst_state.shape == (2,)
+        assert "of 1156 mesh points" in str(e)
+    else:
+        assert "does not contract" in str(e) and "max|Δw|" in str(e)
 
 
 def test_no_convergence_reports_last_changes():

@@ -178,11 +178,16 @@ def _quad_planes(M, v):
 class _Problem:
     """Everything that does not change across iterations, evaluated once at the mesh.
 
-    With ``d = f(x) − x`` and ``Δx = d + g·u + h·w``, the regression row (27)
-    ``∇σ'Δx + ½Δx'∇²σΔx`` is a polynomial of degree two in (u, w) whose
-    coefficients per mesh point and basis term are fixed; so are the terms of
-    (23) and (24). Each iteration then only contracts these tables with the
-    current (u, w) and solves one least-squares problem.
+    With ``d = f(x) − x`` and ``v = g·u + h·w`` (the input's effect on the next
+    state), the regression row (27) is
+
+        ∇σ'(d + v) + ½(d + v)'∇²σ(d + v) = c0 + Σ_i A_i v_i + ½ Σ_ij D_ij v_i v_j,
+        c0 = ∇σ'd + ½ d'∇²σ d,  A_i = ∂_iσ + (∇²σ d)_i,  D_ij = ∂_ij σ,
+
+    a polynomial of degree two in v whose coefficient planes (L, p) are fixed. Only
+    the rows ``i`` that some input reaches ("live" rows, one for the paper's model)
+    take part. With ``Ws`` the weights, ``∇J + ∇²J d = Ws·A`` and ``∇²J = Ws·D``, so
+    the updates (23) and (24) need one matrix-vector product per fit.
     """
 
     def __init__(self, system, basis, cost, X):
@@ -199,121 +204,131 @@ class _Problem:
             raise ShapeError("control_directions(x)", G.shape, f"({p}, {n}, m)")
         if H.shape != (p, n, system.n_disturbances):
             raise ShapeError("disturbance_directions(x)", H.shape, f"({p}, {n}, q)")
-        n = X.shape[1]
+        m, q = G.shape[-1], H.shape[-1]
+        live = [i for i in range(n) if np.any(G[:, i]) or np.any(H[:, i])]
+        if not live:
+            raise ParameterError("control_directions", 0.0,
+                                 "no input reaches any state: nothing to optimize")
+        self.live, nl = live, len(live)
         mono = basis.planes(np.ascontiguousarray(X.T))  # (K, L, p)
         self.phi = mono[0].T
-        dphi = mono[1 : 1 + n]  # (n, L, p)
+        dphi = mono[1 : 1 + n]
         d2 = [[None] * n for _ in range(n)]
         for k_, (j, k) in enumerate(basis.second_derivative_pairs()):
             d2[j][k] = d2[k][j] = mono[1 + n + k_]
-        Ft = np.ascontiguousarray(F.T)  # (n, p)
-        Bd = np.ascontiguousarray(np.concatenate([G, H], axis=-1).transpose(1, 2, 0))  # (n, k, p)
-        live = [i for i in range(n) if np.any(Bd[i])]  # rows of B that are not zero
-        # rows of (27) as a polynomial in z = [u; w]:  X(z) = c0 + c1·z + ½ z'·c2·z,
-        # built plane by plane (L, p) — every product below is elementwise over the mesh
+        Ft = np.ascontiguousarray(F.T)
         d2F = [sum(d2[i][j] * Ft[j] for j in range(n)) for i in range(n)]  # ∇²σ(f − x)
         self.c0 = sum(dphi[i] * Ft[i] + 0.5 * d2F[i] * Ft[i] for i in range(n))
-        A = [dphi[i] + d2F[i] for i in range(n)]
-        k_in = Bd.shape[1]
-        zero = np.zeros_like(self.c0)
-        self.c1 = np.stack([sum((A[i] * Bd[i, a] for i in live), zero) for a in range(k_in)])
-        T = [[sum((Bd[i, a] * d2[i][j] for i in live), zero) for a in range(k_in)]
-             for j in range(n)]  # (∇²σ B)[j, a]
-        self.c2 = np.empty((k_in, k_in) + self.c0.shape)
-        for a in range(k_in):
-            for b in range(a, k_in):
-                self.c2[a, b] = sum((T[j][a] * Bd[j, b] for j in live), zero)
-                self.c2[b, a] = self.c2[a, b]
-        m, q = G.shape[-1], H.shape[-1]
-        self.m, self.q = m, q
+        self.A = np.stack([dphi[i] + d2F[i] for i in live])  # (nl, L, p)
+        self.D = np.stack([np.stack([d2[i][j] for j in live]) for i in live])  # (nl, nl, L, p)
+        self.G = np.ascontiguousarray(G[:, live].transpose(1, 2, 0))  # (nl, m, p)
+        self.H = np.ascontiguousarray(H[:, live].transpose(1, 2, 0))  # (nl, q, p)
+        self.m, self.q, self.nl = m, q, nl
+        self.pairs = [(i, j) for i in range(nl) for j in range(i, nl)]
         self.Qx = _quad_planes(cost.Q, X.T)
         self.R2 = 2.0 * cost.R[:, :, None]
         self.g2P = 2.0 * cost.gamma**2 * cost.P[:, :, None]
         self.p, self.L = p, basis.size
-        # products of inputs as features: X = Σ_k C_k · feature_k (one einsum per use)
-        self.u_pairs = [(a, b) for a in range(m) for b in range(a, m)]
-        self.w_pairs = [(a, b) for a in range(q) for b in range(a, q)]
-        self.Cu = np.stack([self.c0] + [self.c1[a] for a in range(m)]
-                           + [self.c2[a, b] * (0.5 if a == b else 1.0) for a, b in self.u_pairs])
-        self.Cww = np.stack([self.c2[m + a, m + b] * (0.5 if a == b else 1.0)
-                             for a, b in self.w_pairs])
 
-    def control_part(self, u):
-        """``u`` is laid out (m, p).
+    def set_column_scale(self, u):
+        """Fix the column scaling of the fit from the rows of (27) at (u, w = 0).
 
-        Per outer iteration: the coefficient planes of (27) as a polynomial in w.
-
-        Returns ``Cw`` (1 + q + q(q+1)/2, L, p) — the rows at w = 0, the linear and
-        the quadratic coefficients — and ``b1 = Cw[1:1+q]`` with
-        ``h'[∇J + ∇²J(f + g·u − x)] = W·b1``.
+        The planes are multiplied once by ``s_l = 1/‖column l‖`` and the iterations
+        work with the scaled weights ``Ws = W/s`` (for monomials a diagonal column
+        scaling is what scaling the states does: this is QR "on scaled states and
+        normalized columns", with the scales of the initial policy).
         """
-        m, q = self.m, self.q
-        feats = np.empty((len(self.Cu), self.p))
-        feats[0] = 1.0
-        feats[1 : 1 + m] = u
-        for k, (a, b) in enumerate(self.u_pairs):
-            feats[1 + m + k] = u[a] * u[b]
-        Cw = np.empty((1 + q + len(self.w_pairs), self.L, self.p))
-        Cw[0] = np.einsum("klp,kp->lp", self.Cu, feats)
-        Cw[1 : 1 + q] = self.c1[m:] + np.einsum("aklp,kp->alp", self.c2[m:, :m], feats[1 : 1 + m])
-        Cw[1 + q :] = self.Cww
-        # column scales of the regression matrix for this outer iteration: the fit
-        # is done on normalized columns (for monomials this subsumes state scaling)
-        scale = np.sqrt(np.einsum("klp,klp->l", Cw, Cw))
-        if not scale.min() > 0.0:
-            bad = np.flatnonzero(~(scale > 0)).tolist()
+        X0 = self.rows(np.stack([self.c0] + list(self.A)
+                                + [self.D[i, j] * (0.5 if i == j else 1.0)
+                                   for i, j in self.pairs]), self.input_effect(u, None))
+        norms = np.sqrt(np.einsum("lp,lp->l", X0, X0))
+        if not norms.min() > 0.0:
+            bad = np.flatnonzero(~(norms > 0)).tolist()
             raise ParameterError(
                 "basis", bad, "these basis terms give zero (or non-finite) regression columns "
                 "on the mesh (the mesh does not excite them): drop them or widen the mesh")
-        return Cw, Cw[1 : 1 + q], 1.0 / scale
+        s = 1.0 / norms
+        sc = s[:, None]
+        nl, L, p = self.nl, self.L, self.p
+        self.C = np.stack([self.c0 * sc] + [self.A[i] * sc for i in range(nl)]
+                          + [self.D[i, j] * sc * (0.5 if i == j else 1.0) for i, j in self.pairs])
+        # one (L, ·) matrix: Ws @ AD_L gives ∇J + ∇²J(f−x) on the live rows, then ∇²J
+        AD = np.concatenate([self.A.reshape(nl, L, p), self.D.reshape(nl * nl, L, p)]) * sc
+        self.AD_L = np.ascontiguousarray(AD.transpose(1, 0, 2)).reshape(L, -1)
+        self.phi_s = self.phi * s
+        return s
 
-    def regression(self, Cw, w, col_scale=None):
-        """Rows of (27) at (u, w) as an (L, p) array; ``w`` is (q, p).
+    def input_effect(self, u, w):
+        """``v = g·u + h·w`` on the live rows, (nl, p); ``u`` (m, p), ``w`` (q, p) or None."""
+        v = (self.G * u).sum(1)
+        if w is not None:
+            v = v + (self.H * w).sum(1)
+        return v
 
-        With ``col_scale`` (L,), column l of the result is multiplied by it.
-        """
-        q = self.q
-        if col_scale is not None:
-            Cw = Cw * col_scale[:, None]
-        feats = np.empty((len(Cw), self.p))
+    def rows(self, C, v):
+        """Rows of (27) (L, p) for the input effect ``v`` (nl, p)."""
+        feats = np.empty((len(C), self.p))
         feats[0] = 1.0
-        feats[1 : 1 + q] = w
-        for k, (a, b) in enumerate(self.w_pairs):
-            feats[1 + q + k] = w[a] * w[b]
-        return np.einsum("klp,kp->lp", Cw, feats)
+        feats[1 : 1 + self.nl] = v
+        for k, (i, j) in enumerate(self.pairs):
+            feats[1 + self.nl + k] = v[i] * v[j]
+        return np.einsum("klp,kp->lp", C, feats)
 
-    def disturbance_terms(self, W, b1):
-        """``h'[∇J + ∇²J(f + g·u − x)]`` (q, p) and ``Yw = h'∇²J h − 2γ²P`` (q, q, p)."""
-        m = self.m
-        return W @ b1, W @ self.c2[m:, m:] - self.g2P
+    def derivatives(self, Ws):
+        """``a = ∇J + ∇²J(f − x)`` (nl, p) and ``HJ = ∇²J`` (nl, nl, p) on the live rows."""
+        nl = self.nl
+        t = (Ws @ self.AD_L).reshape(nl + nl * nl, self.p)
+        return t[:nl], t[nl:].reshape(nl, nl, self.p)
 
-    def control_terms(self, W, w):
-        """``g'[∇J + ∇²J(f + h·w − x)]`` (m, p) and ``Yu = g'∇²J g + 2R`` (m, m, p)."""
-        m = self.m
-        rhs = W @ self.c1[:m] + ((W @ self.c2[:m, m:]) * w).sum(1)
-        return rhs, W @ self.c2[:m, :m] + self.R2
+    def best_disturbance_system(self, a, HJ, vu):
+        """(23): ``Yw`` (q, q, p) and ``h'[∇J + ∇²J(f + g·u − x)]`` (q, p)."""
+        Hd = self.H
+        HJH = (HJ[:, :, None, :] * Hd[None]).sum(1)  # (nl, q, p): ∇²J h
+        Yw = (Hd[:, :, None, :] * HJH[:, None, :, :]).sum(0) - self.g2P
+        grad = a + (HJ * vu[None]).sum(1)  # ∇J + ∇²J(f + g·u − x), (nl, p)
+        return Yw, (Hd * grad[:, None]).sum(0)
+
+    def best_control_system(self, a, HJ, vw):
+        """(24): ``Yu`` (m, m, p) and ``g'[∇J + ∇²J(f + h·w − x)]`` (m, p)."""
+        Gd = self.G
+        HJG = (HJ[:, :, None, :] * Gd[None]).sum(1)  # (nl, m, p)
+        Yu = (Gd[:, :, None, :] * HJG[:, None, :, :]).sum(0) + self.R2
+        grad = a + (HJ * vw[None]).sum(1)
+        return Yu, (Gd * grad[:, None]).sum(0)
 
 
 _geqrf, _ormqr, _trtrs = get_lapack_funcs(("geqrf", "ormqr", "trtrs"), (np.zeros((2, 2)),))
 
 
-def _lstsq(At, b):
+def _lstsq(At, b, check_rank=True):
     """Least squares ``A x ≈ b`` by Householder QR (LAPACK geqrf/ormqr/trtrs).
 
     ``At`` is ``A`` transposed (L, p), C-ordered, so that ``At.T`` is Fortran-ordered
     for LAPACK; it is overwritten. Columns should be normalized by the caller.
-    Returns the solution (None if rank deficient) and the numerical rank.
+
+    Returns
+    -------
+    x : ndarray (L,) or None
+        None if ``A`` is numerically rank deficient.
+    rank : int
+        The numerical rank (L unless ``check_rank`` found less).
+    residual : float
+        ``‖A x − b‖`` (from the QR factorization, no extra product).
     """
     An = At.T
     p, L = An.shape
     qr, tau, _, info = _geqrf(An, overwrite_a=1)
-    diag = np.abs(qr.diagonal())
-    rank = int(np.count_nonzero(diag > diag.max() * p * _EPS))
-    if rank < L:
-        return None, rank
+    rank = L
+    if check_rank:
+        diag = np.abs(qr.diagonal())
+        rank = int(np.count_nonzero(diag > diag.max() * p * _EPS))
+        if rank < L:
+            return None, rank, np.nan
     cq, _, info = _ormqr("L", "T", qr, tau, b[:, None], lwork=64 * L)
     z, info = _trtrs(qr[:L, :L], cq[:L], lower=0)
-    return z[:, 0], rank
+    if info > 0:  # an exactly zero pivot
+        return None, info - 1, np.nan
+    return z[:, 0], rank, float(np.sqrt(np.dot(cq[L:, 0], cq[L:, 0])))
 
 
 _EPS = float(np.finfo(float).eps)
@@ -390,27 +405,29 @@ def solve_hji(
 
     m, q = system.n_controls, system.n_disturbances
     history: list[IterationRecord] = []
-    W = np.zeros(basis.size)
     u = np.ascontiguousarray(u.T)  # (m, p): per-point quantities are kept as planes
     g2 = cost.gamma**2
+    cs = pr.set_column_scale(u)
     for i in range(1, settings.max_outer + 1):
         w = np.zeros((q, p))
         base_Y = pr.Qx + _quad_planes(cost.R, u)
-        Cw, b1, cs = pr.control_part(u)
-        Cws = Cw * cs[:, None]  # planes with normalized columns
+        vu = pr.input_effect(u, None)
         dws = []
         for j in range(1, settings.max_inner + 1):
-            Xt = pr.regression(Cws, w)  # normalized columns: weights are W/cs
-            Y = base_Y - g2 * _quad_planes(cost.P, w) if j > 1 else base_Y
-            Ws, rank = _lstsq(Xt, -Y)
+            vw = (pr.H * w).sum(1)
+            Xt = pr.rows(pr.C, vu + vw)  # scaled columns: the fit gives Ws = W/cs
+            Y = base_Y if j == 1 else base_Y - g2 * _quad_planes(cost.P, w)
+            # rank checked on the first fit of each outer iteration (the columns change
+            # little with w); an exactly singular R is caught at every fit
+            Ws, rank, res = _lstsq(Xt, -Y, check_rank=(j == 1))
             if Ws is None:
                 raise ParameterError(
                     "mesh", f"rank {rank} < {basis.size}",
                     "the regression matrix (27) is rank deficient: the mesh cannot determine "
                     "every weight; use a finer or wider mesh or a smaller basis")
-            W = Ws * cs
+            a, HJ = pr.derivatives(Ws)
             # (23): Yw·w = −h'[∇J + ∇²J(f + g·u − x)]
-            rhs, Yw = pr.disturbance_terms(W, b1)
+            Yw, rhs = pr.best_disturbance_system(a, HJ, vu)
             eYw = _extreme_eig(Yw, "max")
             if not eYw.max() < 0:
                 k = int(np.argmax(np.nan_to_num(eYw, nan=np.inf)))
@@ -426,9 +443,20 @@ def solve_hji(
                 raise NonFiniteError(f"the weights or the disturbance became NaN/inf at outer "
                                      f"iteration {i}, inner {j}")
             dws.append(dw)
-            w_fit, w = w, w_new
+            w = w_new
             if dw <= settings.tol_w:
                 break
+            if j >= 40 and min(dws[-10:]) >= min(dws[:-10]):
+                # for a fixed control the inner loop is a policy iteration of the
+                # maximizing player: it contracts when gamma exceeds the attenuation
+                # level of that control; no progress in 10 iterations means it does not
+                raise GammaTooSmallError(
+                    cost.gamma,
+                    f"the inner (disturbance) loop does not contract at outer iteration {i} "
+                    f"(max|Δw| of the last iterations: {[f'{v:.2e}' for v in dws[-5:]]}, "
+                    f"best {min(dws):.2e} after {j} iterations): gamma is below the "
+                    "attenuation level of the current control policy"
+                    + (" (the initial policy)" if i == 1 else ""))
         else:
             raise ConvergenceError(
                 f"the inner (disturbance) loop did not converge in {settings.max_inner} "
@@ -437,10 +465,11 @@ def solve_hji(
                 f"{[f'{v:.2e}' for v in dws[-5:]]}). Raise max_inner, loosen tol_w, or "
                 "increase gamma.", history)
         # (24) with the last J and w: Yu·u = −g'[∇J + ∇²J(f + h·w − x)]
-        rhs, Yu = pr.control_terms(W, w)
+        W = Ws * cs
+        Yu, rhs = pr.best_control_system(a, HJ, (pr.H * w).sum(1))
         eYu = _extreme_eig(Yu, "min")
         if not eYu.min() > 0:
-            k = int(np.argmin(eYu))
+            k = int(np.argmin(np.nan_to_num(eYu, nan=-np.inf)))
             raise ControlHessianError(
                 f"Yu = g'∇²J g + 2R is not positive definite at {int((eYu <= 0).sum())} of "
                 f"{p} mesh points (worst at x = {X[k].tolist()}, eigenvalue {eYu[k]:.3g}) in "
@@ -450,11 +479,10 @@ def solve_hji(
         du = float(np.abs(u_new - u).max())
         if not np.isfinite(du):
             raise NonFiniteError(f"the control became NaN/inf at outer iteration {i}")
-        resid = pr.regression(Cw, w_fit).T @ W + Y  # of the last fit
         rec = IterationRecord(
             outer=i, inner=len(dws), max_du=du, max_dw=dws,
-            residual=float(np.linalg.norm(resid) / max(np.linalg.norm(Y), 1e-300)),
-            weights=W.copy(), min_J=float((pr.phi @ W).min()),
+            residual=res / max(float(np.sqrt(np.dot(Y, Y))), 1e-300),
+            weights=W, min_J=float((pr.phi_s @ Ws).min()),
             max_eig_Yw=float(eYw.max()), min_eig_Yu=float(eYu.min()))
         history.append(rec)
         if progress is not None:
