@@ -283,6 +283,11 @@ class _Problem:
     def best_disturbance_system(self, a, HJ, vu):
         """(23): ``Yw`` (q, q, p) and ``h'[∇J + ∇²J(f + g·u − x)]`` (q, p)."""
         Hd = self.H
+        if self.nl == 1:  # one live row (e.g. a swing equation): scalar ∇²J
+            H0, h = HJ[0, 0], Hd[0]
+            grad = a[0] + H0 * vu[0]
+            Yw = (h[:, None] * h[None]) * H0 - self.g2P
+            return Yw, h * grad
         HJH = (HJ[:, :, None, :] * Hd[None]).sum(1)  # (nl, q, p): ∇²J h
         Yw = (Hd[:, :, None, :] * HJH[:, None, :, :]).sum(0) - self.g2P
         grad = a + (HJ * vu[None]).sum(1)  # ∇J + ∇²J(f + g·u − x), (nl, p)
@@ -291,6 +296,10 @@ class _Problem:
     def best_control_system(self, a, HJ, vw):
         """(24): ``Yu`` (m, m, p) and ``g'[∇J + ∇²J(f + h·w − x)]`` (m, p)."""
         Gd = self.G
+        if self.nl == 1:
+            H0, g = HJ[0, 0], Gd[0]
+            grad = a[0] + H0 * vw[0]
+            return (g[:, None] * g[None]) * H0 + self.R2, g * grad
         HJG = (HJ[:, :, None, :] * Gd[None]).sum(1)  # (nl, m, p)
         Yu = (Gd[:, :, None, :] * HJG[:, None, :, :]).sum(0) + self.R2
         grad = a + (HJ * vw[None]).sum(1)
@@ -416,7 +425,12 @@ def solve_hji(
         for j in range(1, settings.max_inner + 1):
             vw = (pr.H * w).sum(1)
             Xt = pr.rows(pr.C, vu + vw)  # scaled columns: the fit gives Ws = W/cs
-            Y = base_Y if j == 1 else base_Y - g2 * _quad_planes(cost.P, w)
+            if j == 1:
+                Y = base_Y
+            elif q == 1:
+                Y = base_Y - (g2 * cost.P[0, 0]) * (w[0] * w[0])
+            else:
+                Y = base_Y - g2 * _quad_planes(cost.P, w)
             # rank checked on the first fit of each outer iteration (the columns change
             # little with w); an exactly singular R is caught at every fit
             Ws, rank, res = _lstsq(Xt, -Y, check_rank=(j == 1))
