@@ -1,0 +1,142 @@
+"""Performance metrics of a simulated response (issue: case studies).
+
+All functions take sampled signals ``(t, y)`` with ``t`` in seconds. A response
+is measured from ``t_start`` (e.g. the fault clearance) against its final value
+``y_final`` (by default the mean over the last ``tail`` seconds).
+
+Definitions used throughout the reports:
+
+* **deviation** ``e(t) = y(t) − y_final``;
+* **overshoot** — the peak ``max |e(t)|`` after ``t_start`` (in the signal's unit
+  and, where a reference is given, in % of it): for a post-fault oscillation there
+  is no step, so the peak excursion is the overshoot;
+* **settling time (2 % band)** — the last time after ``t_start`` at which
+  ``|e(t)|`` exceeds 2 % of that peak, measured from ``t_start``;
+* **ITAE** — ``∫ (t − t_start)·|e(t)| dt`` (trapezoid rule);
+* **control cost** — ``Σ_k u_k'R u_k · T`` over the controller's samples;
+* **running cost of (18)** — ``Σ_{j≤k} x_j'Qx_j + u_j'Ru_j`` along the samples.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..game.errors import ParameterError, ShapeError
+
+__all__ = ["ResponseMetrics", "response_metrics", "settling_time", "itae", "control_cost",
+           "running_cost", "stability_verdict"]
+
+
+def _check(t, y):
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    if t.ndim != 1 or y.shape != t.shape:
+        raise ShapeError("y", y.shape, f"same shape as t {t.shape}")
+    if t.size < 2 or np.any(np.diff(t) <= 0):
+        raise ParameterError("t", "…", "time must increase strictly with at least two samples")
+    return t, y
+
+
+def _final(t, y, tail):
+    sel = t >= t[-1] - tail
+    return float(np.mean(y[sel]))
+
+
+def settling_time(t, y, t_start=0.0, band=0.02, y_final=None, tail=0.5) -> float:
+    """Last time after ``t_start`` where ``|y − y_final| > band·peak`` (s after t_start).
+
+    Returns ``nan`` if the response never settles inside the record (still
+    outside the band in the final ``tail`` seconds).
+    """
+    t, y = _check(t, y)
+    yf = _final(t, y, tail) if y_final is None else float(y_final)
+    sel = t >= t_start
+    e = np.abs(y[sel] - yf)
+    ts = t[sel]
+    if e.size == 0 or e.max() == 0:
+        return 0.0
+    thr = band * e.max()
+    out = np.flatnonzero(e > thr)
+    if out.size == 0:
+        return 0.0
+    last = out[-1]
+    if ts[last] >= t[-1] - tail:
+        return float("nan")
+    # interpolate the crossing between the last sample outside and the next one
+    if last + 1 < ts.size:
+        e0, e1 = e[last], e[last + 1]
+        frac = (e0 - thr) / (e0 - e1) if e0 != e1 else 0.0
+        return float(ts[last] + frac * (ts[last + 1] - ts[last]) - t_start)
+    return float(ts[last] - t_start)
+
+
+def itae(t, y, t_start=0.0, y_final=None, tail=0.5) -> float:
+    """``∫ (t − t_start)·|y − y_final| dt`` from ``t_start`` (trapezoid rule)."""
+    t, y = _check(t, y)
+    yf = _final(t, y, tail) if y_final is None else float(y_final)
+    sel = t >= t_start
+    tt = t[sel] - t_start
+    return float(np.trapezoid(tt * np.abs(y[sel] - yf), tt))
+
+
+def control_cost(u, R, T) -> float:
+    """``Σ_k u_k'R u_k · T`` for controller samples ``u`` (N, m) held for ``T`` s."""
+    u = np.atleast_2d(np.asarray(u, float))
+    R = np.atleast_2d(np.asarray(R, float))
+    if R.shape == (1, 1):
+        R = R[0, 0] * np.eye(u.shape[1])
+    return float(np.einsum("ki,ij,kj->", u, R, u) * T)
+
+
+def running_cost(x, u, Q, R) -> np.ndarray:
+    """Cumulative ``Σ_{j≤k} x_j'Qx_j + u_j'Ru_j`` along the samples (N,)."""
+    x = np.atleast_2d(np.asarray(x, float))
+    u = np.atleast_2d(np.asarray(u, float))
+    return np.cumsum(np.einsum("ki,ij,kj->k", x, Q, x) + np.einsum("ki,ij,kj->k", u, R, u))
+
+
+def stability_verdict(t, y, t_start=0.0, tail=1.0, settled_fraction=0.05) -> str:
+    """'stable' if the oscillation in the last ``tail`` seconds is below
+    ``settled_fraction`` of the peak after ``t_start`` and decaying; 'unstable' if
+    it grows; 'undamped' otherwise (sustained oscillation)."""
+    t, y = _check(t, y)
+    sel = t >= t_start
+    tt, yy = t[sel], y[sel]
+    if not np.all(np.isfinite(yy)):
+        return "unstable"
+    yf = _final(tt, yy, tail)
+    e = np.abs(yy - yf)
+    peak = e.max()
+    if peak == 0:
+        return "stable"
+    late = e[tt >= tt[-1] - tail]
+    prev = e[(tt >= tt[-1] - 2 * tail) & (tt < tt[-1] - tail)]
+    amp_late = late.max()
+    amp_prev = prev.max() if prev.size else peak
+    if amp_late <= settled_fraction * peak:
+        return "stable"
+    if amp_late > 1.2 * amp_prev:
+        return "unstable"
+    return "undamped" if amp_late > 0.8 * amp_prev else "stable"
+
+
+@dataclass
+class ResponseMetrics:
+    """Metrics of one signal's response (see the module docstring)."""
+
+    peak_deviation: float
+    settling_time: float
+    itae: float
+    final_value: float
+    verdict: str
+
+
+def response_metrics(t, y, t_start=0.0, tail=0.5) -> ResponseMetrics:
+    t, y = _check(t, y)
+    yf = _final(t, y, tail)
+    sel = t >= t_start
+    return ResponseMetrics(float(np.max(np.abs(y[sel] - yf))), settling_time(t, y, t_start,
+                           tail=tail), itae(t, y, t_start, tail=tail), yf,
+                           stability_verdict(t, y, t_start, tail=max(tail, 1.0)))
