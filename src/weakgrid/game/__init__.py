@@ -21,6 +21,15 @@ from .hji import IterationRecord, SolverSettings, closed_loop_spectral_radius, s
 from .lq import LQGameSolution, LQRError, attenuation_limit, dlqr, solve_game_riccati
 from .mesh import GridMesh, PointMesh, mesh_from_dict
 from .policies import LinearPolicy
+from .rollout import Rollout, rollout
 from .system import ControlAffineSystem, FunctionSystem, LinearSystem, register_system
 
-__all__ = [name for name in dir() if not name.startswith("_")]
+__all__ = [
+    "PolynomialBasis", "even_monomials", "from_generator", "paper_basis", "quadratic_basis",
+    "GameController", "load_controller", "GameCost", "ControlHessianError", "ConvergenceError",
+    "GammaTooSmallError", "InitialPolicyError", "NonFiniteError", "ParameterError", "ShapeError",
+    "WeakgridError", "IterationRecord", "SolverSettings", "closed_loop_spectral_radius",
+    "solve_hji", "LQGameSolution", "LQRError", "attenuation_limit", "dlqr",
+    "solve_game_riccati", "GridMesh", "PointMesh", "mesh_from_dict", "LinearPolicy", "Rollout",
+    "rollout", "ControlAffineSystem", "FunctionSystem", "LinearSystem", "register_system",
+]
