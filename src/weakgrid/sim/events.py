@@ -37,6 +37,13 @@ class _FaultSwitch(Event):
     def apply(self, sim):
         s = sim.sys
         b = s.network.index_of(self.owner.bus)
+        nx = s.nx
+        if self.on:
+            self.owner._y_pre = sim.z[nx:].copy()
+        elif getattr(self.owner, "_y_pre", None) is not None:
+            # as ANDES: start the post-clearing network solution from the pre-fault voltages
+            sim.z = sim.z.copy()
+            sim.z[nx:] = self.owner._y_pre
         s.fault_shunt[b] += self.owner.y if self.on else -self.owner.y
         if not self.on and abs(s.fault_shunt[b]) < 1e-9:
             s.fault_shunt[b] = 0.0

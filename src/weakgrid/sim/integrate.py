@@ -125,19 +125,27 @@ class Simulator:
     def solve_algebraic(self, t, z, max_iter=30):
         """Re-solve the network (algebraic) variables with the states fixed."""
         nx = self.nx
+        z_start = z.copy()
         z = z.copy()
-        for attempt in range(2):
+        for attempt in range(3):
+            if attempt == 2:
+                z = z_start.copy()
+            if attempt:
+                self._refresh_jacobian(t, z)
             lu = self._alg_lu_get()
-            for _ in range(max_iter):
+            damp = 1.0 if attempt < 2 else 0.5
+            for it in range(max_iter):
+                if attempt and it and it % 3 == 0:   # full Newton on retries
+                    self._refresh_jacobian(t, z)
+                    lu = self._alg_lu_get()
                 F, ctx = self.sys.residual(t, z)
                 self.stats["evals"] += 1
                 dy = sla.lu_solve(lu, F[nx:], check_finite=False)
-                z[nx:] -= dy
+                z[nx:] -= damp * dy
                 if not np.all(np.isfinite(z)):
                     break
                 if np.max(np.abs(dy)) < self.tol:
                     return z
-            self._refresh_jacobian(t, z)
         raise SimulationError(t, "newton", "algebraic re-initialization after an event did not converge")
 
     def _newton(self, t1, h, z_n, f_n, z):
@@ -263,6 +271,7 @@ class Simulator:
         if self._Jdev is None:
             self._refresh_jacobian(self.t, self.z)
             self.z = self.solve_algebraic(self.t, self.z)
+        F, self._ctx = sys.residual(self.t, self.z)
         for c in controllers:
             if c.due(self.t):
                 c.sample(self, self.t, self.z)
@@ -292,18 +301,20 @@ class Simulator:
                     self._check()
                 hit = abs(self.t - tb) <= eps * max(1.0, abs(tb)) * 10
                 discont = False
+                new_jac = False
                 if hit:
                     self.t = tb
                     rec.add(self.t, self.z, self._ctx)
                     while ev_i < len(events) and events[ev_i].t <= self.t + 1e-12:
                         events[ev_i].apply(self)
                         ev_i += 1
-                        discont = True
+                        discont = new_jac = True
                     for c in controllers:
                         if c.due(self.t):
                             discont |= c.sample(self, self.t, self.z)
                     if discont:
-                        self._refresh_jacobian(self.t, self.z)
+                        if new_jac:
+                            self._refresh_jacobian(self.t, self.z)
                         self.z = self.solve_algebraic(self.t, self.z)
                         F, self._ctx = sys.residual(self.t, self.z)
                         self._f = F[:self.nx].copy()

@@ -175,8 +175,6 @@ class System:
         if power_flow or net.pf is None:
             net.solve_power_flow()
         gen_used = {}
-        for model, name in self._machines:
-            pass
         self.comps = sorted(self.components.values(), key=lambda c: c.order)
         nm = len(self._machines)
         self.sig_defaults = {k: np.zeros(nm) for k in SIGNALS}
@@ -184,7 +182,7 @@ class System:
             c.setup(self)
         # one machine per static generator
         for c in self.comps:
-            if c.kind == "machine":
+            if c.kind == "machine" or (c.kind == "device" and hasattr(c, "gen")):
                 for i, g in enumerate(c.gen):
                     if g in gen_used:
                         raise DataError(c.element(i), "gen", int(g), f"gen row already used by {gen_used[g]}")
