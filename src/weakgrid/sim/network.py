@@ -237,9 +237,9 @@ class Network:
     @classmethod
     def from_pandapower(cls, net) -> "Network":
         """Build a :class:`Network` from a pandapower network (via ``pandapower.converter.to_ppc``)."""
-        import pandapower.converter as pc
+        from pandapower.converter.pypower import to_ppc
 
-        ppc = pc.to_ppc(net, init="flat", calculate_voltage_angles=True, trafo_model="pi")
+        ppc = to_ppc(net, init="flat", calculate_voltage_angles=True, trafo_model="pi")
         bus = np.asarray(ppc["bus"])[:, :13].copy()
         gen = np.asarray(ppc["gen"])[:, :21].copy()
         branch = np.asarray(ppc["branch"])[:, :13].real.copy()
