@@ -1,0 +1,82 @@
+"""Benchmark of weakgrid.sim (not a test: prints medians, asserts nothing).
+
+1. kundur_full (ANDES stock case) with a 3-phase fault at bus 8, 1.0-1.05 s, trip disabled, 10 s:
+   weakgrid and ANDES in the same run, each at the largest step whose speeds stay within
+   2e-4 pu of its own converged solution (reference: step 1/480 s); median wall time of 3 runs.
+2. Throughput of 100 fault scenarios on a GTI + UPQC + SG grid (5 s each).
+
+Run:  PYTHONPATH=src python benchmarks/bench_sim.py
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "sim"))
+
+from weakgrid.sim.peer.andes_runs import compare, run_andes, run_weakgrid  # noqa: E402
+
+CASE = "kundur/kundur_full.xlsx"
+FAULT = dict(fault=(8, 1.0, 1.05), disable_toggles=True)
+STEPS = [1 / 5, 1 / 10, 1 / 15, 1 / 20, 1 / 30, 1 / 60, 1 / 120]
+
+
+def largest_ok_step(run, ref, **kw):
+    for h in STEPS:
+        try:
+            r = run(CASE, 10.0, h, **FAULT, **kw)
+        except Exception:
+            continue
+        if r["ok"] and r["t"][-1] > 9.999 and compare(r, ref)[0] < 2e-4:
+            return h, r
+    return None, None
+
+
+def median_wall(run, h, n=3, **kw):
+    return statistics.median(run(CASE, 10.0, h, **FAULT, **kw)["wall"] for _ in range(n))
+
+
+def kundur():
+    print("== kundur_full, fault at bus 8 (1.0-1.05 s), 10 s ==")
+    out = {}
+    for name, run, kw in (("weakgrid", run_weakgrid, dict(tol=1e-5)), ("ANDES", run_andes, dict(tol=1e-4))):
+        ref = run(CASE, 10.0, 1 / 480, **FAULT, **kw)
+        h, r = largest_ok_step(run, ref, **kw)
+        wall = median_wall(run, h, **kw)
+        err = compare(r, ref)[0]
+        out[name] = wall
+        print(f"{name:9s} step 1/{1 / h:.0f} s  speed error vs own 1/480-s solution {err:.2e} pu  "
+              f"median wall {wall * 1e3:.1f} ms")
+    print(f"speed-up weakgrid vs ANDES: {out['ANDES'] / out['weakgrid']:.2f}x")
+
+
+def scenarios(n=100):
+    from sim_cases import build_gti_upqc_sg
+
+    from weakgrid.sim.events import Fault
+    from weakgrid.sim.integrate import Simulator
+
+    rng = np.random.default_rng(0)
+    t0 = time.perf_counter()
+    ok = 0
+    for k in range(n):
+        s = build_gti_upqc_sg("reduced" if k % 2 else "conventional")
+        bus = int(rng.integers(1, 4))
+        ton = 0.2
+        toff = ton + float(rng.uniform(0.03, 0.15))
+        xf = float(rng.uniform(0.02, 0.2))
+        r = Simulator(s, dt=5e-3, tol=1e-6).run(5.0, events=[Fault(bus, ton, toff, xf=xf)], on_failure="return")
+        ok += r.ok
+    wall = time.perf_counter() - t0
+    print(f"== {n} fault scenarios, GTI + UPQC + SG grid, 5 s each, dt 5 ms ==")
+    print(f"total {wall:.2f} s, {n / wall:.1f} runs/s, {ok}/{n} completed")
+
+
+if __name__ == "__main__":
+    kundur()
+    scenarios()

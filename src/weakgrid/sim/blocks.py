@@ -1,0 +1,260 @@
+"""Reusable, vectorized control blocks.
+
+Each block acts on arrays (one entry per device instance) and is described by
+three pure functions of its state ``x`` and input ``u``:
+
+* ``init(u0)`` -> initial state for a steady input ``u0``,
+* ``output(x, u)`` -> block output ``y``,
+* ``deriv(x, u)`` -> ``dx/dt``.
+
+Time constants equal to zero bypass the dynamics (the block becomes a static
+gain), as in PSS/E and ANDES. Blocks with *non-windup* limits (PSS/E
+convention: the state itself is held at its limit while the input pushes it
+outward) expose ``lower``/``upper`` arrays; the integrator enforces them on
+the state (see :mod:`weakgrid.sim.integrate`).
+
+All times are in seconds; signals are in per unit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def _safe(T):
+    T = np.asarray(T, dtype=float)
+    return np.where(T > 0, T, 1.0)
+
+
+class Lag:
+    r"""First-order lag :math:`K/(1+sT)`.
+
+    Parameters
+    ----------
+    K : array_like
+        Gain [pu/pu].
+    T : array_like
+        Time constant [s]; ``T = 0`` makes the block a pure gain.
+    """
+
+    nx = 1
+
+    def __init__(self, K, T):
+        self.K = np.asarray(K, dtype=float)
+        self.T = np.asarray(T, dtype=float)
+        self._on = self.T > 0
+        self._Ts = _safe(self.T)
+
+    def init(self, u0):
+        return self.K * u0
+
+    def output(self, x, u):
+        return np.where(self._on, x, self.K * u)
+
+    def deriv(self, x, u):
+        return np.where(self._on, (self.K * u - x) / self._Ts, 0.0)
+
+
+class LagNonWindup(Lag):
+    r"""First-order lag :math:`K/(1+sT)` whose state is held in ``[lower, upper]`` (non-windup).
+
+    Parameters
+    ----------
+    K, T : array_like
+        Gain [pu/pu] and time constant [s] (must be > 0).
+    lower, upper : array_like
+        State (= output) limits [pu].
+    """
+
+    def __init__(self, K, T, lower, upper):
+        super().__init__(K, T)
+        self.lower = np.asarray(lower, dtype=float)
+        self.upper = np.asarray(upper, dtype=float)
+
+    def output(self, x, u):
+        return x
+
+
+class LeadLag:
+    r"""Lead-lag :math:`K(1+sT_1)/(1+sT_2)`.
+
+    State ``x`` obeys :math:`T_2\dot x = u - x` and the output is
+    :math:`y = K[(T_1/T_2)(u - x) + x]`. With ``T2 = 0`` the block is the gain ``K``.
+
+    Parameters
+    ----------
+    T1, T2 : array_like
+        Lead and lag time constants [s].
+    K : array_like, optional
+        Gain, default 1.
+    """
+
+    nx = 1
+
+    def __init__(self, T1, T2, K=1.0):
+        self.T1 = np.asarray(T1, dtype=float)
+        self.T2 = np.asarray(T2, dtype=float)
+        self.K = np.broadcast_to(np.asarray(K, dtype=float), self.T2.shape)
+        self._on = self.T2 > 0
+        self._T2s = _safe(self.T2)
+
+    def init(self, u0):
+        return np.asarray(u0, dtype=float) * 1.0
+
+    def output(self, x, u):
+        return self.K * np.where(self._on, self.T1 / self._T2s * (u - x) + x, u)
+
+    def deriv(self, x, u):
+        return np.where(self._on, (u - x) / self._T2s, 0.0)
+
+
+class Washout:
+    r"""Washout (high-pass) :math:`sK/(1+sT)`.
+
+    State ``x`` obeys :math:`T\dot x = u - x`, output :math:`y = (K/T)(u - x)`.
+    The classical washout :math:`sT/(1+sT)` is obtained with ``K = T``
+    (ANDES/PSS/E naming). ``T = 0`` gives a zero output.
+
+    Parameters
+    ----------
+    K : array_like
+        Gain [pu·s].
+    T : array_like
+        Time constant [s].
+    """
+
+    nx = 1
+
+    def __init__(self, K, T):
+        self.K = np.asarray(K, dtype=float)
+        self.T = np.asarray(T, dtype=float)
+        self._on = self.T > 0
+        self._Ts = _safe(self.T)
+
+    def init(self, u0):
+        return np.asarray(u0, dtype=float) * 1.0
+
+    def output(self, x, u):
+        return np.where(self._on, self.K / self._Ts * (u - x), 0.0)
+
+    def deriv(self, x, u):
+        return np.where(self._on, (u - x) / self._Ts, 0.0)
+
+
+class Integrator:
+    r"""Integrator :math:`K/s`, output = state.
+
+    Parameters
+    ----------
+    K : array_like
+        Gain [1/s].
+    """
+
+    nx = 1
+
+    def __init__(self, K):
+        self.K = np.asarray(K, dtype=float)
+
+    def output(self, x, u=None):
+        return x
+
+    def deriv(self, x, u):
+        return self.K * u
+
+
+class PINonWindup:
+    r"""PI controller :math:`K_p + K_i/s` with non-windup output limits.
+
+    The integrator state is held in ``[lower, upper]`` by the integrator
+    (non-windup) and the output :math:`y = K_p u + x` is clipped to the same range.
+
+    Parameters
+    ----------
+    Kp : array_like
+        Proportional gain [pu/pu].
+    Ki : array_like
+        Integral gain [1/s].
+    lower, upper : array_like
+        Output limits [pu].
+    """
+
+    nx = 1
+
+    def __init__(self, Kp, Ki, lower, upper):
+        self.Kp = np.asarray(Kp, dtype=float)
+        self.Ki = np.asarray(Ki, dtype=float)
+        self.lower = np.asarray(lower, dtype=float)
+        self.upper = np.asarray(upper, dtype=float)
+
+    def init(self, y0, u0=0.0):
+        return np.asarray(y0, dtype=float) - self.Kp * u0
+
+    def output(self, x, u):
+        return np.clip(self.Kp * u + x, self.lower, self.upper)
+
+    def deriv(self, x, u):
+        return self.Ki * u
+
+
+class PID:
+    r"""PID controller :math:`K_p + K_i/s + K_d s/(1+sT_d)` (no limits).
+
+    States: integrator ``xi`` and derivative-filter state ``xd``
+    (:math:`T_d\dot x_d = u - x_d`, derivative output :math:`K_d(u-x_d)/T_d`).
+
+    Parameters
+    ----------
+    kp, ki, kd : array_like
+        Gains [pu/pu], [1/s], [s].
+    Td : array_like
+        Derivative filter time constant [s] (> 0).
+    """
+
+    nx = 2
+
+    def __init__(self, kp, ki, kd, Td):
+        self.kp = np.asarray(kp, dtype=float)
+        self.ki = np.asarray(ki, dtype=float)
+        self.kd = np.asarray(kd, dtype=float)
+        self.Td = _safe(Td)
+
+    def output(self, xi, xd, u):
+        return self.kp * u + xi + self.kd * (u - xd) / self.Td
+
+    def deriv(self, xi, xd, u):
+        return self.ki * u, (u - xd) / self.Td
+
+
+def quad_saturation_coeffs(E1, SE1, E2, SE2):
+    r"""Coefficients ``(A, B)`` of the quadratic saturation :math:`S(x) = B(x-A)^2/x` for ``x > A``.
+
+    The curve passes through ``(E1, SE1)`` and ``(E2, SE2)``. Following the
+    ANDES ``ExcQuadSat`` convention, saturation is disabled (``B = 0``) when
+    ``SE1 = 0`` or ``E1 = 0`` (and ``SE2 = 0`` is corrected to keep the
+    expressions finite).
+
+    Parameters
+    ----------
+    E1, SE1, E2, SE2 : array_like
+        Saturation points [pu] and values [pu/pu].
+
+    Returns
+    -------
+    A, B : ndarray
+    """
+    E1, SE1, E2, SE2 = (np.asarray(v, dtype=float) for v in (E1, SE1, E2, SE2))
+    z2 = (SE2 != 0).astype(float)
+    E2c = E2 + 2 * (1 - z2)
+    SE2c = SE2 + 2 * (1 - z2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = (SE2c != 0) * np.sqrt(np.abs(SE1 * E1 / (SE2c * E2c)))
+        A = E2c - (E1 - E2c) / (a - 1)
+        B = np.where(a != 0, SE2c * E2c * (a - 1) ** 2 / (E1 - E2c) ** 2, 0.0)
+    A = np.where(np.isfinite(A), A, 0.0)
+    B = np.where(np.isfinite(B), B, 0.0)
+    return A, B
+
+
+def quad_saturation(x, A, B):
+    r"""Quadratic saturation product :math:`x\,S(x) = B(x-A)^2` for ``x >= A`` else 0."""
+    return np.where(x >= A, B * (x - A) ** 2, 0.0)

@@ -1,0 +1,157 @@
+"""Base class of vectorized component models and the evaluation context.
+
+A *component type* (e.g. :class:`~weakgrid.sim.machines.genrou.GENROU`) holds
+all instances of that model in the system and evaluates them together with
+numpy. States are laid out state-major, so state ``k`` of all instances is the
+contiguous slice ``x[off + k*n : off + (k+1)*n]``.
+
+Evaluation happens in two passes over all components (see
+:meth:`weakgrid.sim.system.System.evaluate`):
+
+1. ``compute(ctx)`` in the order machines/sources → PSS → exciters/governors →
+   series devices: each component reads the states, bus voltages and the
+   signals already published by earlier components, publishes its own output
+   signals (e.g. ``vf``, ``tm``) and writes the derivatives it can already form;
+2. ``finish(ctx)``: derivatives that need signals published later (e.g. the
+   machine's field and shaft equations, which need ``vf`` and ``tm``).
+
+Signals between the parts of a generator (machine + shaft + AVR + governor +
+PSS) are arrays indexed by the global machine number, in ``ctx.sig``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import DataError
+from .params import Param, validate
+
+
+class Context:
+    """Scratch data for one evaluation of the system equations.
+
+    Attributes
+    ----------
+    t : float
+        Time [s].
+    x : ndarray
+        State vector.
+    V : ndarray of complex
+        Bus voltage phasors [pu].
+    f : ndarray
+        Output: state derivatives.
+    I : ndarray of complex
+        Output: current injected into each bus by the devices [pu].
+    sig : dict of ndarray
+        Machine-indexed signals (``omega``, ``delta``, ``Pe``, ``Qe``, ``Vt``,
+        ``XadIfd``, ``vf``, ``tm``, ``vs``) and other shared signals.
+    out : dict of ndarray
+        Recorded outputs, keyed ``"<Type>.<output>"``.
+    """
+
+    __slots__ = ("t", "x", "V", "f", "I", "sig", "out", "system")
+
+    def __init__(self, system, t, x, V):
+        self.system = system
+        self.t = t
+        self.x = x
+        self.V = V
+        self.f = np.zeros_like(x)
+        self.I = np.zeros(V.shape, dtype=complex)
+        self.sig = {k: v.copy() for k, v in system.sig_defaults.items()}
+        self.out = {}
+
+
+class Component:
+    """Base class of a vectorized component type.
+
+    Class attributes to define in subclasses
+    ----------------------------------------
+    kind : str
+        ``"machine"``, ``"pss"``, ``"exciter"``, ``"governor"`` or ``"device"``.
+    order : int
+        Position in the ``compute`` pass (lower first).
+    params : tuple of Param
+        Declared parameters (standard PSS/E / ANDES names).
+    states : tuple of str
+        State names.
+    outputs : tuple of str
+        Names of recorded algebraic outputs (set in ``ctx.out``).
+    """
+
+    kind = "device"
+    order = 0
+    params: tuple[Param, ...] = ()
+    states: tuple[str, ...] = ()
+    outputs: tuple[str, ...] = ()
+    #: physical unit class of each state/output for SI conversion (default "pu")
+    units: dict[str, str] = {}
+
+    def __init__(self):
+        self.names: list[str] = []
+        self.links: list[dict] = []
+        self._values: list[dict] = []
+        self.n = 0
+        self.off = 0
+        self.p: dict[str, np.ndarray] = {}
+
+    @property
+    def type_name(self) -> str:
+        return type(self).__name__
+
+    def element(self, i_or_name) -> str:
+        name = self.names[i_or_name] if isinstance(i_or_name, (int, np.integer)) else i_or_name
+        return f"{self.type_name} '{name}'"
+
+    def add(self, name: str, link: dict, values: dict):
+        """Register one instance; ``values`` are validated against :attr:`params`."""
+        if name in self.names:
+            raise DataError(self.element(name), "name", name, "names must be unique within a model type")
+        self._values.append(validate(self.element(name), self.params, values))
+        self.names.append(name)
+        self.links.append(dict(link))
+        self.n = len(self.names)
+
+    # ------------------------------------------------------------------ setup
+    def setup(self, system):
+        """Build parameter arrays (system base). Subclasses extend with link resolution."""
+        self.p = {p.name: np.array([v[p.name] for v in self._values], dtype=float) for p in self.params}
+
+    def assign(self, off: int) -> int:
+        """Reserve state indices starting at ``off``; return the next free index."""
+        self.off = off
+        return off + self.n * len(self.states)
+
+    def sl(self, k: int) -> slice:
+        """Slice of state number ``k`` (all instances) in the state vector."""
+        return slice(self.off + k * self.n, self.off + (k + 1) * self.n)
+
+    def idx(self, state: str) -> np.ndarray:
+        """Global indices of ``state`` for all instances."""
+        k = self.states.index(state)
+        return np.arange(self.off + k * self.n, self.off + (k + 1) * self.n)
+
+    def instance_states(self, i: int) -> list[int]:
+        """Global state indices of instance ``i``."""
+        return [self.off + k * self.n + i for k in range(len(self.states))]
+
+    def limits(self) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """Non-windup limited states: list of ``(global_indices, lower, upper)``."""
+        return []
+
+    # -------------------------------------------------------------- equations
+    def init(self, system, x: np.ndarray, sig: dict):
+        """Set initial states in ``x`` from the power flow and published signals."""
+
+    def compute(self, ctx: Context):
+        """First evaluation pass (outputs, signals, derivatives where possible)."""
+
+    def finish(self, ctx: Context):
+        """Second evaluation pass (derivatives needing later signals)."""
+
+    def pattern(self, system):
+        """Jacobian coupling groups: list of ``(rows, cols)`` global index lists.
+
+        Default: handled by the system (grouped with the linked machine).
+        """
+        return None

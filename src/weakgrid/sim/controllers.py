@@ -1,0 +1,155 @@
+"""Digital controllers: ``u = K(measurements)`` sampled every ``T`` with zero-order hold.
+
+A :class:`DigitalController` samples at ``t0 + k*T`` (exact breakpoints of the
+integrator), computes ``u = K(m)`` from a measurement function, checks it
+(finite, right size) and holds it on its target until the next sample. Outside
+its enable windows (e.g. bypassed during a fault) it outputs ``bypass``.
+
+Measurements of the paper's design states from the simulated grid
+(:func:`gti_design_states`, :func:`sg_design_states`) return ``[phi_hat, upsilon]``:
+
+* GTI: ``phi_hat`` = inverter angle w.r.t. the UPQC shunt bus minus ``phi_s0``;
+  ``upsilon = tau*(Vc^2 - Vc0^2)/2`` from the dc-link energy;
+* SG (classical-model analogue): ``phi_hat`` = rotor angle w.r.t. the UPQC
+  shunt bus minus its initial value; ``upsilon`` = speed error ``omega - 1`` [pu].
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .errors import DataError, SimulationError
+
+
+class UPQCTarget:
+    """Apply ``u = [Vup, Vuq]`` [pu] to UPQC ``name``."""
+
+    size = 2
+
+    def __init__(self, name):
+        self.name = name
+
+    def bind(self, system):
+        up = system.components.get("UPQC")
+        if up is None or self.name not in up.names:
+            raise DataError(f"UPQCTarget '{self.name}'", "name", self.name, "no UPQC with that name")
+        self.upqc = up
+        self.i = up.names.index(self.name)
+
+    def get(self):
+        return np.array([self.upqc.u_p[self.i], self.upqc.u_q[self.i]])
+
+    def apply(self, u):
+        self.upqc.u_p[self.i], self.upqc.u_q[self.i] = float(u[0]), float(u[1])
+
+
+def gti_design_states(gti_name):
+    """Measurement function returning ``[phi_hat, upsilon]`` of GTI ``gti_name`` (see module docstring)."""
+
+    def measure(sim, t, z, ctx):
+        g = sim.sys.components["GTI"]
+        i = g.names.index(gti_name)
+        phi = ctx.out["GTI.phi_s"][i] - g.phi0[i]
+        return np.array([phi, ctx.out["GTI.upsilon"][i]])
+
+    return measure
+
+
+def sg_design_states(machine_name, upqc_bus):
+    """Measurement ``[delta - theta_r - (delta0 - theta_r0), omega - 1]`` of a machine vs. the UPQC shunt bus."""
+
+    def measure(sim, t, z, ctx):
+        s = sim.sys
+        m = s.machine_number(machine_name)
+        b = s.network.index_of(upqc_bus)
+        th = float(np.angle(ctx.V[b]))
+        th0 = float(np.angle(s.network.pf.V[b]))
+        d = ctx.sig["delta"][m] - th - (s.sig_defaults["delta0"][m] - th0)
+        return np.array([d, ctx.sig["omega"][m] - 1.0])
+
+    return measure
+
+
+class DigitalController:
+    """Sampled controller with zero-order hold and enable windows.
+
+    Parameters
+    ----------
+    K : callable
+        ``u = K(m)``; ``m`` is the measurement vector, ``u`` an array of ``target.size``.
+    T : float
+        Sampling period [s].
+    measure : callable
+        ``m = measure(sim, t, z, ctx)``.
+    target : object
+        Where ``u`` goes (e.g. :class:`UPQCTarget`).
+    enable : list of (t_start, t_end) or callable or None
+        When the controller is active; otherwise it outputs ``bypass`` (default: always).
+    bypass : array_like
+        Output while disabled (default zeros).
+    name : str
+        Used in error messages.
+    t0 : float
+        First sampling instant [s].
+    """
+
+    def __init__(self, K, T, measure, target, enable=None, bypass=None, name="controller", t0=0.0):
+        if not (T > 0 and math.isfinite(T)):
+            raise DataError(f"DigitalController '{name}'", "T", T, "sampling period must be a positive number of seconds")
+        self.K, self.T, self.measure, self.target = K, float(T), measure, target
+        self.enable, self.name, self.t0 = enable, name, float(t0)
+        self.bypass = None if bypass is None else np.asarray(bypass, float)
+        self.k = 0
+        self.log_t, self.log_u = [], []
+
+    def bind(self, system):
+        self.target.bind(system)
+        if self.bypass is None:
+            self.bypass = np.zeros(self.target.size)
+        self.k = 0
+
+    def active(self, t):
+        if self.enable is None:
+            return True
+        if callable(self.enable):
+            return bool(self.enable(t))
+        return any(a <= t < b for a, b in self.enable)
+
+    def _tk(self, k):
+        return self.t0 + k * self.T
+
+    def next_time(self, t):
+        while self._tk(self.k) < t - 1e-12:
+            self.k += 1
+        tk = self._tk(self.k)
+        return tk if tk > t + 1e-12 else self._tk(self.k + 1)
+
+    def due(self, t):
+        while self._tk(self.k) < t - 1e-12:
+            self.k += 1
+        return abs(self._tk(self.k) - t) <= 1e-9
+
+    def sample(self, sim, t, z):
+        """Compute and hold a new output; returns True if it changed."""
+        if self.active(t):
+            m = self.measure(sim, t, z, sim._ctx)
+            try:
+                u = np.asarray(self.K(m), dtype=float).reshape(-1)
+            except Exception as exc:
+                raise SimulationError(t, "controller", f"'{self.name}' raised {exc!r}") from exc
+            if u.shape != (self.target.size,) or not np.all(np.isfinite(u)):
+                raise SimulationError(t, "controller",
+                                      f"'{self.name}' returned {u.tolist()} for measurements {np.asarray(m).tolist()}; "
+                                      f"expected {self.target.size} finite values")
+        else:
+            u = self.bypass
+        self.k += 1
+        old = self.target.get()
+        self.log_t.append(t)
+        self.log_u.append(u.copy())
+        if np.array_equal(old, u):
+            return False
+        self.target.apply(u)
+        return True

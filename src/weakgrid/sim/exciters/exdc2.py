@@ -1,0 +1,100 @@
+"""EXDC2: IEEE type DC2 exciter (PSS/E EXDC2, ANDES conventions).
+
+Block diagram (signals in pu, times in s)::
+
+    v --[Lag 1/(1+sTR)]--> LS
+    vi = vref - LS - W + vs                   (vs: PSS output, 0 without PSS)
+    vi --[LeadLag (1+sTC)/(1+sTB)]--> LL
+    LL --[Lag KA/(1+sTA), non-windup VRMIN..VRMAX]--> vr
+    TE dvp/dt = vr - KE*vp - B*(vp - A)^2       (saturation active when omega*vp >= A)
+    vp --[Washout s*KF1/(1+sTF1)]--> W        (rate feedback)
+    vf = omega * vp
+
+Saturation ``A, B`` from ``(E1, SE1)``, ``(E2, SE2)`` by
+:func:`~weakgrid.sim.blocks.quad_saturation_coeffs`. ``vref`` is set at
+initialization so that the initial field voltage is the machine's ``vf0``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..blocks import Lag, LagNonWindup, LeadLag, Washout, quad_saturation, quad_saturation_coeffs
+from ..control_base import MachineControl
+from ..params import Param
+
+
+class EXDC2(MachineControl):
+    """IEEE DC2 exciter. Parameters: TR, TA, TC, TB, TE, TF1 [s]; KA, KE, KF1 [pu];
+    VRMAX, VRMIN [pu]; E1, SE1, E2, SE2 (saturation) [pu]."""
+
+    kind = "exciter"
+    order = 2
+    params = (
+        Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
+        Param("TA", 0.04, "s", "regulator time constant", "pos"),
+        Param("TC", 1.0, "s", "lead time constant", "nonneg"),
+        Param("TB", 1.0, "s", "lag time constant", "nonneg"),
+        Param("TE", 0.8, "s", "exciter time constant", "pos"),
+        Param("TF1", 1.0, "s", "rate feedback time constant", "pos"),
+        Param("KF1", 0.03, "pu", "rate feedback gain", "nonneg"),
+        Param("KA", 40.0, "pu", "regulator gain", "pos"),
+        Param("KE", 1.0, "pu", "exciter constant", ""),
+        Param("VRMAX", 7.3, "pu", "regulator upper limit", ""),
+        Param("VRMIN", -7.3, "pu", "regulator lower limit", ""),
+        Param("E1", 0.0, "pu", "first saturation point", "nonneg"),
+        Param("SE1", 0.0, "pu", "saturation at E1", "nonneg"),
+        Param("E2", 1.0, "pu", "second saturation point", "nonneg"),
+        Param("SE2", 1.0, "pu", "saturation at E2", "nonneg"),
+    )
+    states = ("LS", "LL", "VR", "vp", "W")
+    outputs = ("vi", "vref", "vout")
+
+    def setup(self, system):
+        super().setup(system)
+        p = self.p
+        self.LS = Lag(1.0, p["TR"])
+        self.LL = LeadLag(p["TC"], p["TB"])
+        self.LA = LagNonWindup(p["KA"], p["TA"], p["VRMIN"], p["VRMAX"])
+        self.W = Washout(p["KF1"], p["TF1"])
+        self.SA, self.SB = quad_saturation_coeffs(p["E1"], p["SE1"], p["E2"], p["SE2"])
+
+    def limits(self):
+        return [(self.idx("VR"), self.p["VRMIN"], self.p["VRMAX"])]
+
+    def init(self, system, x, sig):
+        p = self.p
+        vf0 = sig["vf0"][self.mach]
+        v = sig["Vt0"][self.mach]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            Se0 = np.where(vf0 > self.SA, self.SB * (self.SA - vf0) ** 2 / vf0, 0.0)
+        vr0 = (p["KE"] + Se0) * vf0
+        vb0 = vr0 / p["KA"]
+        self.vref0 = v + vb0
+        x[self.sl(0)] = self.LS.init(v)
+        x[self.sl(1)] = self.LL.init(vb0)
+        x[self.sl(2)] = vr0
+        x[self.sl(3)] = vf0
+        x[self.sl(4)] = self.W.init(vf0)
+
+    def compute(self, ctx):
+        p = self.p
+        x = ctx.x
+        m = self.mach
+        ls, ll, vr, vp, w = (x[self.sl(k)] for k in range(5))
+        v = ctx.sig["Vt"][m]
+        omega = ctx.sig["omega"][m]
+        W = self.W.output(w, vp)
+        vi = self.vref0 - self.LS.output(ls, v) - W + ctx.sig["vs"][m]
+        vll = self.LL.output(ll, vi)
+        vout = omega * vp
+        sat = np.where(vout >= self.SA, quad_saturation(vp, self.SA, self.SB), 0.0)
+        f = ctx.f
+        f[self.sl(0)] = self.LS.deriv(ls, v)
+        f[self.sl(1)] = self.LL.deriv(ll, vi)
+        f[self.sl(2)] = self.LA.deriv(vr, vll)
+        f[self.sl(3)] = (vr - p["KE"] * vp - sat) / p["TE"]
+        f[self.sl(4)] = self.W.deriv(w, vp)
+        ctx.sig["vf"][m] = vout
+        o = ctx.out
+        o["EXDC2.vi"], o["EXDC2.vref"], o["EXDC2.vout"] = vi, self.vref0 + 0 * vi, vout

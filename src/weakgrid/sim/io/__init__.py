@@ -1,0 +1,1 @@
+"""Importers: MATPOWER cases and ANDES systems."""

@@ -1,0 +1,91 @@
+"""Common part of synchronous machine models: links, per-unit bases, terminal quantities."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..component import Component
+from ..errors import DataError
+from ..network import GEN_BUS, GEN_STATUS
+from ..params import Param
+
+BASE_PARAMS = (
+    Param("Sn", 100.0, "MVA", "machine power rating", "pos"),
+    Param("Vn", 0.0, "kV", "machine voltage rating (0: bus base kV)", "nonneg"),
+    Param("fn", 60.0, "Hz", "rated frequency", "pos"),
+    Param("M", 6.0, "s (machine base)", "inertia constant M = 2H", "pos", "power"),
+    Param("D", 0.0, "pu (machine base)", "damping coefficient", "nonneg", "power"),
+    Param("ra", 0.0, "pu (machine base)", "armature resistance", "nonneg", "z"),
+    Param("xd1", 0.302, "pu (machine base)", "d-axis transient reactance x'd", "pos", "z"),
+)
+
+
+class SyncMachine(Component):
+    """Base of synchronous machines.
+
+    Each instance is linked to one row ``gen`` of the network's gen table and
+    replaces that static generator in the time domain. Parameters are on the
+    machine base (``Sn``, ``Vn``) and converted to the system base on setup.
+
+    Signals published (machine-indexed): ``omega``, ``delta``, ``Pe``, ``Qe``,
+    ``Vt`` (terminal voltage magnitude), ``theta`` (terminal voltage angle),
+    ``XadIfd``; defaults for ``vf`` and ``tm`` are the initial values (used when
+    no exciter/governor is attached).
+    """
+
+    kind = "machine"
+    order = 0
+    units = {"delta": "angle", "omega": "speed", "Pe": "power", "Qe": "power", "te": "power",
+             "tm": "power", "Id": "current", "Iq": "current"}
+
+    def setup(self, system):
+        super().setup(system)
+        net = system.network
+        n = self.n
+        self.gen = np.zeros(n, dtype=int)
+        self.bus = np.zeros(n, dtype=int)
+        for i, link in enumerate(self.links):
+            g = link.get("gen")
+            if g is None or not (0 <= int(g) < net.gen.shape[0]):
+                raise DataError(self.element(i), "gen", g,
+                                f"give the 0-based row of the gen table (0..{net.gen.shape[0] - 1})")
+            g = int(g)
+            if net.gen[g, GEN_STATUS] <= 0:
+                raise DataError(self.element(i), "gen", g, "this generator is out of service; set GEN_STATUS = 1")
+            self.gen[i] = g
+            self.bus[i] = net.index_of(int(net.gen[g, GEN_BUS]), self.element(i), "gen bus")
+        Sb = system.Sb
+        Vb = net.base_kv[self.bus]
+        Vn = np.where(self.p["Vn"] > 0, self.p["Vn"], Vb)
+        Sn = self.p["Sn"]
+        coeff = {"z": (Vn ** 2 / Sn) / (Vb ** 2 / Sb), "power": Sn / Sb, "ipower": Sb / Sn}
+        for prm in self.params:
+            if prm.base:
+                self.p[prm.name] = self.p[prm.name] * coeff[prm.base]
+        self.wb = 2 * np.pi * self.p["fn"]
+        self.m = np.array([system.machine_number(nm) for nm in self.names], dtype=int)
+
+    def pattern(self, system):
+        return None  # grouped with its controls by the system
+
+    @staticmethod
+    def dq_voltage(V, delta):
+        """d/q components of the terminal voltage: ``vd = v sin(delta-theta)``, ``vq = v cos(delta-theta)``."""
+        s, c = np.sin(delta), np.cos(delta)
+        return V.real * s - V.imag * c, V.real * c + V.imag * s
+
+    @staticmethod
+    def network_current(Id, Iq, delta):
+        """Current phasor injected into the bus: ``(Id + j Iq) * exp(j(delta - pi/2))``."""
+        return (Id + 1j * Iq) * (np.sin(delta) - 1j * np.cos(delta))
+
+    def publish(self, ctx, omega, delta, Pe, Qe, V, XadIfd):
+        m = self.m
+        sig = ctx.sig
+        sig["omega"][m] = omega
+        sig["delta"][m] = delta
+        sig["Pe"][m] = Pe
+        sig["Qe"][m] = Qe
+        sig["Vt"][m] = np.abs(V)
+        sig["theta"][m] = np.angle(V)
+        sig["XadIfd"][m] = XadIfd

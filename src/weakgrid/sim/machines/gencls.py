@@ -1,0 +1,87 @@
+"""GENCLS: classical machine, constant voltage behind the transient reactance.
+
+Equations (system base, ANDES ``GENCLS`` with ``Flux0``)::
+
+    vd = v sin(delta - theta),  vq = v cos(delta - theta)
+    0 = xd1*Id + ra*Iq - (vf - vq)          (d axis, internal emf E' = vf)
+    0 = -ra*Id + xd1*Iq - vd                (q axis)
+    te = (vq + ra*Iq)*Iq + (vd + ra*Id)*Id
+    shaft: see :mod:`weakgrid.sim.machines.shaft`
+
+``vf`` is held at its initial value unless an exciter is attached.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..params import Param
+from .base import BASE_PARAMS, SyncMachine
+from .shaft import swing
+
+
+def solve_stator(psi2d, psi2q, vd, vq, ra, xd2, xq2):
+    """Solve the two algebraic stator equations for ``(Id, Iq)`` [pu, system base].
+
+    ``xd2*Id + ra*Iq = psi2d - vq`` and ``-ra*Id + xq2*Iq = vd - psi2q``.
+    """
+    det = xd2 * xq2 + ra * ra
+    a = psi2d - vq
+    b = vd - psi2q
+    return (xq2 * a - ra * b) / det, (xd2 * b + ra * a) / det
+
+
+class GENCLS(SyncMachine):
+    """Classical machine model (PSS/E and ANDES ``GENCLS``).
+
+    Parameters (machine base unless stated)
+    ----------------------------------------
+    Sn [MVA], Vn [kV], fn [Hz], M = 2H [s], D [pu], ra [pu], xd1 = x'd [pu].
+    """
+
+    params = BASE_PARAMS
+    states = ("delta", "omega")
+    outputs = ("Pe", "Qe", "te", "Id", "Iq", "vf")
+
+    def init(self, system, x, sig):
+        pf = system.network.pf
+        V = pf.V[self.bus]
+        S = pf.Pg[self.gen] + 1j * pf.Qg[self.gen]
+        I = np.conj(S / V)
+        ra, xq = self.p["ra"], self.p["xd1"]
+        E = V + I * (ra + 1j * xq)
+        delta = np.angle(E)
+        vd, vq = self.dq_voltage(V, delta)
+        Idq = I * np.exp(1j * (0.5 * np.pi - delta))
+        Id, Iq = Idq.real, Idq.imag
+        vf0 = vq + ra * Iq + xq * Id
+        tm0 = (vq + ra * Iq) * Iq + (vd + ra * Id) * Id
+        x[self.sl(0)] = delta
+        x[self.sl(1)] = 1.0
+        system.set_machine_initial(self.m, vf0=vf0, tm0=tm0, XadIfd=vf0, Pe=S.real, Qe=S.imag,
+                                   delta=delta, V=V)
+
+    def compute(self, ctx):
+        x = ctx.x
+        delta, omega = x[self.sl(0)], x[self.sl(1)]
+        V = ctx.V[self.bus]
+        vd, vq = self.dq_voltage(V, delta)
+        ra, xq = self.p["ra"], self.p["xd1"]
+        vf = ctx.sig["vf"][self.m]
+        Id, Iq = solve_stator(vf, 0.0, vd, vq, ra, xq, xq)
+        ctx.I[self.bus] += self.network_current(Id, Iq, delta)
+        Pe = vd * Id + vq * Iq
+        Qe = vq * Id - vd * Iq
+        self._te = (vq + ra * Iq) * Iq + (vd + ra * Id) * Id
+        self.publish(ctx, omega, delta, Pe, Qe, V, vf)
+        o = ctx.out
+        o["GENCLS.Pe"], o["GENCLS.Qe"], o["GENCLS.te"] = Pe, Qe, self._te
+        o["GENCLS.Id"], o["GENCLS.Iq"] = Id, Iq
+
+    def finish(self, ctx):
+        omega = ctx.x[self.sl(1)]
+        tm = ctx.sig["tm"][self.m]
+        ctx.out["GENCLS.vf"] = ctx.sig["vf"][self.m]
+        d_delta, d_omega = swing(omega, tm, self._te, self.p["M"], self.p["D"], self.wb)
+        ctx.f[self.sl(0)] = d_delta
+        ctx.f[self.sl(1)] = d_omega

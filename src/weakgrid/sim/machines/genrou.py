@@ -1,0 +1,163 @@
+"""GENROU: round-rotor machine with quadratic saturation (PSS/E GENROU as in ANDES).
+
+Equations on the system base (ANDES ``GENROU`` with ``Flux0``; sub-transient
+reactances must be equal, ``xd2 == xq2``)::
+
+    gd1 = (xd2-xl)/(xd1-xl)      gq1 = (xq2-xl)/(xq1-xl)
+    gd2 = (xd1-xd2)/(xd1-xl)^2   gq2 = (xq1-xq2)/(xq1-xl)^2   gqd = (xq-xl)/(xd-xl)
+    psi2d = gd1*e1q + gd2*(xd1-xl)*e2d          (d-axis air-gap flux)
+    psi2q = gq1*e1d + (1-gq1)*e2q               (q-axis air-gap flux)
+    psi2  = |psi2d + j psi2q|,  Se = B*(psi2-A)^2/psi2 for psi2 >= A
+    stator: xd2*Id + ra*Iq = psi2d - vq,  -ra*Id + xq2*Iq = vd - psi2q
+    XadIfd = e1q + (xd-xd1)*(gd1*Id - gd2*e2d + gd2*e1q) + Se*psi2d
+    XaqI1q = e1d + (xq-xq1)*(gq2*e1d - gq2*e2q - gq1*Iq) + Se*gqd*psi2q
+    Td10 de1q/dt = vf - XadIfd
+    Tq10 de1d/dt = -XaqI1q
+    Td20 de2d/dt = -e2d + e1q - (xd1-xl)*Id
+    Tq20 de2q/dt = -e2q + e1d + (xq1-xl)*Iq
+    te = psid*Iq - psiq*Id, psid = ra*Iq + vq, psiq = -(ra*Id + vd)
+
+Saturation coefficients ``A, B`` come from ``(1.0, S10)`` and ``(1.2, S12)``
+through :func:`weakgrid.sim.blocks.quad_saturation_coeffs` (``S10 = 0`` disables it).
+The steady-state initialization follows the OpenIPSL/ANDES procedure.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..blocks import quad_saturation_coeffs
+from ..errors import DataError
+from ..params import Param
+from .base import BASE_PARAMS, SyncMachine
+from .gencls import solve_stator
+from .shaft import swing
+
+
+class GENROU(SyncMachine):
+    """Round-rotor synchronous machine with quadratic saturation.
+
+    Parameters (machine base unless stated)
+    ----------------------------------------
+    Sn, Vn, fn, M, D, ra, xd1 as in :class:`~weakgrid.sim.machines.gencls.GENCLS`;
+    xl, xd, xq, xd2, xq1, xq2 [pu]; Td10, Td20, Tq10, Tq20 [s]; S10, S12 [pu].
+    """
+
+    params = BASE_PARAMS + (
+        Param("xl", 0.0, "pu (machine base)", "leakage reactance", "nonneg", "z"),
+        Param("xd", 1.9, "pu (machine base)", "d-axis synchronous reactance", "pos", "z"),
+        Param("xq", 1.7, "pu (machine base)", "q-axis synchronous reactance", "pos", "z"),
+        Param("xd2", 0.3, "pu (machine base)", "d-axis sub-transient reactance x''d", "pos", "z"),
+        Param("xq1", 0.5, "pu (machine base)", "q-axis transient reactance x'q", "pos", "z"),
+        Param("xq2", 0.3, "pu (machine base)", "q-axis sub-transient reactance x''q", "pos", "z"),
+        Param("Td10", 8.0, "s", "d-axis transient open-circuit time constant T'd0", "pos"),
+        Param("Td20", 0.04, "s", "d-axis sub-transient open-circuit time constant T''d0", "pos"),
+        Param("Tq10", 0.8, "s", "q-axis transient open-circuit time constant T'q0", "pos"),
+        Param("Tq20", 0.02, "s", "q-axis sub-transient open-circuit time constant T''q0", "pos"),
+        Param("S10", 0.0, "pu", "saturation factor at 1.0 pu flux", "nonneg"),
+        Param("S12", 1.0, "pu", "saturation factor at 1.2 pu flux", "nonneg"),
+    )
+    states = ("delta", "omega", "e1q", "e1d", "e2d", "e2q")
+    outputs = ("Pe", "Qe", "te", "Id", "Iq", "XadIfd", "psi2", "Se", "vf")
+
+    def setup(self, system):
+        super().setup(system)
+        p = self.p
+        for i in range(self.n):
+            if abs(p["xd2"][i] - p["xq2"][i]) > 1e-12 * max(1.0, abs(p["xd2"][i])):
+                raise DataError(self.element(i), "xq2", self._values[i]["xq2"],
+                                "GENROU needs xq2 == xd2 (round rotor, as in PSS/E and ANDES); set xq2 = xd2")
+            if not p["xl"][i] < p["xd2"][i]:
+                raise DataError(self.element(i), "xl", self._values[i]["xl"], "leakage reactance must be < xd2")
+            if not (p["xd2"][i] < p["xd1"][i] < p["xd"][i]) or not (p["xq2"][i] < p["xq1"][i] < p["xq"][i]):
+                raise DataError(self.element(i), "xd1", self._values[i]["xd1"],
+                                "need xd2 < xd1 < xd and xq2 < xq1 < xq")
+        xl = p["xl"]
+        self.gd1 = (p["xd2"] - xl) / (p["xd1"] - xl)
+        self.gq1 = (p["xq2"] - xl) / (p["xq1"] - xl)
+        self.gd2 = (p["xd1"] - p["xd2"]) / (p["xd1"] - xl) ** 2
+        self.gq2 = (p["xq1"] - p["xq2"]) / (p["xq1"] - xl) ** 2
+        self.gqd = (p["xq"] - xl) / (p["xd"] - xl)
+        self.SA, self.SB = quad_saturation_coeffs(1.0, p["S10"], 1.2, p["S12"])
+
+    def _sat(self, psi2):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            Se = np.where(psi2 >= self.SA, self.SB * (psi2 - self.SA) ** 2 / psi2, 0.0)
+        return np.where(np.isfinite(Se), Se, 0.0)
+
+    def init(self, system, x, sig):
+        p = self.p
+        pf = system.network.pf
+        V = pf.V[self.bus]
+        S = pf.Pg[self.gen] + 1j * pf.Qg[self.gen]
+        It = np.conj(S / V)
+        ra, xd2, xq2, xq, xd, xl = p["ra"], p["xd2"], p["xq2"], p["xq"], p["xd"], p["xl"]
+        psi20 = V + It * (ra + 1j * xd2)          # sub-transient flux in the network frame
+        a20 = np.abs(psi20)
+        Se0 = self._sat(a20)
+        ang = np.angle(psi20) - np.angle(It)
+        ap = a20 * (1 + Se0 * self.gqd)
+        bp = np.abs(It) * (xq2 - xq)
+        delta = np.arctan(bp * np.cos(ang) / (bp * np.sin(ang) - ap)) + np.angle(psi20)
+        rot = np.exp(-1j * delta)
+        psi_dq = psi20 * rot
+        It_dq = np.conj(It * rot)
+        psi2d, psi2q = psi_dq.real, -psi_dq.imag
+        Id, Iq = It_dq.imag, It_dq.real
+        vf0 = (Se0 + 1) * psi2d + (xd - xd2) * Id
+        tm0 = (V * np.conj(It)).real + ra * np.abs(It) ** 2
+        x[self.sl(0)] = delta
+        x[self.sl(1)] = 1.0
+        x[self.sl(2)] = Id * (p["xd1"] - xd) - Se0 * psi2d + vf0
+        x[self.sl(3)] = Iq * (xq - p["xq1"]) - Se0 * self.gqd * psi2q
+        x[self.sl(4)] = Id * (xl - xd) - Se0 * psi2d + vf0
+        x[self.sl(5)] = -Iq * (xl - xq) - Se0 * self.gqd * psi2q
+        system.set_machine_initial(self.m, vf0=vf0, tm0=tm0, XadIfd=vf0, Pe=S.real, Qe=S.imag,
+                                   delta=delta, V=V)
+
+    def compute(self, ctx):
+        p = self.p
+        x = ctx.x
+        delta, omega = x[self.sl(0)], x[self.sl(1)]
+        e1q, e1d, e2d, e2q = x[self.sl(2)], x[self.sl(3)], x[self.sl(4)], x[self.sl(5)]
+        xl = p["xl"]
+        psi2d = self.gd1 * e1q + self.gd2 * (p["xd1"] - xl) * e2d
+        psi2q = self.gq1 * e1d + (1 - self.gq1) * e2q
+        psi2 = np.sqrt(psi2d ** 2 + psi2q ** 2)
+        Se = self._sat(psi2)
+        V = ctx.V[self.bus]
+        vd, vq = self.dq_voltage(V, delta)
+        ra = p["ra"]
+        Id, Iq = solve_stator(psi2d, psi2q, vd, vq, ra, p["xd2"], p["xq2"])
+        ctx.I[self.bus] += self.network_current(Id, Iq, delta)
+        XadIfd = e1q + (p["xd"] - p["xd1"]) * (self.gd1 * Id - self.gd2 * e2d + self.gd2 * e1q) + Se * psi2d
+        XaqI1q = e1d + (p["xq"] - p["xq1"]) * (self.gq2 * e1d - self.gq2 * e2q - self.gq1 * Iq) \
+            + Se * self.gqd * psi2q
+        psid = ra * Iq + vq
+        psiq = -(ra * Id + vd)
+        self._te = psid * Iq - psiq * Id
+        self._XadIfd = XadIfd
+        Pe = vd * Id + vq * Iq
+        Qe = vq * Id - vd * Iq
+        self.publish(ctx, omega, delta, Pe, Qe, V, XadIfd)
+        f = ctx.f
+        f[self.sl(3)] = -XaqI1q / p["Tq10"]
+        f[self.sl(4)] = (-e2d + e1q - (p["xd1"] - xl) * Id) / p["Td20"]
+        f[self.sl(5)] = (-e2q + e1d + (p["xq1"] - xl) * Iq) / p["Tq20"]
+        o = ctx.out
+        o["GENROU.Pe"], o["GENROU.Qe"], o["GENROU.te"] = Pe, Qe, self._te
+        o["GENROU.Id"], o["GENROU.Iq"], o["GENROU.XadIfd"] = Id, Iq, XadIfd
+        o["GENROU.psi2"], o["GENROU.Se"] = psi2, Se
+
+    def finish(self, ctx):
+        p = self.p
+        m = self.m
+        omega = ctx.x[self.sl(1)]
+        vf = ctx.sig["vf"][m]
+        tm = ctx.sig["tm"][m]
+        ctx.out["GENROU.vf"] = vf
+        d_delta, d_omega = swing(omega, tm, self._te, p["M"], p["D"], self.wb)
+        f = ctx.f
+        f[self.sl(0)] = d_delta
+        f[self.sl(1)] = d_omega
+        f[self.sl(2)] = (vf - self._XadIfd) / p["Td10"]

@@ -1,0 +1,247 @@
+"""Network data (MATPOWER case form), admittance matrices and the initializing power flow.
+
+The network is held in MATPOWER case form (``baseMVA``, ``bus``, ``gen``,
+``branch`` arrays with the standard MATPOWER columns). Branches are π-models
+with series ``R + jX``, total charging ``B``, off-nominal ratio ``TAP`` (at the
+from-bus) and phase shift ``SHIFT`` [deg]. Loads ``PD + jQD`` [MW, Mvar] become
+constant admittances at their power-flow voltage in the time domain (as the
+ANDES ``PQ`` model with ``p2z = q2z = 1``); shunts ``GS + jBS`` [MW, Mvar at 1 pu].
+
+The power flow is *not* hand-written: :meth:`Network.solve_power_flow` converts
+the case to pandapower (``pandapower.converter.from_ppc``) and runs
+``pandapower.runpp``. The solution is then checked against this module's own
+admittance matrix; a mismatch raises :class:`~weakgrid.sim.errors.PowerFlowError`.
+"""
+
+from __future__ import annotations
+
+import copy
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import DataError, PowerFlowError
+
+# MATPOWER column indices (0-based)
+BUS_I, BUS_TYPE, PD, QD, GS, BS, BUS_AREA, VM, VA, BASE_KV = range(10)
+GEN_BUS, PG, QG, QMAX, QMIN, VG, MBASE, GEN_STATUS = range(8)
+F_BUS, T_BUS, BR_R, BR_X, BR_B, RATE_A, RATE_B, RATE_C, TAP, SHIFT, BR_STATUS = range(11)
+
+
+@dataclass
+class PowerFlowResult:
+    """Solved operating point, all in system per unit.
+
+    Attributes
+    ----------
+    V : ndarray of complex
+        Bus voltage phasors [pu], in bus order.
+    Pg, Qg : ndarray
+        Generator injections [pu on ``baseMVA``], in gen-table order (0 for out-of-service gens).
+    mismatch : float
+        Largest bus power mismatch of the solution [pu], checked with this module's Ybus.
+    """
+
+    V: np.ndarray
+    Pg: np.ndarray
+    Qg: np.ndarray
+    mismatch: float
+
+
+class Network:
+    """A power network in MATPOWER case form.
+
+    Parameters
+    ----------
+    case : dict
+        ``{"baseMVA": float, "bus": (nb, >=13), "gen": (ng, >=10), "branch": (nl, >=11)}``.
+    f_hz : float
+        Nominal frequency [Hz].
+
+    Attributes
+    ----------
+    Sb : float
+        System base power [MVA].
+    bus_ids : ndarray of int
+        External bus numbers; ``index_of(bus_id)`` maps them to 0-based positions.
+    """
+
+    def __init__(self, case: dict, f_hz: float = 60.0):
+        for key in ("baseMVA", "bus", "gen", "branch"):
+            if key not in case:
+                raise DataError("case", key, None, "a MATPOWER case needs baseMVA, bus, gen and branch")
+        self.case = copy.deepcopy({k: case[k] for k in ("baseMVA", "bus", "gen", "branch")})
+        self.Sb = float(self.case["baseMVA"])
+        if not self.Sb > 0:
+            raise DataError("case", "baseMVA", self.Sb, "must be > 0 MVA")
+        self.f_hz = float(f_hz)
+        bus = np.atleast_2d(np.asarray(self.case["bus"], dtype=float))
+        gen = np.atleast_2d(np.asarray(self.case["gen"], dtype=float))
+        branch = np.atleast_2d(np.asarray(self.case["branch"], dtype=float))
+        if bus.shape[1] < 13:
+            raise DataError("case", "bus", bus.shape, "bus table needs the 13 MATPOWER columns")
+        if gen.size and gen.shape[1] < 10:
+            gen = np.hstack([gen, np.zeros((gen.shape[0], 10 - gen.shape[1]))])
+        if branch.shape[1] < 13:
+            branch = np.hstack([branch, np.zeros((branch.shape[0], 13 - branch.shape[1]))])
+        self.bus, self.gen, self.branch = bus, gen, branch
+        self.case.update(bus=bus, gen=gen, branch=branch)
+        self.bus_ids = bus[:, BUS_I].astype(int)
+        if len(set(self.bus_ids)) != len(self.bus_ids):
+            raise DataError("bus table", "BUS_I", list(self.bus_ids), "bus numbers must be unique")
+        self._pos = {b: i for i, b in enumerate(self.bus_ids)}
+        for k, row in enumerate(branch):
+            for col, nm in ((F_BUS, "F_BUS"), (T_BUS, "T_BUS")):
+                self.index_of(int(row[col]), f"branch {k}", nm)
+            if row[BR_R] == 0 and row[BR_X] == 0:
+                raise DataError(f"branch {k}", "BR_X", 0.0, "a branch needs a non-zero impedance R + jX")
+        for k, row in enumerate(gen):
+            self.index_of(int(row[GEN_BUS]), f"gen {k}", "GEN_BUS")
+        kv = bus[:, BASE_KV]
+        for i in np.nonzero(~(kv > 0))[0]:
+            raise DataError(f"bus {self.bus_ids[i]}", "BASE_KV", kv[i], "give the bus base voltage in kV (> 0)")
+        if not np.any(bus[:, BUS_TYPE] == 3):
+            raise DataError("bus table", "BUS_TYPE", "no 3", "one bus must be the slack (BUS_TYPE = 3)")
+        self.nb = bus.shape[0]
+        self.nl = branch.shape[0]
+        self.base_kv = kv.copy()
+        self.pf: PowerFlowResult | None = None
+
+    # ------------------------------------------------------------------ lookup
+    def index_of(self, bus_id, element: str = "element", field: str = "bus") -> int:
+        """0-based position of external bus number ``bus_id``; :class:`DataError` if unknown."""
+        try:
+            return self._pos[int(bus_id)]
+        except (KeyError, TypeError, ValueError):
+            raise DataError(element, field, bus_id,
+                            f"no such bus; known buses are {sorted(self._pos)}") from None
+
+    # ------------------------------------------------------------- admittances
+    def branch_admittances(self):
+        """Two-port admittances of all branches (ignoring status).
+
+        Returns
+        -------
+        f, t : ndarray of int
+            From/to bus positions.
+        Yff, Yft, Ytf, Ytt : ndarray of complex
+            Branch admittance entries [pu] (MATPOWER ``makeYbus`` convention).
+        """
+        br = self.branch
+        f = np.array([self._pos[int(b)] for b in br[:, F_BUS]], dtype=int)
+        t = np.array([self._pos[int(b)] for b in br[:, T_BUS]], dtype=int)
+        ys = 1.0 / (br[:, BR_R] + 1j * br[:, BR_X])
+        bc = br[:, BR_B]
+        tap = np.where(br[:, TAP] == 0, 1.0, br[:, TAP]) * np.exp(1j * np.deg2rad(br[:, SHIFT]))
+        Ytt = ys + 0.5j * bc
+        Yff = Ytt / (tap * np.conj(tap))
+        Yft = -ys / np.conj(tap)
+        Ytf = -ys / tap
+        return f, t, Yff, Yft, Ytf, Ytt
+
+    def ybus(self, branch_status=None, shunt=None) -> np.ndarray:
+        """Dense bus admittance matrix [pu].
+
+        Parameters
+        ----------
+        branch_status : array_like of bool, optional
+            In-service flags per branch (default: the ``BR_STATUS`` column).
+        shunt : array_like of complex, optional
+            Extra shunt admittance per bus [pu] (loads, faults), added to the diagonal.
+        """
+        f, t, Yff, Yft, Ytf, Ytt = self.branch_admittances()
+        st = self.branch[:, BR_STATUS] > 0 if branch_status is None else np.asarray(branch_status, bool)
+        Y = np.zeros((self.nb, self.nb), dtype=complex)
+        np.add.at(Y, (f[st], f[st]), Yff[st])
+        np.add.at(Y, (f[st], t[st]), Yft[st])
+        np.add.at(Y, (t[st], f[st]), Ytf[st])
+        np.add.at(Y, (t[st], t[st]), Ytt[st])
+        Y[np.diag_indices(self.nb)] += (self.bus[:, GS] + 1j * self.bus[:, BS]) / self.Sb
+        if shunt is not None:
+            Y[np.diag_indices(self.nb)] += np.asarray(shunt, dtype=complex)
+        return Y
+
+    def load_admittance(self, V) -> np.ndarray:
+        """Constant-impedance equivalent of the bus loads at voltages ``V`` [pu]."""
+        S = (self.bus[:, PD] + 1j * self.bus[:, QD]) / self.Sb
+        return np.conj(S) / np.abs(V) ** 2
+
+    # -------------------------------------------------------------- power flow
+    def solve_power_flow(self, tol_mva: float = 1e-9, check_tol: float = 1e-6) -> PowerFlowResult:
+        """Solve the power flow with pandapower and check it against this network's Ybus.
+
+        Parameters
+        ----------
+        tol_mva : float
+            pandapower convergence tolerance [MVA].
+        check_tol : float
+            Largest acceptable power mismatch [pu] when re-checked with :meth:`ybus`.
+
+        Raises
+        ------
+        PowerFlowError
+            If pandapower does not converge or the solution does not satisfy the network equations.
+        """
+        import pandapower as pp
+        from pandapower.converter.pypower import from_ppc
+
+        ppc = {"version": "2", "baseMVA": self.Sb, "bus": self.bus.copy(),
+               "gen": self.gen.copy(), "branch": self.branch.copy()}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            import logging
+            logging.getLogger("pandapower").setLevel(logging.ERROR)
+            try:
+                net = from_ppc(ppc, f_hz=self.f_hz, validate_conversion=False)
+                pp.runpp(net, numba=False, tolerance_mva=tol_mva, max_iteration=30,
+                         trafo_model="pi", calculate_voltage_angles=True, init="dc")
+            except Exception as exc:  # pandapower raises LoadflowNotConverged and others
+                raise PowerFlowError(f"pandapower power flow failed: {exc}. Fix: check loads, "
+                                     "generation and the slack bus; reduce loading") from exc
+        rb = net.res_bus.loc[self.bus_ids]
+        V = rb.vm_pu.to_numpy() * np.exp(1j * np.deg2rad(rb.va_degree.to_numpy()))
+        return self._finish_pf(V, check_tol)
+
+    def _finish_pf(self, V, check_tol):
+        Y = self.ybus()
+        Sinj = V * np.conj(Y @ V)
+        Sload = (self.bus[:, PD] + 1j * self.bus[:, QD]) / self.Sb
+        Sgen_bus = Sinj + Sload
+        gen = self.gen
+        ng = gen.shape[0]
+        Pg = np.zeros(ng)
+        Qg = np.zeros(ng)
+        on = gen[:, GEN_STATUS] > 0 if ng else np.zeros(0, bool)
+        gbus = np.array([self._pos[int(b)] for b in gen[:, GEN_BUS]], dtype=int) if ng else np.zeros(0, int)
+        btype = self.bus[:, BUS_TYPE]
+        mismatch = 0.0
+        for i in range(self.nb):
+            g = np.nonzero(on & (gbus == i))[0]
+            if len(g) == 0:
+                mismatch = max(mismatch, abs(Sgen_bus[i]))
+                continue
+            if btype[i] == 3:
+                Pg[g] = Sgen_bus[i].real / len(g)
+            else:
+                Pg[g] = gen[g, PG] / self.Sb
+                mismatch = max(mismatch, abs(Sgen_bus[i].real - Pg[g].sum()))
+            Qg[g] = Sgen_bus[i].imag / len(g)
+        if not np.all(np.isfinite(V)) or mismatch > check_tol:
+            raise PowerFlowError(f"power flow solution has a bus mismatch of {mismatch:.3g} pu "
+                                 f"(> {check_tol:g}). Fix: check branch data and loading; "
+                                 "the case may have no feasible operating point")
+        self.pf = PowerFlowResult(V=V, Pg=Pg, Qg=Qg, mismatch=mismatch)
+        return self.pf
+
+    @classmethod
+    def from_pandapower(cls, net) -> "Network":
+        """Build a :class:`Network` from a pandapower network (via ``pandapower.converter.to_ppc``)."""
+        from pandapower.converter.pypower import to_ppc
+
+        ppc = to_ppc(net, init="flat", calculate_voltage_angles=True, trafo_model="pi")
+        bus = np.asarray(ppc["bus"])[:, :13].copy()
+        gen = np.asarray(ppc["gen"])[:, :21].copy()
+        branch = np.asarray(ppc["branch"])[:, :13].real.copy()
+        return cls({"baseMVA": ppc["baseMVA"], "bus": bus.real, "gen": gen.real, "branch": branch},
+                   f_hz=float(net.f_hz))

@@ -1,0 +1,1 @@
+"""Peer comparison helpers (ANDES). Imports ANDES lazily; it is an optional dependency."""

@@ -1,0 +1,5 @@
+"""Power system stabilizers."""
+
+from .ieeest import IEEEST
+
+__all__ = ["IEEEST"]

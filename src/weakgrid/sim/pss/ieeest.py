@@ -1,0 +1,120 @@
+"""IEEEST: IEEE standard PSS (PSS/E IEEEST; input modes 1, 3, 4, 5).
+
+Block diagram::
+
+    sig --[1/(1 + A1 s + A2 s^2)]--[(1 + A5 s + A6 s^2)/(1 + A3 s + A4 s^2)]
+        --[(1+sT1)/(1+sT2)]--[(1+sT3)/(1+sT4)]--[KS]--[sT5/(1+sT6)]--> clip(LSMIN, LSMAX) = vs
+
+Input ``sig`` by ``MODE``: 1 speed deviation ``omega - 1`` [pu]; 3 electrical
+power on the machine base [pu]; 4 accelerating power ``tm - tm0`` [pu, system
+base]; 5 terminal voltage [pu]. The output is added to the exciter's summing
+junction. The output is cut (set to 0) when the terminal voltage leaves ``[VCL, VCU]``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..blocks import LeadLag, Washout
+from ..control_base import MachineControl
+from ..errors import DataError
+from ..params import Param
+
+
+class IEEEST(MachineControl):
+    """IEEE standard PSS. Parameters: MODE; A1..A6, T1..T6 [s]; KS [pu]; LSMAX, LSMIN, VCU, VCL [pu]."""
+
+    kind = "pss"
+    order = 1
+    params = (
+        Param("MODE", 1.0, "-", "input signal (1 speed, 3 Pe, 4 accelerating power, 5 voltage)", "pos"),
+        Param("A1", 0.0, "s", "filter pole coefficient (s)", "nonneg"),
+        Param("A2", 0.0, "s^2", "filter pole coefficient (s^2)", "nonneg"),
+        Param("A3", 0.0, "s", "filter pole coefficient (s)", "nonneg"),
+        Param("A4", 0.0, "s^2", "filter pole coefficient (s^2)", "nonneg"),
+        Param("A5", 0.0, "s", "filter zero coefficient (s)", "nonneg"),
+        Param("A6", 0.0, "s^2", "filter zero coefficient (s^2)", "nonneg"),
+        Param("T1", 1.0, "s", "first lead", "nonneg"),
+        Param("T2", 1.0, "s", "first lag", "nonneg"),
+        Param("T3", 1.0, "s", "second lead", "nonneg"),
+        Param("T4", 1.0, "s", "second lag", "nonneg"),
+        Param("T5", 1.0, "s", "washout numerator", "nonneg"),
+        Param("T6", 1.0, "s", "washout denominator", "pos"),
+        Param("KS", 1.0, "pu", "gain", ""),
+        Param("LSMAX", 0.3, "pu", "output upper limit", ""),
+        Param("LSMIN", -0.3, "pu", "output lower limit", ""),
+        Param("VCU", 999.0, "pu", "voltage cutoff upper", ""),
+        Param("VCL", -999.0, "pu", "voltage cutoff lower", ""),
+    )
+    states = ("F1a", "F1b", "F2a", "F2b", "LL1", "LL2", "WO")
+    outputs = ("sig", "vss")
+
+    def setup(self, system):
+        super().setup(system)
+        p = self.p
+        for i, mode in enumerate(p["MODE"]):
+            if mode not in (1, 3, 4, 5):
+                raise DataError(self.element(i), "MODE", mode, "supported input modes are 1, 3, 4 and 5")
+        self.LL1 = LeadLag(p["T1"], p["T2"])
+        self.LL2 = LeadLag(p["T3"], p["T4"])
+        self.WO = Washout(p["T5"], p["T6"])
+
+    def _signal(self, ctx):
+        p = self.p
+        m = self.mach
+        s = ctx.sig
+        mode = p["MODE"]
+        return np.select([mode == 1, mode == 3, mode == 4, mode == 5],
+                         [s["omega"][m] - 1.0, s["Pe"][m] * ctx.system.Sb / self.Sn,
+                          s["tm"][m] - s["tm0"][m], s["Vt"][m]])
+
+    def init(self, system, x, sig):
+        p = self.p
+        m = self.mach
+        mode = p["MODE"]
+        u0 = np.select([mode == 1, mode == 3, mode == 4, mode == 5],
+                       [0.0 * m, sig["Pe0"][m] * system.Sb / self.Sn, 0.0 * m, sig["Vt0"][m]])
+        x[self.sl(0)] = u0
+        x[self.sl(1)] = 0.0
+        x[self.sl(2)] = u0
+        x[self.sl(3)] = 0.0
+        x[self.sl(4)] = u0
+        x[self.sl(5)] = u0
+        x[self.sl(6)] = p["KS"] * u0
+
+    @staticmethod
+    def _second_order(xa, xb, u, a1, a2):
+        """States of 1/(1 + a1 s + a2 s^2) (xa = output, xb = its derivative); a2 = 0 reduces order."""
+        on2 = a2 > 0
+        on1 = a1 > 0
+        a2s = np.where(on2, a2, 1.0)
+        a1s = np.where(on1, a1, 1.0)
+        dxa = np.where(on2, xb, np.where(on1, (u - xa) / a1s, 0.0))
+        dxb = np.where(on2, (u - xa - a1 * xb) / a2s, 0.0)
+        y = np.where(on2 | on1, xa, u)
+        return y, dxa, dxb
+
+    def compute(self, ctx):
+        p = self.p
+        x = ctx.x
+        f = ctx.f
+        u = self._signal(ctx)
+        y1, f[self.sl(0)], f[self.sl(1)] = self._second_order(x[self.sl(0)], x[self.sl(1)], u, p["A1"], p["A2"])
+        # (1 + A5 s + A6 s^2)/(1 + A3 s + A4 s^2): w = y1/(den), output = w + A5 w' + A6 w''
+        w, f[self.sl(2)], f[self.sl(3)] = self._second_order(x[self.sl(2)], x[self.sl(3)], y1, p["A3"], p["A4"])
+        has = (p["A3"] > 0) | (p["A4"] > 0)
+        wdot = np.where(p["A4"] > 0, x[self.sl(3)], np.where(p["A3"] > 0, f[self.sl(2)], 0.0))
+        wdd = np.where(p["A4"] > 0, f[self.sl(3)], 0.0)
+        y2 = np.where(has, w + p["A5"] * wdot + p["A6"] * wdd, y1)
+        y3 = self.LL1.output(x[self.sl(4)], y2)
+        f[self.sl(4)] = self.LL1.deriv(x[self.sl(4)], y2)
+        y4 = self.LL2.output(x[self.sl(5)], y3)
+        f[self.sl(5)] = self.LL2.deriv(x[self.sl(5)], y3)
+        vks = p["KS"] * y4
+        vss = self.WO.output(x[self.sl(6)], vks)
+        f[self.sl(6)] = self.WO.deriv(x[self.sl(6)], vks)
+        vs = np.clip(vss, p["LSMIN"], p["LSMAX"])
+        vt = ctx.sig["Vt"][self.mach]
+        vs = np.where((vt > p["VCL"]) & (vt < p["VCU"]), vs, 0.0)
+        ctx.sig["vs"][self.mach] = vs
+        ctx.out["IEEEST.sig"], ctx.out["IEEEST.vss"] = u, vss

@@ -1,0 +1,200 @@
+"""Simulation results: every state, algebraic variable and recorded output by name, in pu and SI.
+
+Names
+-----
+* states: ``"<instance>.<state>"``, e.g. ``"G1.omega"``, ``"G1.avr.VR"``;
+* network: ``"bus<id>.Vr"``, ``"bus<id>.Vi"`` (the algebraic variables) and the
+  derived ``"bus<id>.v"`` (magnitude) and ``"bus<id>.a"`` (angle);
+* outputs: ``"<instance>.<output>"``, e.g. ``"G1.Pe"``, ``"upqc.P_series"``;
+  machines also have ``"<machine>.vf"``, ``".tm"``, ``".vs"``.
+
+Per-unit bases: powers on the system base ``Sb`` [MVA]; voltages on the bus
+base [kV]; speeds in pu of nominal; angles in rad. :meth:`Results.to_frame`
+with ``si=True`` converts to MW/Mvar, kV, rad/s and degrees.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+# unit kind -> (pu label, SI label)
+_LABEL = {"pu": ("pu", "pu"), "power": ("pu (Sb)", "MW"), "voltage": ("pu", "kV"),
+          "angle": ("rad", "deg"), "speed": ("pu", "rad/s"), "current": ("pu (Sb)", "kA"),
+          "time": ("s", "s"), "energy": ("pu·s", "MJ")}
+
+
+class Results:
+    """Trajectories of a simulation.
+
+    Attributes
+    ----------
+    t : ndarray
+        Time points [s] (a breakpoint appears twice: before and after the event).
+    names : list of str
+        Variable names (columns of :attr:`data`).
+    data : ndarray, shape (len(t), len(names))
+        Values in per unit.
+    failure : SimulationError or None
+        Set when the run stopped early with ``on_failure="return"``.
+    stats : dict
+        Integrator counters (steps, Newton iterations, Jacobians, LU factorizations, evaluations).
+    """
+
+    def __init__(self, t, names, data, kinds, si_factor, failure=None, stats=None):
+        self.t = np.asarray(t)
+        self.names = list(names)
+        self.data = np.asarray(data)
+        self.kinds = list(kinds)
+        self.si_factor = np.asarray(si_factor, dtype=float)
+        self.failure = failure
+        self.stats = stats or {}
+        self._col = {n: i for i, n in enumerate(self.names)}
+
+    @property
+    def ok(self) -> bool:
+        return self.failure is None
+
+    def __contains__(self, name):
+        return name in self._col
+
+    def __getitem__(self, name) -> np.ndarray:
+        """Trajectory of variable ``name`` in per unit."""
+        try:
+            return self.data[:, self._col[name]]
+        except KeyError:
+            close = [n for n in self.names if name.split(".")[-1] in n][:8]
+            raise KeyError(f"no variable '{name}' in results; e.g. {close}") from None
+
+    def si(self, name) -> np.ndarray:
+        """Trajectory of ``name`` in SI units (see :meth:`unit`)."""
+        return self[name] * self.si_factor[self._col[name]]
+
+    def unit(self, name, si=False) -> str:
+        return _LABEL[self.kinds[self._col[name]]][1 if si else 0]
+
+    def select(self, pattern: str) -> list[str]:
+        """Names containing ``pattern``."""
+        return [n for n in self.names if pattern in n]
+
+    def to_frame(self, si: bool = False, names=None):
+        """A :class:`pandas.DataFrame` with a ``t`` column; column names carry units in brackets."""
+        import pandas as pd
+
+        names = self.names if names is None else list(names)
+        cols = {"t [s]": self.t}
+        for n in names:
+            cols[f"{n} [{self.unit(n, si)}]"] = self.si(n) if si else self[n]
+        return pd.DataFrame(cols)
+
+    def to_csv(self, path, si: bool = False, names=None):
+        """Write the trajectories to CSV."""
+        self.to_frame(si, names).to_csv(path, index=False)
+
+    def to_parquet(self, path, si: bool = False, names=None):
+        """Write the trajectories to Parquet (pyarrow)."""
+        self.to_frame(si, names).to_parquet(path, index=False)
+
+    def plot(self, names, si: bool = False, ax=None, title=None):
+        """Plot variables against time; axes labelled with units. Returns the matplotlib axes."""
+        import matplotlib.pyplot as plt
+
+        if isinstance(names, str):
+            names = [names]
+        if ax is None:
+            _, ax = plt.subplots(figsize=(7, 3.5))
+        units = set()
+        for n in names:
+            ax.plot(self.t, self.si(n) if si else self[n], label=n)
+            units.add(self.unit(n, si))
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel(" / ".join(sorted(units)) if units else "")
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="best", fontsize=8)
+        if title:
+            ax.set_title(title)
+        return ax
+
+    # ------------------------------------------------------------- recording
+    @staticmethod
+    def recorder(system):
+        return _Recorder(system)
+
+
+class _Recorder:
+    def __init__(self, sys):
+        self.sys = sys
+        net = sys.network
+        self.t = []
+        self.rows = []
+        names, kinds, fac = [], [], []
+        fn = 60.0
+        for nm, u in zip(sys.state_names(), sys.state_units()):
+            names.append(nm)
+            kinds.append(u)
+        self._out_keys = []
+        self._layout_done = False
+        self.names, self.kinds = names, kinds
+        self.fn = net.f_hz
+
+    def _layout(self, ctx):
+        sys = self.sys
+        net = sys.network
+        names, kinds = self.names, self.kinds
+        for b, bid in enumerate(net.bus_ids):
+            names += [f"bus{bid}.Vr", f"bus{bid}.Vi", f"bus{bid}.v", f"bus{bid}.a"]
+            kinds += ["voltage", "voltage", "voltage", "angle"]
+        for c in sys.comps:
+            for o in c.outputs:
+                key = f"{c.type_name}.{o}"
+                if key in ctx.out:
+                    self._out_keys.append((key, c.n))
+                    names += [f"{nm}.{o}" for nm in c.names]
+                    kinds += [c.units.get(o, "pu")] * c.n
+        for s in ("tm", "vs"):
+            names += [f"{m}.{s}" for m in sys.machine_names]
+            kinds += ["power" if s == "tm" else "pu"] * len(sys.machine_names)
+        # SI factors
+        fac = []
+        bus_kv = {f"bus{bid}": net.base_kv[i] for i, bid in enumerate(net.bus_ids)}
+        for n, k in zip(names, kinds):
+            if k == "power":
+                fac.append(sys.Sb)
+            elif k == "angle":
+                fac.append(180 / math.pi)
+            elif k == "speed":
+                fac.append(2 * math.pi * self.fn)
+            elif k == "voltage":
+                fac.append(bus_kv.get(n.split(".")[0], sys.element_kv(n)))
+            elif k == "current":
+                kvb = sys.element_kv(n)
+                fac.append(sys.Sb / (math.sqrt(3) * kvb))
+            elif k == "energy":
+                fac.append(sys.Sb)
+            else:
+                fac.append(1.0)
+        self.fac = fac
+        self._layout_done = True
+
+    def add(self, t, z, ctx):
+        if not self._layout_done:
+            self._layout(ctx)
+        sys = self.sys
+        nx, nb = sys.nx, sys.nb
+        Vr, Vi = z[nx:nx + nb], z[nx + nb:]
+        bus = np.empty(4 * nb)
+        bus[0::4], bus[1::4] = Vr, Vi
+        bus[2::4] = np.hypot(Vr, Vi)
+        bus[3::4] = np.arctan2(Vi, Vr)
+        parts = [z[:nx], bus]
+        for key, n in self._out_keys:
+            parts.append(np.broadcast_to(ctx.out[key], (n,)))
+        parts.append(ctx.sig["tm"])
+        parts.append(ctx.sig["vs"])
+        self.t.append(t)
+        self.rows.append(np.concatenate(parts))
+
+    def finish(self, failure=None, stats=None):
+        data = np.vstack(self.rows) if self.rows else np.zeros((0, len(self.names)))
+        return Results(self.t, self.names, data, self.kinds, self.fac, failure=failure, stats=stats)

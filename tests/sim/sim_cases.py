@@ -1,0 +1,59 @@
+"""Small test networks in MATPOWER form."""
+
+import numpy as np
+
+
+def two_machine_case(x_line=0.3, p=0.8):
+    """Two buses, one line, a PV generator at bus 1 and the slack generator at bus 2 (MATPOWER form)."""
+    bus = np.array([
+        [1, 2, 0, 0, 0, 0, 1, 1.0, 0, 110, 1, 1.5, 0.5],
+        [2, 3, 0, 0, 0, 0, 1, 1.0, 0, 110, 1, 1.5, 0.5],
+    ], dtype=float)
+    gen = np.array([
+        [1, p * 100, 0, 999, -999, 1.0, 100, 1, 999, -999] + [0] * 11,
+        [2, 0, 0, 999, -999, 1.0, 100, 1, 999, -999] + [0] * 11,
+    ], dtype=float)
+    branch = np.array([[1, 2, 0.0, x_line, 0.0, 0, 0, 0, 0, 0, 1, -360, 360]], dtype=float)
+    return {"baseMVA": 100.0, "bus": bus, "gen": gen, "branch": branch}
+
+
+def gti_upqc_sg_case(p_gti=50.0):
+    """GTI (bus 1) -- UPQC branch -- shunt bus r = 2 (load) -- line -- SG slack bus 3 (load)."""
+    bus = np.array([
+        [1, 2, 0, 0, 0, 0, 1, 1.0, 0, 20, 1, 1.5, 0.5],
+        [2, 1, 30, 10, 0, 0, 1, 1.0, 0, 20, 1, 1.5, 0.5],
+        [3, 3, 100, 30, 0, 0, 1, 1.0, 0, 20, 1, 1.5, 0.5],
+    ], dtype=float)
+    gen = np.array([
+        [1, p_gti, 0, 999, -999, 1.0, 100, 1, 999, -999] + [0] * 11,
+        [3, 0, 0, 999, -999, 1.02, 200, 1, 999, -999] + [0] * 11,
+    ], dtype=float)
+    branch = np.array([
+        [2, 1, 0.002, 0.05, 0.0, 0, 0, 0, 0, 0, 1, -360, 360],     # UPQC series branch (r -> 1)
+        [2, 3, 0.02, 0.20, 0.05, 0, 0, 0, 0, 0, 1, -360, 360],
+    ], dtype=float)
+    return {"baseMVA": 100.0, "bus": bus, "gen": gen, "branch": branch}
+
+
+def build_gti_upqc_sg(structure="conventional", mode="energy", p_gti=50.0):
+    """System with a GTI + UPQC + an SG (GENROU + SEXS + HYGOV + IEEEST); set up."""
+    from weakgrid.sim.gti import GTI
+    from weakgrid.sim.system import System
+    from weakgrid.sim.upqc import UPQC
+
+    s = System(gti_upqc_sg_case(p_gti))
+    s.add_generator("SG", 1,
+                    machine=("GENROU", dict(Sn=200, M=8.0, D=0.0, ra=0.003, xl=0.15, xd=1.8, xq=1.7,
+                                            xd1=0.3, xq1=0.55, xd2=0.25, xq2=0.25, Td10=6.0, Td20=0.03,
+                                            Tq10=0.4, Tq20=0.05, S10=0.05, S12=0.3)),
+                    exciter=("SEXS", dict(TATB=0.2, TB=10.0, K=100.0, TE=0.05, EMIN=0.0, EMAX=5.0)),
+                    governor=("HYGOV", dict(R=0.05, r=0.4, Tr=5.0, Tf=0.05, Tg=0.5, VELM=0.2,
+                                            GMAX=1.0, GMIN=0.0, Tw=1.0, At=1.2, qNL=0.08)),
+                    pss=("IEEEST", dict(MODE=1, T1=0.15, T2=0.05, T3=0.15, T4=0.05, T5=2.0, T6=2.0,
+                                        KS=10.0, LSMAX=0.1, LSMIN=-0.1)))
+    gti = s.add_component(GTI())
+    gti.add_gti("PV", gen=0, ref_bus=2, mode=mode, C=0.05, Vc0=1.0, chi=0.02, B=20.0, ks_max=1.5, tau=2.0)
+    up = s.add_component(UPQC())
+    up.add_upqc("U", branch=0, structure=structure, gti="PV" if structure == "reduced" else None, Vmax=0.2)
+    s.setup()
+    return s
