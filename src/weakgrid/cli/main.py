@@ -7,9 +7,9 @@ import sys
 
 from .. import __version__
 from ..game.errors import WeakgridError
-from . import train
+from . import reproduce, simulate, train
 
-SUBCOMMANDS = [train]
+SUBCOMMANDS = [train, simulate, reproduce]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -34,8 +34,9 @@ def _check(t, y):
     y = np.asarray(y, float)
     if t.ndim != 1 or y.shape != t.shape:
         raise ShapeError("y", y.shape, f"same shape as t {t.shape}")
-    if t.size < 2 or np.any(np.diff(t) <= 0):
-        raise ParameterError("t", "…", "time must increase strictly with at least two samples")
+    if t.size < 2 or np.any(np.diff(t) < 0) or t[-1] <= t[0]:
+        raise ParameterError("t", "…", "time must not decrease (repeated instants at "
+                             "discontinuities are fine) and must span at least two samples")
     return t, y
 
 

@@ -1,0 +1,98 @@
+"""The controllers the paper compares, built for a case's design model.
+
+=============  ===============================================================
+name           what
+=============  ===============================================================
+``hji``        the game-theoretic controller (24)/(23) trained on the design model
+               derived from the grid's operating point, with the paper's settings
+``nonlinear-29``  the paper's initial nonlinear controller (29) (case 1)
+``lqr``        discrete LQR of the design model's linearization (case 2's
+               initial policy), Q = 0.01·I, R = I
+``pq``         conventional PQ control of the GTI (PID, paper's gains), no UPQC (case 1)
+``pss-only``   UPQC idle (u = 0): the SG's PSS and governor alone
+``none``       UPQC idle and the PSS out of service: no supplementary control
+=============  ===============================================================
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..game.errors import ParameterError
+from ..models import NonlinearInitialPolicy, load_preset, lqr_policy
+
+__all__ = ["CONTROLLERS", "PAPER_SETTINGS", "ControllerChoice", "make_controller",
+           "train_hji_for"]
+
+CONTROLLERS = ("hji", "nonlinear-29", "lqr", "pq", "pss-only", "none")
+# the paper's game settings (Q, R, P, γ, Ω, mesh, basis, initial policy) per case
+PAPER_SETTINGS = {"case1-weak-grid": "case1-paper", "case2-lv-microgrid": "case2-paper"}
+
+
+@dataclass
+class ControllerChoice:
+    """A controller ready for a case.
+
+    Attributes
+    ----------
+    name : str
+    policy : callable or None
+        ``u = policy(x)`` for the design state x = [ϕ̂, υ] (None: UPQC idle).
+    variant : str
+        The case variant it needs ("upqc" or "pq").
+    pss : bool
+        Whether the SG's PSS stays in service.
+    info : dict
+        Training record (weights, iterations, time) or parameters, for the report.
+    """
+
+    name: str
+    policy: object
+    variant: str = "upqc"
+    pss: bool = True
+    info: dict = field(default_factory=dict)
+
+
+def train_hji_for(case_name: str, design, progress=None):
+    """Train the HJI controller on ``design`` with the paper's settings of the case."""
+    base = load_preset(PAPER_SETTINGS[case_name])
+    base.system = design
+    if base.raw.get("initial_policy", {}).get("kind") == "nonlinear-29":
+        ip = base.raw["initial_policy"]
+        base.initial_policy = NonlinearInitialPolicy.on_design_model(design, ip["gain"],
+                                                                     ip["phase"])
+    else:
+        ip = base.raw.get("initial_policy", {})
+        base.initial_policy = lqr_policy(design, float(ip.get("Q", 0.01)) * np.eye(2),
+                                         float(ip.get("R", 1.0)) * np.eye(2))
+    base.name = f"{case_name}-derived"
+    base.published = {}
+    return base, base.train(progress=progress)
+
+
+def make_controller(name: str, case_name: str, design, trained=None) -> ControllerChoice:
+    """Build controller ``name`` for a case whose design model is ``design``.
+
+    ``trained`` may carry an already trained HJI controller (a GameController) so
+    that one training serves every scenario with the same design model.
+    """
+    if name not in CONTROLLERS:
+        raise ParameterError("controller", name, f"choose one of {CONTROLLERS}")
+    if name == "hji":
+        ctl = trained if trained is not None else train_hji_for(case_name, design)[1]
+        return ControllerChoice(name, ctl.control, info={
+            "weights": ctl.weights.tolist(), "iterations": ctl.iterations,
+            "train_seconds": ctl.train_seconds})
+    if name == "nonlinear-29":
+        pol = NonlinearInitialPolicy.on_design_model(design, 125.0, 0.069)
+        return ControllerChoice(name, pol, info=pol.to_dict())
+    if name == "lqr":
+        pol = lqr_policy(design, 0.01 * np.eye(2), np.eye(2))
+        return ControllerChoice(name, pol, info=pol.to_dict())
+    if name == "pq":
+        return ControllerChoice(name, None, variant="pq")
+    if name == "pss-only":
+        return ControllerChoice(name, None)
+    return ControllerChoice(name, None, pss=False)

@@ -1,0 +1,107 @@
+"""Metrics table (CSV, Markdown) and the HTML report with a verdict per claim."""
+
+from __future__ import annotations
+
+import html
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import pandas as pd
+
+__all__ = ["metrics_frame", "write_tables", "write_html"]
+
+COLUMNS = [
+    ("id", "run"), ("load", "load"), ("upqc", "UPQC"), ("controller", "controller"),
+    ("fault", "fault"), ("speed_peak_dev_pu", "speed peak dev. [pu]"),
+    ("speed_settling_s", "speed settling (2 %) [s]"), ("speed_itae", "speed ITAE [pu·s²]"),
+    ("speed_verdict", "speed verdict"), ("vdc_peak_dev_pu", "Vdc peak dev. [pu]"),
+    ("vdc_settling_s", "Vdc settling (2 %) [s]"), ("vdc_itae", "Vdc ITAE [pu·s²]"),
+    ("control_cost", "control cost Σu'Ru·T [pu²·s]"),
+    ("running_cost_18", "running cost (18) [–]"), ("vu_peak_pu", "|Vu| peak [pu]"),
+    ("vu_rms_pu", "|Vu| rms [pu]"), ("vu_rating_reached", "rating reached"),
+    ("p_series_peak_mw", "P_series peak [MW]"),
+    ("p_series_peak_pct_line", "P_series peak [% line]"), ("failed", "failed"),
+    ("wall_s", "wall time [s]"),
+]
+
+
+def _atomic_write(path: Path, text: str):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    with os.fdopen(fd, "w") as fh:
+        fh.write(text)
+    os.replace(tmp, path)
+
+
+def metrics_frame(metrics: list[dict]) -> pd.DataFrame:
+    df = pd.DataFrame(metrics)
+    for key, _ in COLUMNS:
+        if key not in df:
+            df[key] = float("nan")
+    return df[[k for k, _ in COLUMNS] + [c for c in df.columns if c not in dict(COLUMNS)]]
+
+
+def _fmt(v):
+    if isinstance(v, float):
+        return "–" if math.isnan(v) else f"{v:.4g}"
+    return str(v)
+
+
+def write_tables(metrics: list[dict], folder) -> tuple[Path, Path]:
+    """``metrics.csv`` (every metric, machine-readable) and ``metrics.md``."""
+    folder = Path(folder)
+    df = metrics_frame(metrics)
+    csv = folder / "metrics.csv"
+    _atomic_write(csv, df.to_csv(index=False))
+    head = "| " + " | ".join(lbl for _, lbl in COLUMNS) + " |"
+    sep = "|" + "---|" * len(COLUMNS)
+    rows = ["| " + " | ".join(_fmt(r[k]) for k, _ in COLUMNS) + " |" for r in
+            df.to_dict("records")]
+    md = folder / "metrics.md"
+    _atomic_write(md, "\n".join(["# weakgrid reproduce — metrics", "", head, sep, *rows, ""]))
+    return csv, md
+
+
+_CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em}
+table{border-collapse:collapse;font-size:0.85em;margin:1em 0}td,th{border:1px solid #ccc;
+padding:3px 6px;vertical-align:top}th{background:#f4f4f4}.reproduced{background:#d8f5d8}
+.partly{background:#fff3c4}.not{background:#f8d0d0}.notrun{background:#eee}
+img{max-width:100%;border:1px solid #ddd;margin:0.5em 0}"""
+
+
+def write_html(path, *, claims, metrics, figures, designs, meta) -> Path:
+    """One HTML page: claims with verdicts, design models, figures, metrics."""
+    e = html.escape
+    parts = [f"<!doctype html><meta charset='utf-8'><title>weakgrid reproduce</title>"
+             f"<style>{_CSS}</style><h1>weakgrid — reproduction of Nazaripouya &amp; "
+             f"Mehraeen (2015)</h1>",
+             f"<p>weakgrid {e(meta.get('version', ''))}, {e(meta.get('mode', ''))} run, "
+             f"{meta.get('n_runs', 0)} simulations in {meta.get('wall_s', 0):.0f} s. "
+             "Every number below was measured in this run; the rules that turn them into "
+             "verdicts are stated beside them.</p>",
+             "<h2>Claims of the paper</h2><table><tr><th>claim</th><th>case</th><th>paper"
+             "</th><th>measured</th><th>rule</th><th>verdict</th></tr>"]
+    for c in claims:
+        cls = c["verdict"].replace(" ", "")
+        parts.append(f"<tr><td>{e(c['id'])}</td><td>{e(c['case'])}</td><td>{e(c['paper'])}"
+                     f"</td><td>{e(c['measured'] or '—')}</td><td>{e(c['rule'])}</td>"
+                     f"<td class='{cls}'>{e(c['verdict'])}</td></tr>")
+    parts.append("</table><h2>Design models derived from the grids</h2><table><tr><th>case"
+                 "</th><th>load</th><th>UPQC</th><th>T [s]</th><th>a</th><th>V̄r [pu]</th>"
+                 "<th>ϕs0 [rad]</th><th>preset (T, a, V̄r, ϕs0)</th><th>HJI training</th></tr>")
+    for d in designs:
+        parts.append("<tr>" + "".join(f"<td>{e(str(v))}</td>" for v in d) + "</tr>")
+    parts.append("</table><h2>Figures</h2>")
+    for f in figures:
+        parts.append(f"<figure><img src='{e(f)}' alt='{e(f)}'></figure>")
+    parts.append("<h2>Metrics</h2><table><tr>" + "".join(f"<th>{e(lbl)}</th>"
+                                                         for _, lbl in COLUMNS) + "</tr>")
+    for r in metrics_frame(metrics).to_dict("records"):
+        parts.append("<tr>" + "".join(f"<td>{e(_fmt(r[k]))}</td>" for k, _ in COLUMNS) +
+                     "</tr>")
+    parts.append("</table><h2>Parameters</h2><pre>" + e(meta.get("parameters", "")) + "</pre>")
+    path = Path(path)
+    _atomic_write(path, "\n".join(parts))
+    return path
