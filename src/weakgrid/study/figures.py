@@ -12,6 +12,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+matplotlib.rcParams["svg.fonttype"] = "none"  # keep text as text: labels stay searchable
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
