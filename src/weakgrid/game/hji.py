@@ -22,6 +22,7 @@ normalization subsumes it); the normal equations are never formed (SPEC §3).
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -511,6 +512,14 @@ def solve_hji(
             f"the last iterations: {[f'{r.max_du:.2e}' for r in history[-5:]]}). Raise "
             "max_outer or loosen tol_u.", history)
 
+    J = pr.phi_s @ Ws
+    if J.min() < -1e-9 * max(1.0, float(np.abs(J).max())):
+        k = int(np.argmin(J))
+        warnings.warn(
+            f"the trained cost J is negative at {int((J < 0).sum())} of {p} mesh points "
+            f"(minimum {J[k]:.3g} at x = {X[k].tolist()}): the basis cannot represent a "
+            "nonnegative value on this region; use a richer basis or a smaller region",
+            RuntimeWarning, stacklevel=2)
     elapsed = time.perf_counter() - t0
     record = {
         "model": _system_record(system),
