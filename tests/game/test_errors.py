@@ -103,3 +103,21 @@ def test_mesh_too_coarse_for_basis():
     with pytest.raises(ParameterError, match="mesh"):
         solve_hji(sysm, paper_basis(), GameCost.for_system(sysm, 1, 1, 1, 10),
                   GridMesh([0, -1], [0.0001, 1], [0.00005, 1.0]), LinearPolicy(np.zeros((1, 2))))
+
+
+def test_negative_cost_is_warned():
+    """A basis that cannot represent a nonnegative J: the solver says so (J ≥ 0 check)."""
+    import warnings
+
+    from weakgrid.game import PolynomialBasis
+
+    A = np.array([[0.5, 0.4], [0.0, 0.5]])
+    sysm = LinearSystem(A, np.eye(2), np.array([[1.0], [0.0]]))
+    basis = PolynomialBasis(np.array([[1, 1], [2, 0]]))  # no x2² term
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        ctl = solve_hji(sysm, basis, GameCost.for_system(sysm, np.diag([0.01, 1.0]), np.eye(2), 1, 5),
+                        GridMesh([-1, -1], [1, 1], [0.05, 0.05]), LinearPolicy(np.zeros((2, 2))))
+    msgs = [str(x.message) for x in w if issubclass(x.category, RuntimeWarning)]
+    assert any("negative" in m and "mesh points" in m for m in msgs)
+    assert ctl.diagnostics(GridMesh([-1, -1], [1, 1], [0.05, 0.05]).points)["n_negative_J"] > 0
