@@ -166,3 +166,19 @@ def test_fault_at_upqc_bus_survived_at_high_load():
     assert np.max(np.abs(w[t > 6.0] - 1)) < 2e-3        # and the SG settles back
     v = res[cb.signals["shunt_bus_v"]]
     assert np.min(v[(t > 3.0) & (t < 3.1)]) < 0.2       # a real fault at the UPQC bus
+
+
+def test_series_voltage_input_gain_matches_design_model():
+    """A quadrature step Vup accelerates the SG by ≈ a·cos ϕs0·Vup (the design model's g, u1 channel)."""
+    cb = built("high")
+    u = np.array([0.02, 0.0])
+    K = DigitalController(lambda m: u, 0.5, cb.measure, UPQCTarget(cb.upqc_name), enable=[(0.5, 9.0)])
+    res = simulate(cb.system, 0.52, dt=1e-3, controllers=[K])
+    assert res.ok
+    t, iu = np.unique(res.t, return_index=True)
+    w = res[cb.signals["sg_speed"]][iu]
+    k = np.searchsorted(t, 0.5)
+    acc = (w[k + 10] - w[k]) / (t[k + 10] - t[k]) * 2 * math.pi * 50.0      # rad/s²
+    d = cb.design
+    assert acc == pytest.approx(d.a * math.cos(d.phi_s0) * u[0], rel=0.25)
+    assert np.max(np.abs(res[cb.signals["vup"]][iu][k + 1:] - u[0])) < 1e-12

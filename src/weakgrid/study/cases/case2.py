@@ -199,6 +199,15 @@ def build(load: str = "high", upqc: str = "conventional", variant: str = "upqc")
             f"with H = {float(sg['machine']['M']) / 2:g} s, i.e. a {f_design:.1f} Hz SG mode. Only "
             "the products a·V̄r·cos ϕs0 (mode) and a (input gain) matter to the controllers; "
             "a design from the derived model will give weights different from (31)."),
+        "notes": [
+            "measure: ϕ̂ = deviation of the GENROU rotor angle δ w.r.t. the shunt bus (it tracks the "
+            "deviation of the E' angle of the classical model); υ = (ω − 1)·ωs in rad/s.",
+            "checked in tests/study/test_case2.py: SG mode within 15 % of sqrt(a·V̄r·cos ϕs0)/2π "
+            "(measured ≈ +2 % high load, −2 % low load); Vup step gain within 25 % of a·cos ϕs0 "
+            "(measured +16 %). The Vuq channel (−a·sin ϕs0, small at ϕs0 ≈ 0.1-0.2 rad) is "
+            "dominated by the resistive parts (Ru, ra) neglected in B and is not reproduced.",
+            "UPQC branch resistance Ru and stator ra are neglected in B (lossless design model).",
+        ],
         "E_prime": float(abs(E)), "B": B, "H_system_base_s": H_sys, "M_design": 2 * H_sys / ws,
         "x_d1_system": xd1, "Xu_system": Xu, "Ru_system": Ru, "ra_system": ra,
         "Pe_sg_pu": S.real, "Qe_sg_pu": S.imag, "Pm_design_pu": Pm_model,
