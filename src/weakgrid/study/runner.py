@@ -137,7 +137,7 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
         series["vu"] = vu
         metrics["vu_peak_pu"] = float(np.nanmax(vu)) if vu.size else 0.0
         metrics["vu_rms_pu"] = float(np.sqrt(np.nanmean(vu[post] ** 2))) if post.any() else 0.0
-        vmax = float(case.info.get("upqc_vmax_pu", np.inf))
+        vmax = float(case.info.get("upqc_Vmax_pu", case.info.get("upqc_vmax_pu", np.inf)))
         metrics["vu_rating_pu"] = vmax
         metrics["vu_rating_reached"] = bool(metrics["vu_peak_pu"] >= vmax * (1 - 1e-6))
     if "p_series" in series:
