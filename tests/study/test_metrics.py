@@ -59,3 +59,12 @@ def test_verdicts():
 def test_not_settled_is_nan():
     t, y = damped(0.0, t_end=10)
     assert np.isnan(settling_time(t, y, y_final=0.0))
+
+
+def test_backswing_of_a_damped_cosine():
+    from weakgrid.study.metrics import backswing
+
+    sigma, omega = 1.5, 2 * np.pi * 1.2
+    t, y = damped(sigma, omega)
+    # first negative extreme near half a period: e^{-σ·π/ω}
+    assert backswing(t, y, y_final=0.0) == pytest.approx(np.exp(-sigma * np.pi / omega), rel=2e-2)

@@ -10,6 +10,9 @@ Definitions used throughout the reports:
 * **overshoot** — the peak ``max |e(t)|`` after ``t_start`` (in the signal's unit
   and, where a reference is given, in % of it): for a post-fault oscillation there
   is no step, so the peak excursion is the overshoot;
+* **backswing (overshoot past the final value)** — after ``t_start`` the largest
+  excursion of the sign opposite to the deviation at ``t_start``: the first swing is
+  set by the fault (the controller is bypassed), the backswing by the controller;
 * **settling time (2 % band)** — the last time after ``t_start`` at which
   ``|e(t)|`` exceeds 2 % of that peak, measured from ``t_start``;
 * **ITAE** — ``∫ (t − t_start)·|e(t)| dt`` (trapezoid rule);
@@ -25,7 +28,7 @@ import numpy as np
 
 from ..game.errors import ParameterError, ShapeError
 
-__all__ = ["ResponseMetrics", "response_metrics", "settling_time", "itae", "control_cost",
+__all__ = ["ResponseMetrics", "response_metrics", "settling_time", "itae", "backswing", "control_cost",
            "running_cost", "stability_verdict"]
 
 
@@ -71,6 +74,18 @@ def settling_time(t, y, t_start=0.0, band=0.02, y_final=None, tail=0.5) -> float
         frac = (e0 - thr) / (e0 - e1) if e0 != e1 else 0.0
         return float(ts[last] + frac * (ts[last + 1] - ts[last]) - t_start)
     return float(ts[last] - t_start)
+
+
+def backswing(t, y, t_start=0.0, y_final=None, tail=0.5) -> float:
+    """Largest excursion after ``t_start`` opposite in sign to the deviation at ``t_start``."""
+    t, y = _check(t, y)
+    yf = _final(t, y, tail) if y_final is None else float(y_final)
+    sel = t >= t_start
+    e = y[sel] - yf
+    if e.size == 0:
+        return float("nan")
+    s = np.sign(e[0]) or 1.0
+    return float(max(0.0, np.max(-s * e)))
 
 
 def itae(t, y, t_start=0.0, y_final=None, tail=0.5) -> float:

@@ -15,9 +15,10 @@ __all__ = ["metrics_frame", "write_tables", "write_html"]
 COLUMNS = [
     ("id", "run"), ("load", "load"), ("upqc", "UPQC"), ("controller", "controller"),
     ("fault", "fault"), ("speed_peak_dev_pu", "speed peak dev. [pu]"),
+    ("speed_backswing_pu", "speed backswing [pu]"),
     ("speed_settling_s", "speed settling (2 %) [s]"), ("speed_itae", "speed ITAE [pu·s²]"),
     ("speed_verdict", "speed verdict"), ("vdc_peak_dev_pu", "Vdc peak dev. [pu]"),
-    ("vdc_settling_s", "Vdc settling (2 %) [s]"), ("vdc_itae", "Vdc ITAE [pu·s²]"),
+    ("vdc_backswing_pu", "Vdc backswing [pu]"), ("vdc_settling_s", "Vdc settling (2 %) [s]"), ("vdc_itae", "Vdc ITAE [pu·s²]"),
     ("control_cost", "control cost Σu'Ru·T [pu²·s]"),
     ("running_cost_18", "running cost (18) [–]"), ("vu_peak_pu", "|Vu| peak [pu]"),
     ("vu_rms_pu", "|Vu| rms [pu]"), ("vu_rating_reached", "rating reached"),

@@ -12,7 +12,7 @@ from ..sim.events import Fault
 from ..sim.integrate import simulate
 from .cases import build_case
 from .controllers import make_controller
-from .metrics import control_cost, itae, running_cost, settling_time, stability_verdict
+from .metrics import backswing, control_cost, itae, running_cost, settling_time, stability_verdict
 
 __all__ = ["RunRecord", "run_scenario", "FAULT_IMPEDANCE"]
 
@@ -118,12 +118,14 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
         ok = np.isfinite(y) & post
         if ok.sum() > 2:
             metrics[f"{label}_peak_dev_pu"] = float(np.max(np.abs(y[ok] - y[0])))
+            metrics[f"{label}_backswing_pu"] = backswing(t[ok], y[ok], after, y_final=y[0])
             metrics[f"{label}_settling_s"] = settling_time(t[ok], y[ok], after, y_final=y[0])
             metrics[f"{label}_itae"] = itae(t[ok], y[ok], after, y_final=y[0])
             metrics[f"{label}_verdict"] = stability_verdict(t[ok], y[ok], after) \
                 if res.failure is None else "unstable"
         else:
             metrics.update({f"{label}_peak_dev_pu": float("nan"),
+                            f"{label}_backswing_pu": float("nan"),
                             f"{label}_settling_s": float("nan"),
                             f"{label}_itae": float("nan"), f"{label}_verdict": "unstable"})
     xa = np.nan_to_num(xk)
