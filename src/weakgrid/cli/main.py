@@ -7,9 +7,9 @@ import sys
 
 from .. import __version__
 from ..game.errors import WeakgridError
-from . import train
+from . import gamma, train
 
-SUBCOMMANDS = [train]
+SUBCOMMANDS = [train, gamma]
 
 
 def build_parser() -> argparse.ArgumentParser:
