@@ -7,9 +7,9 @@ import sys
 
 from .. import __version__
 from ..game.errors import WeakgridError
-from . import gamma, train
+from . import export, gamma, train
 
-SUBCOMMANDS = [train, gamma]
+SUBCOMMANDS = [train, gamma, export]
 
 
 def build_parser() -> argparse.ArgumentParser:
