@@ -7,9 +7,9 @@ import sys
 
 from .. import __version__
 from ..game.errors import WeakgridError
-from . import export, gamma, train
+from . import export, gamma, train, verify
 
-SUBCOMMANDS = [train, gamma, export]
+SUBCOMMANDS = [train, gamma, verify, export]
 
 
 def build_parser() -> argparse.ArgumentParser:
