@@ -2,7 +2,6 @@
 
 import json
 
-import numpy as np
 
 import weakgrid
 from weakgrid.cli.main import main

@@ -57,3 +57,20 @@ def test_settings_errors_name_the_field():
         SearchSettings(starts=("magic",))
     with pytest.raises(ParameterError, match="escape_factor"):
         SearchSettings(escape_factor=0.5)
+
+
+def test_fixed_initial_start_stops_at_its_own_limit():
+    """Why the search restarts: from the LQR start alone γ* is the LQR policy's limit."""
+    A, B, E, Q, R, P = linear_case(0)
+    system = LinearSystem(A, B, E)
+    K0, _, _ = dlqr(A, B, Q, R)
+    g_lin = attenuation_limit(A, B, E, Q, R, P)
+    g_pol = policy_attenuation_limit(A, B, E, K0, Q, R, P)
+    cost = GameCost.for_system(system, Q, R, P, 3.0 * g_pol)
+    res = search_min_gamma(
+        system, quadratic_basis(2), cost, GridMesh([-1, -1], [1, 1], [0.5, 0.5]),
+        LinearPolicy(K0), SolverSettings(tol_u=1e-10, tol_w=1e-10, max_outer=3000,
+                                         max_inner=3000),
+        SearchSettings(rtol=1e-3, rollout_steps=500, return_fraction=0.5, escape_factor=1e4,
+                       starts=("initial",)))
+    assert res.gamma_star >= g_pol * (1 - 1e-3) > g_lin

@@ -52,7 +52,6 @@ Everything is vectorized over the nodes (NumPy/SciPy; no Python loop per node).
 
 from __future__ import annotations
 
-import itertools
 import time
 from dataclasses import dataclass, field
 
@@ -503,7 +502,6 @@ def solve_game_dp(system, cost, lower, upper, settings: DPSettings | None = None
         if dV <= settings.tol:
             converged = True
             break
-    m = system.n_controls
     shape = tuple(settings.n_points)
     return DPSolution(system, cost, axes, S0, r.reshape(shape),
                       Z.reshape(shape + (Z.shape[1],)), settings, history, bias,

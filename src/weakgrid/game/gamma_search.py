@@ -264,7 +264,7 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
     def policy_for(start, gamma):
         if start == "continuation":
             ctl = best["controller"]
-            return None if ctl is None else ctl.control
+            return None if ctl is None else _SaddleControl(ctl)
         if start == "game-riccati":
             try:
                 sol = solve_game_riccati(A, B, E, cost.Q, cost.R, cost.P, gamma)
@@ -348,6 +348,21 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
 
 
 _MAX_DOUBLINGS = 10
+
+
+class _SaddleControl:
+    """``u*`` of a trained controller as an initial policy (recorded by its γ)."""
+
+    def __init__(self, controller):
+        self.controller = controller
+
+    def __call__(self, x):
+        return self.controller.control(x)
+
+    def to_dict(self):
+        return {"kind": "continuation", "name": "saddle-point control u* of the controller "
+                f"trained at gamma = {self.controller.cost.gamma:.9g}",
+                "gamma": self.controller.cost.gamma}
 
 
 def _short(exc, n=220):
