@@ -33,6 +33,9 @@ def add_parser(sub):
                    help="rollouts must stay inside the region enlarged this many times")
     p.add_argument("--return-fraction", type=float, default=d.return_fraction,
                    help="final state within this fraction of the region's half-widths")
+    p.add_argument("--starts", nargs="+", default=list(d.starts),
+                   choices=("continuation", "game-riccati", "initial"),
+                   help="starts of the policy iteration tried for each gamma, in order")
     p.add_argument("--tol", type=float, default=None,
                    help="δu = δw of the policy iteration (default: the problem's)")
     p.add_argument("--output", "-o", type=Path, default=None,
@@ -48,7 +51,8 @@ def run(args) -> int:
     problem = problem_of(args)
     settings = SearchSettings(rtol=args.rtol, max_trials=args.max_trials,
                               rollout_steps=args.rollout_steps, escape_factor=args.escape_factor,
-                              return_fraction=args.return_fraction)
+                              return_fraction=args.return_fraction,
+                              starts=tuple(args.starts))
     solver = problem.settings
     if args.tol is not None:
         solver = replace(solver, tol_u=args.tol, tol_w=args.tol)

@@ -66,6 +66,12 @@ def run(args) -> int:
     print(f"weakgrid verify: {problem.name}  ({problem.source})")
     if args.controller:
         ctl = load_controller(args.controller)
+        mine, theirs = problem.system.to_dict(), ctl.problem.get("model", {})
+        if any(mine.get(k) != theirs.get(k) for k in set(mine) - {"source", "state_names"}):
+            raise ParameterError("--controller", str(args.controller),
+                                 f"it was trained on another model ({theirs.get('kind')}: "
+                                 f"{ {k: v for k, v in theirs.items() if k != 'source'} }) "
+                                 f"than {problem.name}: pass the matching --preset/--config")
         print(f"  controller  {args.controller} (gamma = {ctl.cost.gamma:g})")
     else:
         ctl = problem.train()
