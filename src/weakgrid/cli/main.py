@@ -7,9 +7,9 @@ import sys
 
 from .. import __version__
 from ..game.errors import WeakgridError
-from . import reproduce, simulate, train
+from . import export, gamma, reproduce, simulate, train, verify
 
-SUBCOMMANDS = [train, simulate, reproduce]
+SUBCOMMANDS = [train, gamma, verify, export, simulate, reproduce]
 
 
 def build_parser() -> argparse.ArgumentParser:

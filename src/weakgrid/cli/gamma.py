@@ -1,0 +1,90 @@
+"""``weakgrid gamma``: the smallest attenuation level γ the HJI method accepts."""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import replace
+from pathlib import Path
+
+from ..game.controller import write_json_atomic
+from ..game.gamma_search import SearchSettings, search_min_gamma
+from ._common import add_problem_arguments, problem_of, provenance
+
+NAME = "gamma"
+
+
+def add_parser(sub):
+    p = sub.add_parser(
+        NAME, help="bisect for the minimum attenuation level gamma",
+        description="Bisect gamma between the linearization's game-Riccati attenuation limit "
+                    "and the problem's gamma: a gamma is accepted when the policy iteration "
+                    "converges, Yw < 0 on the whole mesh and the closed loop under the "
+                    "worst-case disturbance w* stays bounded and returns to the origin from "
+                    "the corners and edge midpoints of the training region. Prints gamma*, "
+                    "the bracket and every trial; writes the controller at gamma*.",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    add_problem_arguments(p)
+    d = SearchSettings()
+    p.add_argument("--rtol", type=float, default=d.rtol, help="relative width of the bracket")
+    p.add_argument("--max-trials", type=int, default=d.max_trials, help="cap on gammas tried")
+    p.add_argument("--rollout-steps", type=int, default=d.rollout_steps,
+                   help="length of the worst-case rollouts (steps)")
+    p.add_argument("--escape-factor", type=float, default=d.escape_factor,
+                   help="rollouts must stay inside the region enlarged this many times")
+    p.add_argument("--return-fraction", type=float, default=d.return_fraction,
+                   help="final state within this fraction of the region's half-widths")
+    p.add_argument("--starts", nargs="+", default=list(d.starts),
+                   choices=("continuation", "game-riccati", "initial"),
+                   help="starts of the policy iteration tried for each gamma, in order")
+    p.add_argument("--tol", type=float, default=None,
+                   help="δu = δw of the policy iteration (default: the problem's)")
+    p.add_argument("--output", "-o", type=Path, default=None,
+                   help="write the controller trained at gamma* (JSON)")
+    p.add_argument("--report", type=Path, default=None,
+                   help="write the search (bracket, history, parameters) as JSON")
+    p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
+    p.set_defaults(func=run)
+    return p
+
+
+def run(args) -> int:
+    problem = problem_of(args)
+    settings = SearchSettings(rtol=args.rtol, max_trials=args.max_trials,
+                              rollout_steps=args.rollout_steps, escape_factor=args.escape_factor,
+                              return_fraction=args.return_fraction,
+                              starts=tuple(args.starts))
+    solver = problem.settings
+    if args.tol is not None:
+        solver = replace(solver, tol_u=args.tol, tol_w=args.tol)
+    print(f"weakgrid gamma: {problem.name}  ({problem.source})")
+    print(f"  problem's gamma = {problem.cost.gamma:g};  bracket rtol = {settings.rtol:g}; "
+          f"rollouts of {settings.rollout_steps} steps from the corners/edge midpoints of Ω")
+    if not args.quiet:
+        print("\n  trial      gamma     decision  start           seconds  reason")
+    count = [0]
+
+    def progress(t):
+        count[0] += 1
+        if not args.quiet:
+            print(f"  {count[0]:5d}  {t.gamma:10.6g}  {'accepted' if t.accepted else 'rejected':>9}"
+                  f"  {t.start or '-':14}  {t.seconds:7.2f}  {t.reason}", flush=True)
+
+    res = search_min_gamma(problem.system, problem.basis, problem.cost, problem.mesh,
+                           problem.initial_policy, solver, settings,
+                           problem={"name": problem.name, "source": problem.source},
+                           progress=progress)
+    lo, hi = res.bracket
+    print(f"\n  gamma* = {res.gamma_star:.6g}   bracket [{lo:.6g}, {hi:.6g}] "
+          f"(relative width {(hi - lo) / hi:.2e})")
+    print(f"  lower bound (game-Riccati limit of the linearization) = {res.linear_limit:.6g}; "
+          f"gamma*/bound = {res.gamma_star / res.linear_limit:.4g}")
+    print(f"  {len(res.history)} trials in {res.seconds:.1f} s"
+          + ("" if res.converged else "  (stopped at --max-trials before the bracket closed)"))
+    if args.report:
+        rec = provenance(problem, NAME, **settings.to_dict(), solver=solver.to_dict())
+        write_json_atomic(args.report, {**rec, **res.to_dict()})
+        print(f"  wrote {args.report}")
+    if args.output:
+        res.controller.save(args.output)
+        print(f"  wrote the controller at gamma* to {args.output}")
+    return 0

@@ -1,0 +1,123 @@
+"""``weakgrid verify``: the trained controller against a dynamic-programming ground truth."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from ..game.controller import write_json_atomic
+from ..game.dynamic_programming import DPSettings, solve_game_dp
+from ..game.errors import ParameterError
+from ..game.optimality import closed_loop_gap, default_starts, value_error
+from ..models import load_controller
+from ._common import add_problem_arguments, problem_of, provenance
+
+NAME = "verify"
+
+
+def add_parser(sub):
+    p = sub.add_parser(
+        NAME, help="compare the controller with a grid dynamic-programming ground truth",
+        description="Solve the zero-sum game of a 2-state problem on a grid (policy iteration "
+                    "with exact sparse policy evaluation, cubic interpolation of the value "
+                    "around the linearization's game-Riccati quadratic, V(0) = 0 pinned) and "
+                    "report the relative error of the controller's cost J against the DP "
+                    "value on the training region and the closed-loop optimality gap (cost "
+                    "of u* vs the DP policy from a set of starts, with no disturbance and with "
+                    "the DP's worst-case disturbance).",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    add_problem_arguments(p)
+    d = DPSettings()
+    p.add_argument("--controller", type=Path, default=None,
+                   help="a controller file to verify (default: train the problem's)")
+    p.add_argument("--points", type=int, default=d.n_points[0], help="grid nodes per state "
+                   "(odd)")
+    p.add_argument("--hold-steps", type=int, default=d.hold_steps,
+                   help="k of the k-step lifting (inputs held k steps); 1 = no lifting")
+    p.add_argument("--margin", type=float, nargs="+", default=[d.margin],
+                   help="grid box = region enlarged by this fraction of its width per side "
+                        "(one value, or one per state)")
+    p.add_argument("--interpolation", choices=("cubic", "linear"), default=d.interpolation)
+    p.add_argument("--max-iterations", type=int, default=d.max_iterations)
+    p.add_argument("--steps", type=int, default=4000, help="closed-loop horizon (steps)")
+    p.add_argument("--start-fraction", type=float, default=0.5,
+                   help="starts: corners/edge midpoints of the region shrunk by this")
+    p.add_argument("--report", type=Path, default=None, help="write the report (JSON)")
+    p.set_defaults(func=run)
+    return p
+
+
+def _pct(v):
+    return f"{100 * v:.2f} %"
+
+
+def run(args) -> int:
+    problem = problem_of(args)
+    if problem.system.n_states != 2:
+        raise ParameterError("model", f"{problem.system.n_states} states",
+                             "the grid ground truth is for 2-state problems")
+    if not (0 < args.start_fraction <= 1):
+        raise ParameterError("--start-fraction", args.start_fraction, "use a value in (0, 1]")
+    settings = DPSettings(n_points=(args.points,) * 2, hold_steps=args.hold_steps,
+                          margin=tuple(args.margin), interpolation=args.interpolation,
+                          max_iterations=args.max_iterations)
+    print(f"weakgrid verify: {problem.name}  ({problem.source})")
+    if args.controller:
+        ctl = load_controller(args.controller)
+        mine, theirs = problem.system.to_dict(), ctl.problem.get("model", {})
+        if any(mine.get(k) != theirs.get(k) for k in set(mine) - {"source", "state_names"}):
+            raise ParameterError("--controller", str(args.controller),
+                                 f"it was trained on another model ({theirs.get('kind')}: "
+                                 f"{ {k: v for k, v in theirs.items() if k != 'source'} }) "
+                                 f"than {problem.name}: pass the matching --preset/--config")
+        print(f"  controller  {args.controller} (gamma = {ctl.cost.gamma:g})")
+    else:
+        ctl = problem.train()
+        print(f"  controller  trained now: {ctl.iterations['outer']} outer iterations, "
+              f"gamma = {ctl.cost.gamma:g}")
+    lo, hi = problem.mesh.lower, problem.mesh.upper
+    print(f"  DP grid     {args.points} x {args.points} on {list(lo)} .. {list(hi)} "
+          f"(margin {args.margin}), hold {args.hold_steps} step(s), {args.interpolation} "
+          f"residual around the game-Riccati quadratic")
+    print("\n  iteration  max|dV|/max V   max|dz|   bad-inertia nodes  seconds")
+
+    def progress(r):
+        print(f"  {r['iteration']:9d}  {r['max_rel_dV']:13.3e}  {r['max_dz']:8.2e}  "
+              f"{r['n_bad_inertia']:17d}  {r['seconds']:7.2f}", flush=True)
+
+    dp = solve_game_dp(problem.system, ctl.cost, lo, hi, settings, progress=progress)
+    print(f"  DP {'converged' if dp.converged else 'NOT converged'} in {len(dp.history)} "
+          f"iterations, {dp.seconds:.1f} s; lifting bias on the linearization "
+          f"{_pct(dp.lifting_bias)}")
+    ve = value_error(ctl, dp, lo, hi)
+    print(f"\n  value: J (controller) vs V (DP) on {ve['n_nodes']} grid nodes of the region")
+    print(f"    max|J - V| / max V = {_pct(ve['sup_error_over_max_V'])}  (max V = "
+          f"{ve['max_V']:.4g}, max J = {ve['max_J']:.4g}; worst at x = "
+          f"{np.round(ve['worst_state'], 4).tolist()}: J = {ve['J_at_worst']:.4g}, "
+          f"V = {ve['V_at_worst']:.4g})")
+    print(f"    |J - V| / V: median {_pct(ve['median_relative_error'])}, 90th percentile "
+          f"{_pct(ve['p90_relative_error'])} (nodes with V >= 1 % of max V)")
+    starts = default_starts(lo, hi, args.start_fraction)
+    gap = closed_loop_gap(ctl, dp, starts, args.steps)
+    print(f"\n  closed loop from {len(starts)} starts (region shrunk x{args.start_fraction:g}), "
+          f"{args.steps} steps: cost of u* vs the DP policy")
+    for key, label in (("no_disturbance", "no disturbance"),
+                       ("worst_case", "worst case (DP's w)")):
+        g = gap[key]
+        print(f"    {label:22s} gap mean {_pct(g['mean_relative_gap'])}, max "
+              f"{_pct(g['max_relative_gap'])}, min {_pct(g['min_relative_gap'])}; diverged "
+              f"{g['diverged_controller']}/{g['diverged_dp']}; DP off grid "
+              f"{_pct(g['dp_fraction_of_steps_off_grid'])} of steps")
+    print(f"    DP self-consistency: |cost(u_dp, w_dp) - V(x0)| / V(x0) <= "
+          f"{_pct(gap['dp_consistency'])}")
+    if args.report:
+        rec = provenance(problem, NAME, dp=settings.to_dict(), steps=args.steps,
+                         start_fraction=args.start_fraction,
+                         controller=str(args.controller) if args.controller else "trained",
+                         gamma=ctl.cost.gamma)
+        write_json_atomic(args.report, {**rec, "dp": dp.to_dict(), "value_error": ve,
+                                        "closed_loop": gap})
+        print(f"\n  wrote {args.report}")
+    return 0

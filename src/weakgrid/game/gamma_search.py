@@ -1,0 +1,370 @@
+"""The smallest attenuation level γ the HJI policy iteration accepts (bisection).
+
+The paper names the nonlinear H∞ attenuation level but does not compute it. Here a
+γ is *accepted* when
+
+1. the two-loop policy iteration (:func:`~weakgrid.game.hji.solve_hji`) converges,
+2. ``Yw = h'∇²J h − 2γ²P ≺ 0`` at every mesh point of Ω (and ``Yu ≻ 0``), and
+3. the closed loop under the trained saddle point, ``x+ = f + g·u*(x) + h·w*(x)``
+   (the worst-case disturbance feeding back), started from the corners, edge
+   midpoints and face centres of Ω, stays inside Ω enlarged ``escape_factor``
+   times about its centre and returns to within ``return_fraction`` of Ω's
+   half-widths of the origin in ``rollout_steps`` steps.
+
+The lower end of the bracket is the attenuation limit of the linearization at the
+origin (:func:`~weakgrid.game.lq.attenuation_limit` on ``system.linearize()`` with
+the cost's Q, R, P): near the origin the nonlinear game is its linearization, so
+no γ below it can be admissible. The upper end is the problem's own γ if it is
+accepted, otherwise the first accepted γ found by doubling it.
+
+Start of the policy iteration (the choice that makes the search work)
+---------------------------------------------------------------------
+Policy iteration starts from a fixed policy ``u⁽⁰⁾`` and its first inner loop
+maximizes the cost over ``w`` against that policy: it diverges (Yw loses
+negativity) unless γ exceeds the attenuation limit *of that policy*
+(:func:`~weakgrid.game.lq.policy_attenuation_limit` in the LQ case), which for a
+fixed LQR-like start can be far above the game's own limit. So each γ is tried
+from up to three starts, in this order, and accepted at the first that passes:
+
+* ``continuation`` — the saddle-point control ``u*`` of the controller trained at
+  the smallest γ accepted so far (a larger γ); it attenuates disturbances almost
+  as well as the saddle policy at the new γ, so the inner loop is well posed;
+* ``game-riccati`` — ``u = −K(γ)x``, the saddle-point gain of the linearization's
+  game Riccati equation at this very γ (exists for every γ above the lower
+  bound); for a linear system with a quadratic basis this policy's own
+  attenuation limit is below γ, so the search recovers the game-Riccati limit;
+* ``initial`` — the problem's initial policy.
+
+Acceptance is assumed monotone in γ (true for the LQ game); for the nonlinear
+approximate method it is an assumption, and the history shows every decision.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from .cost import GameCost
+from .errors import ParameterError, WeakgridError
+from .hji import SolverSettings, solve_hji
+from .lq import attenuation_limit, solve_game_riccati
+from .policies import LinearPolicy
+
+__all__ = ["GammaTrial", "GammaSearchResult", "SearchSettings", "search_min_gamma",
+           "worst_case_rollout_check"]
+
+
+@dataclass(frozen=True)
+class SearchSettings:
+    """Parameters of the γ bisection.
+
+    Parameters
+    ----------
+    rtol : float
+        Stop when ``(γ_hi − γ_lo) ≤ rtol·γ_hi``.
+    max_trials : int
+        Cap on the number of γ values tried.
+    rollout_steps : int
+        Length of the worst-case closed-loop rollouts (steps of the system).
+    escape_factor : float
+        Rollouts must stay inside Ω enlarged by this factor about its centre.
+    return_fraction : float
+        The final state must lie within this fraction of Ω's half-widths.
+    starts : tuple of str
+        Starts of the policy iteration tried for each γ, in order (see the module).
+    """
+
+    rtol: float = 1e-3
+    max_trials: int = 60
+    rollout_steps: int = 4000
+    escape_factor: float = 10.0
+    return_fraction: float = 0.05
+    starts: tuple = ("continuation", "game-riccati", "initial")
+
+    def __post_init__(self):
+        if not (np.isfinite(self.rtol) and 0 < self.rtol < 1):
+            raise ParameterError("rtol", self.rtol, "use a relative tolerance in (0, 1), "
+                                 "e.g. 1e-3")
+        if int(self.max_trials) != self.max_trials or self.max_trials < 2:
+            raise ParameterError("max_trials", self.max_trials, "use an integer ≥ 2")
+        if int(self.rollout_steps) != self.rollout_steps or self.rollout_steps < 1:
+            raise ParameterError("rollout_steps", self.rollout_steps, "use an integer ≥ 1")
+        if not (np.isfinite(self.escape_factor) and self.escape_factor >= 1):
+            raise ParameterError("escape_factor", self.escape_factor, "use a number ≥ 1")
+        if not (np.isfinite(self.return_fraction) and 0 < self.return_fraction <= 1):
+            raise ParameterError("return_fraction", self.return_fraction,
+                                 "use a fraction in (0, 1]")
+        bad = [s for s in self.starts if s not in ("continuation", "game-riccati", "initial")]
+        if bad or not self.starts:
+            raise ParameterError("starts", list(self.starts),
+                                 "use a non-empty subset of 'continuation', 'game-riccati', "
+                                 "'initial'")
+
+    def to_dict(self):
+        return {"rtol": self.rtol, "max_trials": self.max_trials,
+                "rollout_steps": self.rollout_steps, "escape_factor": self.escape_factor,
+                "return_fraction": self.return_fraction, "starts": list(self.starts)}
+
+
+@dataclass
+class GammaTrial:
+    """One γ tried by the search.
+
+    Attributes
+    ----------
+    gamma : float
+    accepted : bool
+    reason : str
+        Why it was accepted (the start that worked) or rejected (every start's failure).
+    start : str or None
+        The start that was accepted.
+    outer, max_inner : int or None
+        Iterations of the accepted run.
+    max_eig_Yw : float or None
+        Largest eigenvalue of Yw on the mesh for the accepted run.
+    final_norm : float or None
+        Largest final normalized state of the worst-case rollouts.
+    seconds : float
+    """
+
+    gamma: float
+    accepted: bool
+    reason: str
+    start: str | None = None
+    outer: int | None = None
+    max_inner: int | None = None
+    max_eig_Yw: float | None = None
+    final_norm: float | None = None
+    seconds: float = 0.0
+
+    def to_dict(self):
+        return dict(self.__dict__)
+
+
+@dataclass
+class GammaSearchResult:
+    """The outcome of :func:`search_min_gamma`.
+
+    Attributes
+    ----------
+    gamma_star : float
+        The smallest accepted γ (upper end of the final bracket).
+    bracket : (float, float)
+        ``(γ_lo, γ_hi)``: γ_lo rejected (or the linear lower bound), γ_hi accepted.
+    linear_limit : float
+        The game-Riccati attenuation limit of the linearization (the lower bound).
+    history : list of GammaTrial
+    controller : GameController
+        Trained at γ*.
+    settings : SearchSettings
+    seconds : float
+    """
+
+    gamma_star: float
+    bracket: tuple
+    linear_limit: float
+    history: list
+    controller: object
+    settings: SearchSettings
+    seconds: float
+    converged: bool = True
+    meta: dict = field(default_factory=dict)
+
+    def to_dict(self):
+        return {"gamma_star": self.gamma_star, "bracket": list(self.bracket),
+                "linear_limit": self.linear_limit, "converged": self.converged,
+                "settings": self.settings.to_dict(), "seconds": self.seconds,
+                "history": [t.to_dict() for t in self.history], **self.meta}
+
+
+def _box(mesh):
+    return np.asarray(mesh.lower, float), np.asarray(mesh.upper, float)
+
+
+def _starts_of(mesh):
+    if hasattr(mesh, "corners_and_midpoints"):
+        return mesh.corners_and_midpoints()
+    from .mesh import GridMesh
+
+    lo, hi = _box(mesh)
+    return GridMesh(lo, hi, (hi - lo) / 2).corners_and_midpoints()
+
+
+def worst_case_rollout_check(controller, mesh, steps, escape_factor=10.0, return_fraction=0.05):
+    """Roll the closed loop out under ``(u*, w*)`` from the corners/edge midpoints of Ω.
+
+    Returns
+    -------
+    ok : bool
+    final_norm : float
+        Largest final state in units of Ω's half-widths (∞-norm).
+    reason : str
+    """
+    lo, hi = _box(mesh)
+    centre, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    x = _starts_of(mesh)
+    system = controller.system
+    for k in range(int(steps)):
+        u, w = controller.saddle_point(x)
+        x = system.step(x, u, w)
+        if not np.all(np.isfinite(x)):
+            return False, float("inf"), f"the worst-case closed loop gave NaN/inf at step {k + 1}"
+        dev = np.abs((x - centre) / half).max()
+        if dev > escape_factor:
+            return False, float(np.abs(x / half).max()), (
+                f"the worst-case closed loop left Ω enlarged {escape_factor:g}× at step {k + 1}")
+    final = float(np.abs(x / half).max())
+    if final > return_fraction:
+        return False, final, (f"the worst-case closed loop did not return: after {steps} steps "
+                              f"the state is {final:.3g} half-widths of Ω from the origin "
+                              f"(> {return_fraction:g})")
+    return True, final, "bounded and returns"
+
+
+def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
+                     solver: SolverSettings | None = None,
+                     settings: SearchSettings | None = None, *,
+                     problem: dict | None = None,
+                     progress: Callable[[GammaTrial], None] | None = None) -> GammaSearchResult:
+    """Bisect for the smallest γ accepted by the HJI policy iteration (see the module).
+
+    Parameters
+    ----------
+    system, basis, cost, mesh, initial_policy, solver
+        As for :func:`~weakgrid.game.hji.solve_hji`; ``cost.gamma`` is the first
+        upper-bound candidate.
+    settings : SearchSettings
+    problem : dict, optional
+        Recorded in the controller file.
+    progress : callable, optional
+        Called with each :class:`GammaTrial` as it is decided.
+
+    Returns
+    -------
+    GammaSearchResult
+
+    Raises
+    ------
+    ConvergenceError
+        No accepted γ was found while doubling from ``cost.gamma``.
+    """
+    from .errors import ConvergenceError
+
+    solver = solver or SolverSettings()
+    settings = settings or SearchSettings()
+    t0 = time.perf_counter()
+    A, B, E = system.linearize()
+    g_lin = attenuation_limit(A, B, E, cost.Q, cost.R, cost.P, rtol=min(1e-8, settings.rtol))
+    history: list[GammaTrial] = []
+    best = {"gamma": None, "controller": None}
+
+    def policy_for(start, gamma):
+        if start == "continuation":
+            ctl = best["controller"]
+            return None if ctl is None else _SaddleControl(ctl)
+        if start == "game-riccati":
+            try:
+                sol = solve_game_riccati(A, B, E, cost.Q, cost.R, cost.P, gamma)
+            except WeakgridError:
+                return None
+            return LinearPolicy(sol.K, name=f"game-Riccati gain of the linearization at "
+                                            f"gamma={gamma:.6g}")
+        return initial_policy
+
+    def trial(gamma):
+        t1 = time.perf_counter()
+        c = GameCost(cost.Q, cost.R, cost.P, float(gamma))
+        reasons = []
+        for start in settings.starts:
+            pol = policy_for(start, gamma)
+            if pol is None:
+                continue
+            try:
+                ctl = solve_hji(system, basis, c, mesh, pol, solver, problem=problem)
+            except WeakgridError as exc:
+                reasons.append(f"[{start}] {type(exc).__name__}: {_short(exc)}")
+                continue
+            eu, ew = ctl.block_eigenvalues(mesh.points)
+            if not (ew.max() < 0 and eu.min() > 0):
+                reasons.append(f"[{start}] Yw not ≺ 0 or Yu not ≻ 0 on the mesh "
+                               f"(max eig Yw {ew.max():.3g}, min eig Yu {eu.min():.3g})")
+                continue
+            ok, final, why = worst_case_rollout_check(
+                ctl, mesh, settings.rollout_steps, settings.escape_factor,
+                settings.return_fraction)
+            if not ok:
+                reasons.append(f"[{start}] {why}")
+                continue
+            rec = GammaTrial(float(gamma), True, f"[{start}] converged, Yw ≺ 0 on the mesh, "
+                             f"worst-case closed loop {why}", start, ctl.iterations["outer"],
+                             max(ctl.iterations["inner"]), float(ew.max()), final,
+                             time.perf_counter() - t1)
+            return rec, ctl
+        rec = GammaTrial(float(gamma), False, "; ".join(reasons) or "no start available",
+                         seconds=time.perf_counter() - t1)
+        return rec, None
+
+    def record(rec, ctl):
+        history.append(rec)
+        if progress is not None:
+            progress(rec)
+        if rec.accepted and (best["gamma"] is None or rec.gamma < best["gamma"]):
+            best["gamma"], best["controller"] = rec.gamma, ctl
+
+    # upper end: the problem's gamma, doubled until accepted
+    hi = max(float(cost.gamma), g_lin * (1 + 2 * settings.rtol))
+    while True:
+        rec, ctl = trial(hi)
+        record(rec, ctl)
+        if rec.accepted:
+            break
+        if len(history) > _MAX_DOUBLINGS or len(history) >= settings.max_trials:
+            raise ConvergenceError(
+                f"no accepted gamma found up to {hi:g} ({len(history)} trials doubling the "
+                f"problem's gamma; last reason: {rec.reason}). Check the initial policy and "
+                "the training region, or start from a larger gamma", history)
+        hi *= 2.0
+    lo = g_lin
+    converged = True
+    while hi - lo > settings.rtol * hi:
+        if len(history) >= settings.max_trials:
+            converged = False
+            break
+        mid = np.sqrt(lo * hi) if hi / lo > 2.0 else 0.5 * (lo + hi)
+        rec, ctl = trial(mid)
+        record(rec, ctl)
+        if rec.accepted:
+            hi = mid
+        else:
+            lo = mid
+    ctl = best["controller"]
+    ctl.problem["gamma_search"] = {"gamma_star": hi, "bracket": [lo, hi],
+                                   "linear_limit": g_lin, "settings": settings.to_dict()}
+    return GammaSearchResult(hi, (lo, hi), g_lin, history, ctl, settings,
+                             time.perf_counter() - t0, converged)
+
+
+_MAX_DOUBLINGS = 10
+
+
+class _SaddleControl:
+    """``u*`` of a trained controller as an initial policy (recorded by its γ)."""
+
+    def __init__(self, controller):
+        self.controller = controller
+
+    def __call__(self, x):
+        return self.controller.control(x)
+
+    def to_dict(self):
+        return {"kind": "continuation", "name": "saddle-point control u* of the controller "
+                f"trained at gamma = {self.controller.cost.gamma:.9g}",
+                "gamma": self.controller.cost.gamma}
+
+
+def _short(exc, n=220):
+    s = str(exc)
+    return s if len(s) <= n else s[: n - 1] + "…"
