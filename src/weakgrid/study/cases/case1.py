@@ -64,9 +64,11 @@ def matpower_case(data: dict, load: str) -> dict:
         pd, qd = loads.get(str(b["id"]), [0.0, 0.0])
         vm = 1.0
         bus.append([b["id"], b["type"], pd, qd, 0, 0, 1, vm, 0, b["base_kv"], 1, 1.5, 0.5])
+    # gen 0: the GTI (a PV bus holds its PCC voltage; on a PQ bus it injects P_mw + j·Q_mvar)
     g, s = data["gti"], data["sg"]
     gen = [
-        [g["bus"], g["P_mw"], 0, 9999, -9999, g["V_set"], g["Mbase"], 1, 9999, -9999] + [0] * 11,
+        [g["bus"], g["P_mw"], g.get("Q_mvar", 0.0), 9999, -9999, g.get("V_set", 1.0), g["Mbase"], 1,
+         9999, -9999] + [0] * 11,
         [s["bus"], 0, 0, 9999, -9999, s["V_set"], s["Mbase"], 1, 9999, -9999] + [0] * 11,
     ]
     branch = [[br["from"], br["to"], br["r"], br["x"], br["b"], 0, 0, 0, 0, 0, 1, -360, 360]
@@ -223,6 +225,7 @@ def build(load: str = "high", upqc: str = "conventional", variant: str = "upqc",
         "gti_Q_Mvar": float(net.pf.Qg[0] * Sb),
         "bus_voltages": {int(b): float(abs(v)) for b, v in zip(net.bus_ids, net.pf.V)},
         "upqc_Vmax": float(data["upqc"]["Vmax"]) if variant == "upqc" else None,
+        "fault": dict(data["fault"]),
         "sources": "data/cases/case1-weak-grid.toml (values chosen; paper Tables I-II missing)",
     }
     f = data["fault"]
