@@ -106,8 +106,7 @@ def transfer_twoport(system, data):
     Y = np.zeros((4, 4), complex)
     yg = -1j * Bg
     Y[0, 0] += yg; Y[1, 1] += yg; Y[0, 1] -= yg; Y[1, 0] -= yg
-    idx = {int(f[k_fd]): None, int(t[k_fd]): None}
-    if set(idx) != {gbus, int(b1)}:
+    if {int(f[k_fd]), int(t[k_fd])} != {gbus, int(b1)}:
         raise ParameterError("branch.feeder", (int(f[k_fd]), int(t[k_fd])),
                              "the feeder must join the GTI bus and the UPQC's bus 1")
     loc = {gbus: 1, int(b1): 2}
@@ -128,9 +127,8 @@ def derive_design(system, data, upqc="conventional"):
     net = system.network
     gti = system.components["GTI"]
     g = data["gti"]
-    r = net.index_of(data["bus_r"]) if "bus_r" in data else None
     k_up = _branch_index(data, "upqc")
-    r = int(np.nonzero(net.bus_ids == int(net.branch[k_up, 0]))[0][0]) if r is None else r
+    r = net.index_of(int(net.branch[k_up, 0]))      # the UPQC shunt bus (from-bus of its branch)
     Vr = net.pf.V[r]
     Vs = float(gti.Vs0[0])
     phi0 = float(gti.phi0[0])
@@ -151,6 +149,8 @@ def derive_design(system, data, upqc="conventional"):
            # the exact two-port power at the operating point vs the design model's Vs·V̄r·B·sin ϕs0
            "P_twoport": float(Vs**2 * Y11.real + Vs * B * abs(Vr) * np.sin(phi0 - eps)),
            "P_design": float(Vs * abs(Vr) * B * np.sin(phi0)),
+           # the lossless design model with this angle would match the two-port exactly
+           "phi_s0_lossless_equivalent": phi0 - eps,
            "omega_design": float(np.sqrt(a * abs(Vr) * np.cos(phi0))),
            "omega_twoport": float(np.sqrt(tau_p / C * Vs * B * abs(Vr) * np.cos(phi0 - eps)))}
     return model, det
