@@ -16,7 +16,8 @@ from .metrics import backswing, control_cost, itae, running_cost, settling_time,
 
 __all__ = ["RunRecord", "run_scenario", "FAULT_IMPEDANCE"]
 
-FAULT_IMPEDANCE = {"rf": 0.0, "xf": 1e-3}  # pu on the system base: a near-bolted fault
+# default fault impedance (pu on the system base) where a case's data give none
+FAULT_IMPEDANCE = {"rf": 0.0, "xf": 1e-3}
 Q_DESIGN = 0.01 * np.eye(2)  # the paper's state weight of (18)
 R_DESIGN = np.eye(2)
 
@@ -86,7 +87,8 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
     dc = DigitalController(K, T=T, measure=case.measure, target=target,
                            enable=[(0.0, sc.t_fault), (sc.t_clear, sc.t_end + 1.0)],
                            name=sc.controller)
-    fault = Fault(bus=case.fault_bus, t_on=sc.t_fault, t_off=sc.t_clear, **FAULT_IMPEDANCE)
+    fz = {k: float(case.info.get("fault", {}).get(k, v)) for k, v in FAULT_IMPEDANCE.items()}
+    fault = Fault(bus=case.fault_bus, t_on=sc.t_fault, t_off=sc.t_clear, **fz)
     t0 = time.perf_counter()
     res = simulate(case.system, sc.t_end, dt=dt or T, events=[fault], controllers=[dc],
                    on_failure="return")
@@ -139,7 +141,9 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
         series["vu"] = vu
         metrics["vu_peak_pu"] = float(np.nanmax(vu)) if vu.size else 0.0
         metrics["vu_rms_pu"] = float(np.sqrt(np.nanmean(vu[post] ** 2))) if post.any() else 0.0
-        vmax = float(case.info.get("upqc_Vmax_pu", case.info.get("upqc_vmax_pu", np.inf)))
+        up = case.system.components.get("UPQC")
+        vmax = float(up.p["Vmax"][up.names.index(case.upqc_name)]) if up is not None and \
+            case.upqc_name in up.names else float("inf")
         metrics["vu_rating_pu"] = vmax
         metrics["vu_rating_reached"] = bool(metrics["vu_peak_pu"] >= vmax * (1 - 1e-6))
     if "p_series" in series:
