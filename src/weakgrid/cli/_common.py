@@ -26,20 +26,3 @@ def provenance(problem, command: str, **parameters) -> dict:
             "source": problem.source, "parameters": parameters}
 
 
-def write_text_atomic(path, text: str) -> Path:
-    """Write a text file atomically (temporary file in the same folder, then rename)."""
-    import os
-    import tempfile
-
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path

@@ -7,12 +7,12 @@ import re
 from pathlib import Path
 
 from .. import __version__
-from ..game.controller import write_json_atomic
+from ..fileio import write_json_atomic
 from ..game.errors import ParameterError
 from ..game.export_c import generate_c, valid_c_name
 from ..game.export_json import describe_controller
 from ..models import load_controller
-from ._common import write_text_atomic
+from ..fileio import write_text_atomic
 
 NAME = "export"
 

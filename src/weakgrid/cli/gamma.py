@@ -6,7 +6,7 @@ import argparse
 from dataclasses import replace
 from pathlib import Path
 
-from ..game.controller import write_json_atomic
+from ..fileio import write_json_atomic
 from ..game.gamma_search import SearchSettings, search_min_gamma
 from ._common import add_problem_arguments, problem_of, provenance
 

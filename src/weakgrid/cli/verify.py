@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..game.controller import write_json_atomic
+from ..fileio import write_json_atomic
 from ..game.dynamic_programming import DPSettings, solve_game_dp
 from ..game.errors import ParameterError
 from ..game.optimality import closed_loop_gap, default_starts, value_error

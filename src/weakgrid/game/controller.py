@@ -11,8 +11,6 @@ with ``Yu = g'∇²J g + 2R`` and ``Yw = h'∇²J h − 2γ²P``.
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -22,6 +20,7 @@ from .bases import PolynomialBasis
 from .cost import GameCost
 from .errors import ParameterError, ShapeError
 from .system import ControlAffineSystem, system_from_dict
+from ..fileio import write_json_atomic
 
 __all__ = ["GameController", "load_controller", "FILE_FORMAT"]
 
@@ -35,23 +34,6 @@ def _package_version():
         return version("weakgrid")
     except PackageNotFoundError:  # pragma: no cover
         return "0.0.0+unknown"
-
-
-def write_json_atomic(path, obj) -> Path:
-    """Write JSON to ``path`` atomically (temporary file in the same folder, then rename)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(obj, fh, indent=1)
-            fh.write("\n")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
 
 
 @dataclass(eq=False)

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import html
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import pandas as pd
+
+from ..fileio import write_text_atomic
 
 __all__ = ["metrics_frame", "write_tables", "write_html"]
 
@@ -26,14 +26,6 @@ COLUMNS = [
     ("p_series_peak_pct_line", "P_series peak [% line]"), ("failed", "failed"),
     ("wall_s", "wall time [s]"),
 ]
-
-
-def _atomic_write(path: Path, text: str):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
-    os.replace(tmp, path)
 
 
 def metrics_frame(metrics: list[dict]) -> pd.DataFrame:
@@ -55,13 +47,13 @@ def write_tables(metrics: list[dict], folder) -> tuple[Path, Path]:
     folder = Path(folder)
     df = metrics_frame(metrics)
     csv = folder / "metrics.csv"
-    _atomic_write(csv, df.to_csv(index=False))
+    write_text_atomic(csv, df.to_csv(index=False))
     head = "| " + " | ".join(lbl for _, lbl in COLUMNS) + " |"
     sep = "|" + "---|" * len(COLUMNS)
     rows = ["| " + " | ".join(_fmt(r[k]) for k, _ in COLUMNS) + " |" for r in
             df.to_dict("records")]
     md = folder / "metrics.md"
-    _atomic_write(md, "\n".join(["# weakgrid reproduce — metrics", "", head, sep, *rows, ""]))
+    write_text_atomic(md, "\n".join(["# weakgrid reproduce — metrics", "", head, sep, *rows, ""]))
     return csv, md
 
 
@@ -104,5 +96,5 @@ def write_html(path, *, claims, metrics, figures, designs, meta) -> Path:
                      "</tr>")
     parts.append("</table><h2>Parameters</h2><pre>" + e(meta.get("parameters", "")) + "</pre>")
     path = Path(path)
-    _atomic_write(path, "\n".join(parts))
+    write_text_atomic(path, "\n".join(parts))
     return path

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
-from ..game.controller import write_json_atomic
+from ..fileio import replace_atomic, write_json_atomic
 from ..models import load_preset
 from .cases import build_case
 from .claims import judge_all
@@ -49,10 +49,7 @@ def _save_series(rec, folder: Path):
     t = s["t"]
     cols = {k: v for k, v in s.items() if isinstance(v, np.ndarray) and v.shape == t.shape}
     df = pd.DataFrame(cols)
-    p = folder / f"{rec.scenario.id}.parquet"
-    tmp = p.with_suffix(".parquet.tmp")
-    df.to_parquet(tmp)
-    tmp.replace(p)
+    replace_atomic(folder / f"{rec.scenario.id}.parquet", df.to_parquet)
 
 
 def reproduce(output="reproduce-output", quick=False, log=print) -> dict:
