@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..game.hji import closed_loop_spectral_radius
-from ..models import load_preset, load_problem, preset_names
+from ._common import add_problem_arguments, problem_of
 
 NAME = "train"
 
@@ -20,9 +20,7 @@ def add_parser(sub):
                     "print the iterations, the weights beside the published ones, timing and "
                     "diagnostics, and write the controller file (JSON).",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--preset", choices=preset_names(), help="a shipped preset")
-    src.add_argument("--config", type=Path, help="a problem file (TOML), see the README")
+    add_problem_arguments(p)
     p.add_argument("--output", "-o", type=Path, default=None,
                    help="controller file to write (default: NAME.controller.json)")
     p.add_argument("--tol", type=float, default=None,
@@ -37,7 +35,7 @@ def _fmt_row(cells, widths):
 
 
 def run(args) -> int:
-    problem = load_preset(args.preset) if args.preset else load_problem(args.config)
+    problem = problem_of(args)
     settings = problem.settings
     if args.tol is not None:
         from dataclasses import replace
