@@ -133,7 +133,7 @@ class Simulator:
         return self._alg_lu
 
     # ------------------------------------------------------------------ solves
-    def solve_algebraic(self, t, z, max_iter=30, return_eval=False):
+    def solve_algebraic(self, t, z, max_iter=30, return_eval=False, y_guess=None):
         """Re-solve the network (algebraic) variables with the states fixed.
 
         Converged when the Newton update of the algebraic variables is below
@@ -145,6 +145,8 @@ class Simulator:
         nx = self.nx
         z_start = z.copy()
         z = z.copy()
+        if y_guess is not None:   # first attempt from a predicted algebraic solution
+            z[nx:] = y_guess
         for attempt in range(3):
             if attempt == 2:
                 z = z_start.copy()
@@ -302,6 +304,8 @@ class Simulator:
         rec.add(self.t, self.z, self._ctx)
         ev_i = 0
         eps = 1e-12
+        self._jump, self._jump_t = None, -math.inf
+        jump_gap = min([c.T for c in controllers if hasattr(c, "T")] or [0.0])
         nstep = 0
         failure = None
         try:
@@ -333,10 +337,21 @@ class Simulator:
                         if c.due(self.t):
                             discont |= c.sample(self, self.t, self.z)
                     if discont:
+                        y_before = self.z[self.nx:]
+                        guess = None
                         if new_jac:
                             self._refresh_jacobian(self.t, self.z)
                             self._zprev = None     # events: restart the predictor
-                        self.z, F, self._ctx = self.solve_algebraic(self.t, self.z, return_eval=True)
+                            self._jump = None
+                        elif self._jump is not None and self._jump_t > self.t - 1.5 * jump_gap:
+                            # consecutive ZOH samples of a smooth control: the algebraic jump
+                            # is close to the previous one; start the re-solve from there
+                            guess = y_before + self._jump
+                        self.z, F, self._ctx = self.solve_algebraic(self.t, self.z, return_eval=True,
+                                                                    y_guess=guess)
+                        if not new_jac:
+                            self._jump = self.z[self.nx:] - y_before
+                            self._jump_t = self.t
                         self._f = F[:self.nx].copy()
                         rec.add(self.t, self.z, self._ctx)
                 elif nstep % self.save_every == 0:
