@@ -44,14 +44,19 @@ class Lag:
         self.T = np.asarray(T, dtype=float)
         self._on = self.T > 0
         self._Ts = _safe(self.T)
+        self._all = bool(np.all(self._on))
 
     def init(self, u0):
         return self.K * u0
 
     def output(self, x, u):
+        if self._all:
+            return x
         return np.where(self._on, x, self.K * u)
 
     def deriv(self, x, u):
+        if self._all:
+            return (self.K * u - x) / self._Ts
         return np.where(self._on, (self.K * u - x) / self._Ts, 0.0)
 
 
@@ -97,14 +102,22 @@ class LeadLag:
         self.K = np.broadcast_to(np.asarray(K, dtype=float), self.T2.shape)
         self._on = self.T2 > 0
         self._T2s = _safe(self.T2)
+        self._all = bool(np.all(self._on))
+        self._r = self.T1 / self._T2s
+        self._unit = bool(np.all(self.K == 1.0))
 
     def init(self, u0):
         return np.asarray(u0, dtype=float) * 1.0
 
     def output(self, x, u):
-        return self.K * np.where(self._on, self.T1 / self._T2s * (u - x) + x, u)
+        if self._all:
+            y = self._r * (u - x) + x
+            return y if self._unit else self.K * y
+        return self.K * np.where(self._on, self._r * (u - x) + x, u)
 
     def deriv(self, x, u):
+        if self._all:
+            return (u - x) / self._T2s
         return np.where(self._on, (u - x) / self._T2s, 0.0)
 
 
@@ -130,14 +143,20 @@ class Washout:
         self.T = np.asarray(T, dtype=float)
         self._on = self.T > 0
         self._Ts = _safe(self.T)
+        self._all = bool(np.all(self._on))
+        self._g = self.K / self._Ts
 
     def init(self, u0):
         return np.asarray(u0, dtype=float) * 1.0
 
     def output(self, x, u):
-        return np.where(self._on, self.K / self._Ts * (u - x), 0.0)
+        if self._all:
+            return self._g * (u - x)
+        return np.where(self._on, self._g * (u - x), 0.0)
 
     def deriv(self, x, u):
+        if self._all:
+            return (u - x) / self._Ts
         return np.where(self._on, (u - x) / self._Ts, 0.0)
 
 

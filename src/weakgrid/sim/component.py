@@ -56,10 +56,24 @@ class Context:
         self.t = t
         self.x = x
         self.V = V
-        self.f = np.zeros_like(x)
+        self.f = np.zeros(x.shape)
         self.I = np.zeros(V.shape, dtype=complex)
-        self.sig = {k: v.copy() for k, v in system.sig_defaults.items()}
+        # one copy of the stacked defaults; the dict holds row views of it
+        S = system._sig_stack
+        if x.ndim > 1:   # a batch of points (leading axis): one row block per point
+            S = np.broadcast_to(S[:, None, :], (S.shape[0],) + x.shape[:-1] + (S.shape[1],))
+        self.sig = dict(zip(system._sig_keys, S.copy()))
         self.out = {}
+
+
+def scatter_add(a, idx, v, unique):
+    """``a[..., idx] += v`` along the last axis, also for repeated indices (``unique=False``)."""
+    if unique:
+        a[..., idx] += v
+    else:
+        v = np.broadcast_to(v, a.shape[:-1] + (len(idx),))
+        for k, j in enumerate(idx):
+            a[..., j] += v[..., k]
 
 
 class Component:
@@ -120,11 +134,12 @@ class Component:
     def assign(self, off: int) -> int:
         """Reserve state indices starting at ``off``; return the next free index."""
         self.off = off
+        self._sls = [slice(off + k * self.n, off + (k + 1) * self.n) for k in range(len(self.states))]
         return off + self.n * len(self.states)
 
     def sl(self, k: int) -> slice:
         """Slice of state number ``k`` (all instances) in the state vector."""
-        return slice(self.off + k * self.n, self.off + (k + 1) * self.n)
+        return self._sls[k]
 
     def idx(self, state: str) -> np.ndarray:
         """Global indices of ``state`` for all instances."""

@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from .blocks import PID
-from .component import Component
+from .component import Component, scatter_add
 from .errors import DataError
 from .network import GEN_BUS, GEN_STATUS
 from .params import Param
@@ -94,6 +94,8 @@ class GTI(Component):
         self.pidP = PID(p["kp_p"], p["ki_p"], p["kd_p"], p["Td"])
         self.pidQ = PID(p["kp_q"], p["ki_q"], p["kd_q"], p["Td"])
         self.p_series = np.zeros(self.n)
+        self._any_pq = bool(self.pq.any())
+        self._uniq = len(set(self.bus.tolist())) == self.n
 
     def pattern(self, system):
         groups = []
@@ -128,50 +130,54 @@ class GTI(Component):
     def compute(self, ctx):
         p = self.p
         x = ctx.x
-        Vc, ph = x[self.sl(0)], x[self.sl(1)]
-        V = ctx.V[self.bus]
-        th_r = np.angle(ctx.V[self.ref])
+        sl = self._sls
+        Vc, ph = x[..., sl[0]], x[..., sl[1]]
+        V = ctx.V[..., self.bus]
+        th_r = np.angle(ctx.V[..., self.ref])
         phi_s = self.phi0 + ph
         Vs_ref = self.Vs0
-        if self.pq.any():
+        if self._any_pq:
             # PID on filtered measurements (states only: no algebraic loop)
-            eP = self.Pin / (1 + p["chi"]) - x[self.sl(2)]
-            eQ = self.Q0 - x[self.sl(3)]
-            uP = self.pidP.output(x[self.sl(4)], x[self.sl(5)], eP)
-            uQ = self.pidQ.output(x[self.sl(6)], x[self.sl(7)], eQ)
+            eP = self.Pin / (1 + p["chi"]) - x[..., sl[2]]
+            eQ = self.Q0 - x[..., sl[3]]
+            uP = self.pidP.output(x[..., sl[4]], x[..., sl[5]], eP)
+            uQ = self.pidQ.output(x[..., sl[6]], x[..., sl[7]], eQ)
             phi_s = np.where(self.pq, self.phi0 + uP, phi_s)
             Vs_ref = np.where(self.pq, self.Vs0 + uQ, Vs_ref)
             self._eP, self._eQ = eP, eQ
-        Vcs = np.where(Vc > 1e-6, Vc, 1e-6)
+        Vcs = np.where(Vc > 1e-6, Vc, 1e-6) if not (Vc > 1e-6).all() else Vc
         ks = np.minimum(Vs_ref / Vcs, p["ks_max"])
         Vs = ks * Vc
         Es = Vs * np.exp(1j * (th_r + phi_s))
         I = -1j * p["B"] * (Es - V)
-        ctx.I[self.bus] += I
+        scatter_add(ctx.I, self.bus, I, self._uniq)
         self._Pac = (Es * np.conj(I)).real
         self._Q = (V * np.conj(I)).imag
         self._Vs, self._ks, self._phis = Vs, ks, phi_s
-        ctx.sig["gti_p_series"] = np.zeros(self.n)
+        ctx.sig["gti_p_series"] = np.zeros(x.shape[:-1] + (self.n,))
 
     def finish(self, ctx):
         p = self.p
         x = ctx.x
         f = ctx.f
-        Vc = x[self.sl(0)]
+        sl = self._sls
+        Vc = x[..., sl[0]]
         ps = ctx.sig["gti_p_series"]
         Pe = (1 + p["chi"]) * self._Pac
         dVc = (self.Pin - Pe - ps) / (p["C"] * Vc)
         ups = p["tau"] * (Vc ** 2 - p["Vc0"] ** 2) / 2
-        f[self.sl(0)] = dVc
-        f[self.sl(1)] = np.where(self.pq, 0.0, ups)
-        if self.pq.any():
+        f[..., sl[0]] = dVc
+        if self._any_pq:
             q = self.pq
-            f[self.sl(2)] = np.where(q, (self._Pac - x[self.sl(2)]) / p["Td"], 0.0)
-            f[self.sl(3)] = np.where(q, (self._Q - x[self.sl(3)]) / p["Td"], 0.0)
-            dip, ddp = self.pidP.deriv(x[self.sl(4)], x[self.sl(5)], self._eP)
-            diq, ddq = self.pidQ.deriv(x[self.sl(6)], x[self.sl(7)], self._eQ)
-            f[self.sl(4)], f[self.sl(5)] = np.where(q, dip, 0.0), np.where(q, ddp, 0.0)
-            f[self.sl(6)], f[self.sl(7)] = np.where(q, diq, 0.0), np.where(q, ddq, 0.0)
+            f[..., sl[1]] = np.where(q, 0.0, ups)
+            f[..., sl[2]] = np.where(q, (self._Pac - x[..., sl[2]]) / p["Td"], 0.0)
+            f[..., sl[3]] = np.where(q, (self._Q - x[..., sl[3]]) / p["Td"], 0.0)
+            dip, ddp = self.pidP.deriv(x[..., sl[4]], x[..., sl[5]], self._eP)
+            diq, ddq = self.pidQ.deriv(x[..., sl[6]], x[..., sl[7]], self._eQ)
+            f[..., sl[4]], f[..., sl[5]] = np.where(q, dip, 0.0), np.where(q, ddp, 0.0)
+            f[..., sl[6]], f[..., sl[7]] = np.where(q, diq, 0.0), np.where(q, ddq, 0.0)
+        else:   # all energy mode: the pq states are constant (their f stays 0)
+            f[..., sl[1]] = ups
         o = ctx.out
         o["GTI.Vs"], o["GTI.ks"], o["GTI.phi_s"] = self._Vs, self._ks, self._phis
         o["GTI.P_ac"], o["GTI.Q"], o["GTI.Pe"] = self._Pac, self._Q, Pe

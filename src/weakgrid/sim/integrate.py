@@ -32,9 +32,16 @@ import math
 
 import numpy as np
 import scipy.linalg as sla
+from scipy.linalg.lapack import dgetrs
 
 from .errors import DataError, SimulationError
 from .results import Results
+
+
+def lu_solve(lu, b):
+    """``scipy.linalg.lu_solve`` without its per-call checks (LAPACK getrs on a factored matrix)."""
+    x, info = dgetrs(lu[0], lu[1], b)
+    return x
 
 
 class Simulator:
@@ -78,6 +85,7 @@ class Simulator:
         self._Jdev = None
         self._lu = None
         self._lu_key = None
+        self._lu_h = None
         self._alg_lu = None
         self._alg_key = None
         self.events = []
@@ -97,8 +105,10 @@ class Simulator:
         return J
 
     def _iteration_lu(self, h):
-        key = (h, self.sys.net_version, self.frozen.tobytes())
-        if self._lu_key != key:
+        key = (self.sys.net_version, self.frozen.tobytes())
+        # a step that differs from the factored one only by round-off (steps onto
+        # sampling breakpoints) reuses the chord matrix
+        if self._lu_key != key or abs(h - self._lu_h) > 1e-9 * h:
             J = self._full_jac()
             nx = self.nx
             M = J
@@ -110,6 +120,7 @@ class Simulator:
                 M[fi, fi] = 1.0
             self._lu = sla.lu_factor(M, check_finite=False)
             self._lu_key = key
+            self._lu_h = h
             self.stats["lu"] += 1
         return self._lu
 
@@ -122,11 +133,20 @@ class Simulator:
         return self._alg_lu
 
     # ------------------------------------------------------------------ solves
-    def solve_algebraic(self, t, z, max_iter=30):
-        """Re-solve the network (algebraic) variables with the states fixed."""
+    def solve_algebraic(self, t, z, max_iter=30, return_eval=False, y_guess=None):
+        """Re-solve the network (algebraic) variables with the states fixed.
+
+        Converged when the Newton update of the algebraic variables is below
+        ``tol``; the point returned is the last one *evaluated* (its distance to
+        the solution is that update, i.e. < ``tol``), so that with
+        ``return_eval=True`` the residual ``F`` and context evaluated there are
+        returned too (``(z, F, ctx)``) and need not be recomputed.
+        """
         nx = self.nx
         z_start = z.copy()
         z = z.copy()
+        if y_guess is not None:   # first attempt from a predicted algebraic solution
+            z[nx:] = y_guess
         for attempt in range(3):
             if attempt == 2:
                 z = z_start.copy()
@@ -140,12 +160,12 @@ class Simulator:
                     lu = self._alg_lu_get()
                 F, ctx = self.sys.residual(t, z)
                 self.stats["evals"] += 1
-                dy = sla.lu_solve(lu, F[nx:], check_finite=False)
-                z[nx:] -= damp * dy
-                if not np.all(np.isfinite(z)):
+                dy = lu_solve(lu, F[nx:])
+                if not np.all(np.isfinite(dy)):
                     break
                 if np.max(np.abs(dy)) < self.tol:
-                    return z
+                    return (z, F, ctx) if return_eval else z
+                z[nx:] -= damp * dy
         raise SimulationError(t, "newton", "algebraic re-initialization after an event did not converge")
 
     def _newton(self, t1, h, z_n, f_n, z):
@@ -165,7 +185,7 @@ class Simulator:
             R[:nx] = z[:nx] - x_n - 0.5 * h * (f_n + F[:nx])
             if len(li) and fz.any():
                 R[li[fz]] = z[li[fz]] - limval
-            dz = sla.lu_solve(lu, R, check_finite=False)
+            dz = lu_solve(lu, R)
             z -= dz
             self.stats["newton"] += 1
             if not np.all(np.isfinite(z)):
@@ -181,7 +201,9 @@ class Simulator:
         li = self.sys.lim_idx
         guess = z_n.copy()
         if self._zprev is not None and self._hprev:
-            guess = z_n + (z_n - self._zprev) * (h / self._hprev)
+            # linear extrapolation of the previous step's increment (taken before any
+            # controller re-solve at the breakpoint, so the predictor survives ZOH samples)
+            guess = z_n + (self._zend - self._zprev) * (h / self._hprev)
         refreshed = False
         while True:
             z, nit = self._newton(t + h, h, z_n, f_n, guess)
@@ -214,9 +236,9 @@ class Simulator:
                 fl = f1[li]
                 rel = ((self.frozen > 0) & (fl < 0)) | ((self.frozen < 0) & (fl > 0))
                 self.frozen[rel] = 0
-            if nit > self.max_iter // 2:
+            if nit > self.max_iter // 2 - 1:   # refresh the chord matrix after slow convergence (cheap: batched)
                 self._refresh_jacobian(t + h, z)
-            self._zprev, self._hprev = z_n, h
+            self._zprev, self._zend, self._hprev = z_n, z, h
             self.z, self._f, self._ctx = z, f1.copy(), ctx
             self.t = t + h
             self.stats["steps"] += 1
@@ -282,6 +304,8 @@ class Simulator:
         rec.add(self.t, self.z, self._ctx)
         ev_i = 0
         eps = 1e-12
+        self._jump, self._jump_t = None, -math.inf
+        jump_gap = min([c.T for c in controllers if hasattr(c, "T")] or [0.0])
         nstep = 0
         failure = None
         try:
@@ -313,12 +337,22 @@ class Simulator:
                         if c.due(self.t):
                             discont |= c.sample(self, self.t, self.z)
                     if discont:
+                        y_before = self.z[self.nx:]
+                        guess = None
                         if new_jac:
                             self._refresh_jacobian(self.t, self.z)
-                        self.z = self.solve_algebraic(self.t, self.z)
-                        F, self._ctx = sys.residual(self.t, self.z)
+                            self._zprev = None     # events: restart the predictor
+                            self._jump = None
+                        elif self._jump is not None and self._jump_t > self.t - 1.5 * jump_gap:
+                            # consecutive ZOH samples of a smooth control: the algebraic jump
+                            # is close to the previous one; start the re-solve from there
+                            guess = y_before + self._jump
+                        self.z, F, self._ctx = self.solve_algebraic(self.t, self.z, return_eval=True,
+                                                                    y_guess=guess)
+                        if not new_jac:
+                            self._jump = self.z[self.nx:] - y_before
+                            self._jump_t = self.t
                         self._f = F[:self.nx].copy()
-                        self._zprev = None
                         rec.add(self.t, self.z, self._ctx)
                 elif nstep % self.save_every == 0:
                     rec.add(self.t, self.z, self._ctx)

@@ -126,8 +126,6 @@ class _Recorder:
     def __init__(self, sys):
         self.sys = sys
         net = sys.network
-        self.t = []
-        self.rows = []
         names, kinds, fac = [], [], []
         fn = 60.0
         for nm, u in zip(sys.state_names(), sys.state_units()):
@@ -177,24 +175,51 @@ class _Recorder:
         self.fac = fac
         self._layout_done = True
 
+    def _plan(self):
+        """Column ranges of each part of a row (set once, after the layout)."""
+        sys = self.sys
+        nx, nb, nm = sys.nx, sys.nb, len(sys.machine_names)
+        c = nx + 4 * nb
+        self._bus = slice(nx, c)
+        self._outs = []
+        for key, n in self._out_keys:
+            self._outs.append((key, slice(c, c + n)))
+            c += n
+        self._tm = slice(c, c + nm)
+        self._vs = slice(c + nm, c + 2 * nm)
+        self._ncol = c + 2 * nm
+        self._buf = np.empty((256, self._ncol))
+        self._tbuf = np.empty(256)
+        self._n = 0
+
     def add(self, t, z, ctx):
         if not self._layout_done:
             self._layout(ctx)
+            self._plan()
+        if self._n == len(self._tbuf):   # grow (amortized doubling)
+            self._buf = np.concatenate([self._buf, np.empty_like(self._buf)])
+            self._tbuf = np.concatenate([self._tbuf, np.empty_like(self._tbuf)])
         sys = self.sys
         nx, nb = sys.nx, sys.nb
+        row = self._buf[self._n]
+        row[:nx] = z[:nx]
         Vr, Vi = z[nx:nx + nb], z[nx + nb:]
-        bus = np.empty(4 * nb)
+        bus = row[self._bus]
         bus[0::4], bus[1::4] = Vr, Vi
         bus[2::4] = np.hypot(Vr, Vi)
         bus[3::4] = np.arctan2(Vi, Vr)
-        parts = [z[:nx], bus]
-        for key, n in self._out_keys:
-            parts.append(np.broadcast_to(ctx.out[key], (n,)))
-        parts.append(ctx.sig["tm"])
-        parts.append(ctx.sig["vs"])
-        self.t.append(t)
-        self.rows.append(np.concatenate(parts))
+        out = ctx.out
+        for key, sl in self._outs:
+            row[sl] = out[key]
+        row[self._tm] = ctx.sig["tm"]
+        row[self._vs] = ctx.sig["vs"]
+        self._tbuf[self._n] = t
+        self._n += 1
 
     def finish(self, failure=None, stats=None):
-        data = np.vstack(self.rows) if self.rows else np.zeros((0, len(self.names)))
-        return Results(self.t, self.names, data, self.kinds, self.fac, failure=failure, stats=stats)
+        if self._layout_done:
+            data = self._buf[:self._n].copy()
+            t = self._tbuf[:self._n].copy()
+        else:
+            data, t = np.zeros((0, len(self.names))), np.zeros(0)
+        return Results(t, self.names, data, self.kinds, self.fac, failure=failure, stats=stats)

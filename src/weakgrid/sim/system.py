@@ -177,7 +177,10 @@ class System:
         gen_used = {}
         self.comps = sorted(self.components.values(), key=lambda c: c.order)
         nm = len(self._machines)
-        self.sig_defaults = {k: np.zeros(nm) for k in SIGNALS}
+        # machine-indexed signal defaults: rows of one array (copied once per evaluation)
+        self._sig_keys = SIGNALS
+        self._sig_stack = np.zeros((len(SIGNALS), nm))
+        self.sig_defaults = dict(zip(SIGNALS, self._sig_stack))
         for c in self.comps:
             c.setup(self)
         # one machine per static generator
@@ -276,14 +279,19 @@ class System:
         self.colour = colour
         self.ncolours = len(used)
         self._pr, self._pc = np.nonzero(P)
+        self._ccols = np.nonzero(colour >= 0)[0]
         self._pcol = colour[self._pc]
 
     # --------------------------------------------------------------- equations
     def evaluate(self, t: float, z: np.ndarray) -> Context:
-        """Evaluate all components at ``(t, z)``; returns the context with ``f``, ``I``, ``out``."""
+        """Evaluate all components at ``(t, z)``; returns the context with ``f``, ``I``, ``out``.
+
+        ``z`` may also be a batch of points, shape ``(B, N)`` (components index
+        the last axis), as used by the finite-difference Jacobian.
+        """
         nx, nb = self.nx, self.nb
-        V = z[nx:nx + nb] + 1j * z[nx + nb:]
-        ctx = Context(self, t, z[:nx], V)
+        V = z[..., nx:nx + nb] + 1j * z[..., nx + nb:]
+        ctx = Context(self, t, z[..., :nx], V)
         for c in self.comps:
             c.compute(ctx)
         for c in self.comps:
@@ -292,7 +300,8 @@ class System:
 
     def device_residual(self, t, z):
         ctx = self.evaluate(t, z)
-        return np.concatenate([ctx.f, -ctx.I.real, -ctx.I.imag]), ctx
+        I = ctx.I
+        return np.concatenate([ctx.f, -I.real, -I.imag], axis=-1), ctx
 
     def residual(self, t, z):
         """Full residual ``F = [f; g]`` and the evaluation context."""
@@ -301,19 +310,21 @@ class System:
         return F, ctx
 
     def jacobian_devices(self, t, z, F0=None):
-        """Device part of ``dF/dz`` by coloured forward differences (dense array)."""
-        if F0 is None:
-            F0, _ = self.device_residual(t, z)
+        """Device part of ``dF/dz`` by coloured forward differences (dense array).
+
+        All ``ncolours`` perturbed points (and the base point) are evaluated in
+        one batched evaluation.
+        """
         h = 1e-7 * np.maximum(1.0, np.abs(z))
-        D = np.empty((self.ncolours, self.N))
-        for k in range(self.ncolours):
-            zk = z.copy()
-            sel = self.colour == k
-            zk[sel] += h[sel]
-            D[k] = self.device_residual(t, zk)[0]
+        Z = np.repeat(z[None, :], self.ncolours + 1, axis=0)
+        cols = self._ccols
+        Z[self.colour[cols] + 1, cols] += h[cols]
+        D = self.device_residual(t, Z)[0]
+        if F0 is None:
+            F0 = D[0]
         J = np.zeros((self.N, self.N))
         r, c = self._pr, self._pc
-        J[r, c] = (D[self._pcol, r] - F0[r]) / h[c]
+        J[r, c] = (D[self._pcol + 1, r] - F0[r]) / h[c]
         return J
 
     def jacobian(self, t, z):

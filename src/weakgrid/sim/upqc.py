@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .component import Component
+from .component import Component, scatter_add
 from .errors import DataError
 from .network import BR_B, BR_R, BR_X, F_BUS, SHIFT, T_BUS, TAP
 from .params import Param
@@ -88,6 +88,11 @@ class UPQC(Component):
                 self.gti_i[i] = gti.names.index(lk["gti"])
         self.u_p = np.zeros(n)
         self.u_q = np.zeros(n)
+        self._conv = ~self.reduced
+        self._any_conv = bool(self._conv.any())
+        self._any_red = bool(self.reduced.any())
+        self._uniq = len(set(self.r.tolist()) | set(self.b1.tolist())) == 2 * n
+        self._uniq_g = len(set(self.gti_i[self.reduced].tolist())) == int(self.reduced.sum())
 
     def set_input(self, name, Vup, Vuq):
         """Hold series-voltage commands ``Vup`` (quadrature) and ``Vuq`` (in phase) [pu] for UPQC ``name``."""
@@ -108,27 +113,34 @@ class UPQC(Component):
 
     def compute(self, ctx):
         on = ctx.system.branch_status[self.branch]
-        Vr = ctx.V[self.r]
-        V1 = ctx.V[self.b1]
+        Vr = ctx.V[..., self.r]
+        V1 = ctx.V[..., self.b1]
         vr_abs = np.abs(Vr)
-        ur = np.where(vr_abs > 1e-9, Vr / np.where(vr_abs > 1e-9, vr_abs, 1.0), 1.0)
+        if (vr_abs > 1e-6).all():      # fast path (same values as the guarded expressions)
+            ur = Vr / vr_abs
+            Vr_safe = Vr
+        else:
+            ur = np.where(vr_abs > 1e-9, Vr / np.where(vr_abs > 1e-9, vr_abs, 1.0), 1.0)
+            Vr_safe = np.where(vr_abs > 1e-6, Vr, 1e-6)
         Vu = (self.u_q + 1j * self.u_p) * ur
         mag = np.abs(Vu)
         Vmax = self.p["Vmax"]
-        scale = np.where(mag > Vmax, Vmax / np.where(mag > 0, mag, 1.0), 1.0)
-        Vu = np.where(on, Vu * scale, 0.0)
+        if (mag > Vmax).any():
+            Vu = Vu * np.where(mag > Vmax, Vmax / np.where(mag > 0, mag, 1.0), 1.0)
+        if not on.all():
+            Vu = np.where(on, Vu, 0.0)
         Isrc = self.yu * Vu
-        np.add.at(ctx.I, self.b1, Isrc)
-        np.add.at(ctx.I, self.r, -Isrc)
+        scatter_add(ctx.I, self.b1, Isrc, self._uniq)
+        scatter_add(ctx.I, self.r, -Isrc, self._uniq)
         I = self.yu * (Vr + Vu - V1) * on
         S = Vu * np.conj(I)
         P = S.real
-        conv = ~self.reduced
-        if conv.any():
-            Vr_safe = np.where(vr_abs > 1e-6, Vr, 1e-6)
-            np.add.at(ctx.I, self.r[conv], -(P[conv] / np.conj(Vr_safe[conv])))
-        if self.reduced.any():
-            np.add.at(ctx.sig["gti_p_series"], self.gti_i[self.reduced], P[self.reduced])
+        conv = self._conv
+        if self._any_conv:
+            scatter_add(ctx.I, self.r[conv], -(P[..., conv] / np.conj(Vr_safe[..., conv])), self._uniq)
+        if self._any_red:
+            red = self.reduced
+            scatter_add(ctx.sig["gti_p_series"], self.gti_i[red], P[..., red], self._uniq_g)
         rot = Vu * np.conj(ur)
         o = ctx.out
         o["UPQC.Vuq"], o["UPQC.Vup"], o["UPQC.Vu"] = rot.real, rot.imag, np.abs(Vu)

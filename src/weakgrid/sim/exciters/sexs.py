@@ -53,11 +53,11 @@ class SEXS(MachineControl):
 
     def compute(self, ctx):
         m = self.mach
-        ll, law = ctx.x[self.sl(0)], ctx.x[self.sl(1)]
-        vi = self.vref0 - ctx.sig["Vt"][m] + ctx.sig["vs"][m]
+        ll, law = ctx.x[..., self._sls[0]], ctx.x[..., self._sls[1]]
+        vi = self.vref0 - ctx.sig["Vt"][..., m] + ctx.sig["vs"][..., m]
         y = self.LL.output(ll, vi)
-        ctx.f[self.sl(0)] = self.LL.deriv(ll, vi)
-        ctx.f[self.sl(1)] = self.LAW.deriv(law, y)
-        vf = np.clip(self.LAW.output(law, y), self.p["EMIN"], self.p["EMAX"])
-        ctx.sig["vf"][m] = vf
+        ctx.f[..., self._sls[0]] = self.LL.deriv(ll, vi)
+        ctx.f[..., self._sls[1]] = self.LAW.deriv(law, y)
+        vf = np.minimum(np.maximum(self.LAW.output(law, y), self.p["EMIN"]), self.p["EMAX"])
+        ctx.sig["vf"][..., m] = vf
         ctx.out["SEXS.vi"] = vi

@@ -66,16 +66,16 @@ class HYGOV(MachineControl):
     def compute(self, ctx):
         p = self.p
         m = self.mach
-        x1, xi, g, q = (ctx.x[self.sl(k)] for k in range(4))
-        wd = ctx.sig["omega"][m] - p["wref0"]
+        x1, xi, g, q = (ctx.x[..., self._sls[k]] for k in range(4))
+        wd = ctx.sig["omega"][..., m] - p["wref0"]
         c = xi + x1 / p["r"]
         e = self.pref0 - wd - p["R"] * c
         h = (q / g) ** 2
         f = ctx.f
-        f[self.sl(0)] = self.LF.deriv(x1, e)
-        f[self.sl(1)] = np.clip(x1 / (p["r"] * p["Tr"]), -p["VELM"], p["VELM"])
-        f[self.sl(2)] = self.LG.deriv(g, c)
-        f[self.sl(3)] = (1.0 - h) / p["Tw"]
+        f[..., self._sls[0]] = self.LF.deriv(x1, e)
+        f[..., self._sls[1]] = np.minimum(np.maximum(x1 / (p["r"] * p["Tr"]), -p["VELM"]), p["VELM"])
+        f[..., self._sls[2]] = self.LG.deriv(g, c)
+        f[..., self._sls[3]] = (1.0 - h) / p["Tw"]
         tm = (p["At"] * h * (q - p["qNL"]) - p["Dt"] * wd * g) * self.Sbase
-        ctx.sig["tm"][m] = tm
+        ctx.sig["tm"][..., m] = tm
         ctx.out["HYGOV.gate"], ctx.out["HYGOV.head"] = g, h

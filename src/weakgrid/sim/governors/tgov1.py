@@ -60,11 +60,11 @@ class TGOV1(MachineControl):
     def compute(self, ctx):
         p = self.p
         m = self.mach
-        lag, ll = ctx.x[self.sl(0)], ctx.x[self.sl(1)]
-        wd = ctx.sig["omega"][m] - p["wref0"]
+        lag, ll = ctx.x[..., self._sls[0]], ctx.x[..., self._sls[1]]
+        wd = ctx.sig["omega"][..., m] - p["wref0"]
         pd = self.pref0 + (self.paux - wd) / p["R"]
-        ctx.f[self.sl(0)] = self.LAG.deriv(lag, pd)
-        ctx.f[self.sl(1)] = self.LL.deriv(ll, lag)
+        ctx.f[..., self._sls[0]] = self.LAG.deriv(lag, pd)
+        ctx.f[..., self._sls[1]] = self.LL.deriv(ll, lag)
         pout = self.LL.output(ll, lag) - p["Dt"] * wd
-        ctx.sig["tm"][m] = pout
+        ctx.sig["tm"][..., m] = pout
         ctx.out["TGOV1.pout"] = pout

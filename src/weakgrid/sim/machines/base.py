@@ -82,10 +82,10 @@ class SyncMachine(Component):
     def publish(self, ctx, omega, delta, Pe, Qe, V, XadIfd):
         m = self.m
         sig = ctx.sig
-        sig["omega"][m] = omega
-        sig["delta"][m] = delta
-        sig["Pe"][m] = Pe
-        sig["Qe"][m] = Qe
-        sig["Vt"][m] = np.abs(V)
-        sig["theta"][m] = np.angle(V)
-        sig["XadIfd"][m] = XadIfd
+        sig["omega"][..., m] = omega
+        sig["delta"][..., m] = delta
+        sig["Pe"][..., m] = Pe
+        sig["Qe"][..., m] = Qe
+        sig["Vt"][..., m] = np.abs(V)
+        sig["theta"][..., m] = np.angle(V)
+        sig["XadIfd"][..., m] = XadIfd

@@ -63,13 +63,13 @@ class GENCLS(SyncMachine):
 
     def compute(self, ctx):
         x = ctx.x
-        delta, omega = x[self.sl(0)], x[self.sl(1)]
-        V = ctx.V[self.bus]
+        delta, omega = x[..., self._sls[0]], x[..., self._sls[1]]
+        V = ctx.V[..., self.bus]
         vd, vq = self.dq_voltage(V, delta)
         ra, xq = self.p["ra"], self.p["xd1"]
-        vf = ctx.sig["vf"][self.m]
+        vf = ctx.sig["vf"][..., self.m]
         Id, Iq = solve_stator(vf, 0.0, vd, vq, ra, xq, xq)
-        ctx.I[self.bus] += self.network_current(Id, Iq, delta)
+        ctx.I[..., self.bus] += self.network_current(Id, Iq, delta)
         Pe = vd * Id + vq * Iq
         Qe = vq * Id - vd * Iq
         self._te = (vq + ra * Iq) * Iq + (vd + ra * Id) * Id
@@ -79,9 +79,9 @@ class GENCLS(SyncMachine):
         o["GENCLS.Id"], o["GENCLS.Iq"] = Id, Iq
 
     def finish(self, ctx):
-        omega = ctx.x[self.sl(1)]
-        tm = ctx.sig["tm"][self.m]
-        ctx.out["GENCLS.vf"] = ctx.sig["vf"][self.m]
+        omega = ctx.x[..., self._sls[1]]
+        tm = ctx.sig["tm"][..., self.m]
+        ctx.out["GENCLS.vf"] = ctx.sig["vf"][..., self.m]
         d_delta, d_omega = swing(omega, tm, self._te, self.p["M"], self.p["D"], self.wb)
-        ctx.f[self.sl(0)] = d_delta
-        ctx.f[self.sl(1)] = d_omega
+        ctx.f[..., self._sls[0]] = d_delta
+        ctx.f[..., self._sls[1]] = d_omega

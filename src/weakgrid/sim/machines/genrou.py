@@ -79,8 +79,18 @@ class GENROU(SyncMachine):
         self.gq2 = (p["xq1"] - p["xq2"]) / (p["xq1"] - xl) ** 2
         self.gqd = (p["xq"] - xl) / (p["xd"] - xl)
         self.SA, self.SB = quad_saturation_coeffs(1.0, p["S10"], 1.2, p["S12"])
+        # constants of compute
+        self._c_e2d = self.gd2 * (p["xd1"] - xl)
+        self._c_e2q = 1 - self.gq1
+        self._det = p["xd2"] * p["xq2"] + p["ra"] * p["ra"]
+        self._xdd1 = p["xd"] - p["xd1"]
+        self._xqq1 = p["xq"] - p["xq1"]
+        self._xd1l = p["xd1"] - xl
+        self._xq1l = p["xq1"] - xl
 
     def _sat(self, psi2):
+        if (psi2 > 0).all():   # fast path: same values as below for psi2 > 0
+            return self.SB * np.maximum(psi2 - self.SA, 0.0) ** 2 / psi2
         with np.errstate(divide="ignore", invalid="ignore"):
             Se = np.where(psi2 >= self.SA, self.SB * (psi2 - self.SA) ** 2 / psi2, 0.0)
         return np.where(np.isfinite(Se), Se, 0.0)
@@ -118,20 +128,27 @@ class GENROU(SyncMachine):
     def compute(self, ctx):
         p = self.p
         x = ctx.x
-        delta, omega = x[self.sl(0)], x[self.sl(1)]
-        e1q, e1d, e2d, e2q = x[self.sl(2)], x[self.sl(3)], x[self.sl(4)], x[self.sl(5)]
-        xl = p["xl"]
-        psi2d = self.gd1 * e1q + self.gd2 * (p["xd1"] - xl) * e2d
-        psi2q = self.gq1 * e1d + (1 - self.gq1) * e2q
-        psi2 = np.sqrt(psi2d ** 2 + psi2q ** 2)
+        sl = self._sls
+        delta, omega = x[..., sl[0]], x[..., sl[1]]
+        e1q, e1d, e2d, e2q = x[..., sl[2]], x[..., sl[3]], x[..., sl[4]], x[..., sl[5]]
+        psi2d = self.gd1 * e1q + self._c_e2d * e2d
+        psi2q = self.gq1 * e1d + self._c_e2q * e2q
+        psi2 = np.sqrt(psi2d * psi2d + psi2q * psi2q)
         Se = self._sat(psi2)
-        V = ctx.V[self.bus]
-        vd, vq = self.dq_voltage(V, delta)
+        V = ctx.V[..., self.bus]
+        sd, cd = np.sin(delta), np.cos(delta)
+        Vre, Vim = V.real, V.imag
+        vd = Vre * sd - Vim * cd
+        vq = Vre * cd + Vim * sd
         ra = p["ra"]
-        Id, Iq = solve_stator(psi2d, psi2q, vd, vq, ra, p["xd2"], p["xq2"])
-        ctx.I[self.bus] += self.network_current(Id, Iq, delta)
-        XadIfd = e1q + (p["xd"] - p["xd1"]) * (self.gd1 * Id - self.gd2 * e2d + self.gd2 * e1q) + Se * psi2d
-        XaqI1q = e1d + (p["xq"] - p["xq1"]) * (self.gq2 * e1d - self.gq2 * e2q - self.gq1 * Iq) \
+        # stator (see gencls.solve_stator)
+        a = psi2d - vq
+        b = vd - psi2q
+        Id = (p["xq2"] * a - ra * b) / self._det
+        Iq = (p["xd2"] * b + ra * a) / self._det
+        ctx.I[..., self.bus] += (Id + 1j * Iq) * (sd - 1j * cd)
+        XadIfd = e1q + self._xdd1 * (self.gd1 * Id - self.gd2 * e2d + self.gd2 * e1q) + Se * psi2d
+        XaqI1q = e1d + self._xqq1 * (self.gq2 * e1d - self.gq2 * e2q - self.gq1 * Iq) \
             + Se * self.gqd * psi2q
         psid = ra * Iq + vq
         psiq = -(ra * Id + vd)
@@ -141,9 +158,9 @@ class GENROU(SyncMachine):
         Qe = vq * Id - vd * Iq
         self.publish(ctx, omega, delta, Pe, Qe, V, XadIfd)
         f = ctx.f
-        f[self.sl(3)] = -XaqI1q / p["Tq10"]
-        f[self.sl(4)] = (-e2d + e1q - (p["xd1"] - xl) * Id) / p["Td20"]
-        f[self.sl(5)] = (-e2q + e1d + (p["xq1"] - xl) * Iq) / p["Tq20"]
+        f[..., sl[3]] = -XaqI1q / p["Tq10"]
+        f[..., sl[4]] = (-e2d + e1q - self._xd1l * Id) / p["Td20"]
+        f[..., sl[5]] = (-e2q + e1d + self._xq1l * Iq) / p["Tq20"]
         o = ctx.out
         o["GENROU.Pe"], o["GENROU.Qe"], o["GENROU.te"] = Pe, Qe, self._te
         o["GENROU.Id"], o["GENROU.Iq"], o["GENROU.XadIfd"] = Id, Iq, XadIfd
@@ -152,12 +169,13 @@ class GENROU(SyncMachine):
     def finish(self, ctx):
         p = self.p
         m = self.m
-        omega = ctx.x[self.sl(1)]
-        vf = ctx.sig["vf"][m]
-        tm = ctx.sig["tm"][m]
+        sl = self._sls
+        omega = ctx.x[..., sl[1]]
+        vf = ctx.sig["vf"][..., m]
+        tm = ctx.sig["tm"][..., m]
         ctx.out["GENROU.vf"] = vf
         d_delta, d_omega = swing(omega, tm, self._te, p["M"], p["D"], self.wb)
         f = ctx.f
-        f[self.sl(0)] = d_delta
-        f[self.sl(1)] = d_omega
-        f[self.sl(2)] = (vf - self._XadIfd) / p["Td10"]
+        f[..., sl[0]] = d_delta
+        f[..., sl[1]] = d_omega
+        f[..., sl[2]] = (vf - self._XadIfd) / p["Td10"]

@@ -58,15 +58,22 @@ class IEEEST(MachineControl):
         self.LL1 = LeadLag(p["T1"], p["T2"])
         self.LL2 = LeadLag(p["T3"], p["T4"])
         self.WO = Washout(p["T5"], p["T6"])
+        # constant structure flags (fast paths of compute)
+        self._mode1 = bool(np.all(p["MODE"] == 1))
+        self._filt1 = bool(np.any((p["A1"] > 0) | (p["A2"] > 0)))
+        self._filt2 = bool(np.any((p["A3"] > 0) | (p["A4"] > 0)))
+        self._no_cut = bool(np.all(p["VCL"] <= -999.0) and np.all(p["VCU"] >= 999.0))
 
     def _signal(self, ctx):
         p = self.p
         m = self.mach
         s = ctx.sig
+        if self._mode1:                          # all speed input (the usual case)
+            return s["omega"][..., m] - 1.0
         mode = p["MODE"]
         return np.select([mode == 1, mode == 3, mode == 4, mode == 5],
-                         [s["omega"][m] - 1.0, s["Pe"][m] * ctx.system.Sb / self.Sn,
-                          s["tm"][m] - s["tm0"][m], s["Vt"][m]])
+                         [s["omega"][..., m] - 1.0, s["Pe"][..., m] * ctx.system.Sb / self.Sn,
+                          s["tm"][..., m] - s["tm0"][..., m], s["Vt"][..., m]])
 
     def init(self, system, x, sig):
         p = self.p
@@ -98,23 +105,32 @@ class IEEEST(MachineControl):
         p = self.p
         x = ctx.x
         f = ctx.f
+        sl = self._sls
         u = self._signal(ctx)
-        y1, f[self.sl(0)], f[self.sl(1)] = self._second_order(x[self.sl(0)], x[self.sl(1)], u, p["A1"], p["A2"])
-        # (1 + A5 s + A6 s^2)/(1 + A3 s + A4 s^2): w = y1/(den), output = w + A5 w' + A6 w''
-        w, f[self.sl(2)], f[self.sl(3)] = self._second_order(x[self.sl(2)], x[self.sl(3)], y1, p["A3"], p["A4"])
-        has = (p["A3"] > 0) | (p["A4"] > 0)
-        wdot = np.where(p["A4"] > 0, x[self.sl(3)], np.where(p["A3"] > 0, f[self.sl(2)], 0.0))
-        wdd = np.where(p["A4"] > 0, f[self.sl(3)], 0.0)
-        y2 = np.where(has, w + p["A5"] * wdot + p["A6"] * wdd, y1)
-        y3 = self.LL1.output(x[self.sl(4)], y2)
-        f[self.sl(4)] = self.LL1.deriv(x[self.sl(4)], y2)
-        y4 = self.LL2.output(x[self.sl(5)], y3)
-        f[self.sl(5)] = self.LL2.deriv(x[self.sl(5)], y3)
+        if self._filt1:
+            y1, f[..., sl[0]], f[..., sl[1]] = self._second_order(x[..., sl[0]], x[..., sl[1]], u, p["A1"], p["A2"])
+        else:   # no filter: output = input, derivatives 0
+            y1 = u
+        if self._filt2:
+            # (1 + A5 s + A6 s^2)/(1 + A3 s + A4 s^2): w = y1/(den), output = w + A5 w' + A6 w''
+            w, f[..., sl[2]], f[..., sl[3]] = self._second_order(x[..., sl[2]], x[..., sl[3]], y1, p["A3"], p["A4"])
+            has = (p["A3"] > 0) | (p["A4"] > 0)
+            wdot = np.where(p["A4"] > 0, x[..., sl[3]], np.where(p["A3"] > 0, f[..., sl[2]], 0.0))
+            wdd = np.where(p["A4"] > 0, f[..., sl[3]], 0.0)
+            y2 = np.where(has, w + p["A5"] * wdot + p["A6"] * wdd, y1)
+        else:
+            y2 = y1
+        x4, x5, x6 = x[..., sl[4]], x[..., sl[5]], x[..., sl[6]]
+        y3 = self.LL1.output(x4, y2)
+        f[..., sl[4]] = self.LL1.deriv(x4, y2)
+        y4 = self.LL2.output(x5, y3)
+        f[..., sl[5]] = self.LL2.deriv(x5, y3)
         vks = p["KS"] * y4
-        vss = self.WO.output(x[self.sl(6)], vks)
-        f[self.sl(6)] = self.WO.deriv(x[self.sl(6)], vks)
-        vs = np.clip(vss, p["LSMIN"], p["LSMAX"])
-        vt = ctx.sig["Vt"][self.mach]
-        vs = np.where((vt > p["VCL"]) & (vt < p["VCU"]), vs, 0.0)
-        ctx.sig["vs"][self.mach] = vs
+        vss = self.WO.output(x6, vks)
+        f[..., sl[6]] = self.WO.deriv(x6, vks)
+        vs = np.minimum(np.maximum(vss, p["LSMIN"]), p["LSMAX"])
+        if not self._no_cut:
+            vt = ctx.sig["Vt"][..., self.mach]
+            vs = np.where((vt > p["VCL"]) & (vt < p["VCU"]), vs, 0.0)
+        ctx.sig["vs"][..., self.mach] = vs
         ctx.out["IEEEST.sig"], ctx.out["IEEEST.vss"] = u, vss
