@@ -2,7 +2,7 @@
 
 Case 1: three-phase fault 0.2–0.25 s, the UPQC controller bypassed during the
 fault, high and low load; HJI and (29) with the conventional and the reduced
-UPQC, the PQ baseline, PSS alone and no supplementary control.
+UPQC, LQR, the PQ baseline, PSS alone and no supplementary control.
 Case 2: fault at the UPQC bus 3.0–3.2 s and 3.0–3.1 s at high load, 3.0–3.1 s
 at low load; HJI against LQR (its initial policy), PSS alone.
 """
@@ -55,7 +55,7 @@ def paper_scenarios(quick: bool = False) -> list[Scenario]:
     t1 = 3.0 if quick else 6.0
     for load in ("high", "low"):
         ctrls = ["hji", "nonlinear-29", "pq"] if quick else \
-            ["hji", "nonlinear-29", "pq", "pss-only", "none"]
+            ["hji", "nonlinear-29", "lqr", "pq", "pss-only", "none"]
         for c in ctrls:
             out.append(Scenario(f"c1-{load}-conv-{c}", C1, load, "conventional", c, 0.2, 0.25, t1))
         for c in (["hji"] if quick else ["hji", "nonlinear-29"]):
