@@ -64,7 +64,7 @@ padding:3px 6px;vertical-align:top}th{background:#f4f4f4}.reproduced{background:
 img{max-width:100%;border:1px solid #ddd;margin:0.5em 0}"""
 
 
-def write_html(path, *, claims, metrics, figures, designs, meta) -> Path:
+def write_html(path, *, claims, metrics, figures, designs, meta, notes=None) -> Path:
     """One HTML page: claims with verdicts, design models, figures, metrics."""
     e = html.escape
     parts = [f"<!doctype html><meta charset='utf-8'><title>weakgrid reproduce</title>"
@@ -86,7 +86,12 @@ def write_html(path, *, claims, metrics, figures, designs, meta) -> Path:
                  "<th>ϕs0 [rad]</th><th>preset (T, a, V̄r, ϕs0)</th><th>HJI training</th></tr>")
     for d in designs:
         parts.append("<tr>" + "".join(f"<td>{e(str(v))}</td>" for v in d) + "</tr>")
-    parts.append("</table><h2>Figures</h2>")
+    parts.append("</table>")
+    for case, items in (notes or {}).items():
+        if items:
+            parts.append(f"<h3>Notes from the data of {e(case)}</h3><ul>" +
+                         "".join(f"<li>{e(n)}</li>" for n in items) + "</ul>")
+    parts.append("<h2>Figures</h2>")
     for f in figures:
         parts.append(f"<figure><img src='{e(f)}' alt='{e(f)}'></figure>")
     parts.append("<h2>Metrics</h2><table><tr>" + "".join(f"<th>{e(lbl)}</th>"

@@ -64,11 +64,15 @@ def reproduce(output="reproduce-output", quick=False, log=print) -> dict:
     scenarios = paper_scenarios(quick)
     keys = sorted({(s.case, s.load, s.upqc) for s in scenarios if s.controller == "hji"})
     prog = Progress(len(keys) + len(scenarios))
-    trained, designs = {}, []
+    trained, designs, notes = {}, [], {}
     for case, load, upqc in keys:
         build = build_case(case, load, upqc)
         problem, ctl = train_hji_for(case, build.design)
         trained[(case, load, upqc)] = ctl
+        info = build.info
+        case_notes = [info[k] for k in ("difference",) if isinstance(info.get(k), str)]
+        case_notes += [n for n in info.get("notes", []) if isinstance(n, str)]
+        notes.setdefault(case, case_notes)
         preset = load_preset({"case1-weak-grid": "case1-paper",
                               "case2-lv-microgrid": "case2-paper"}[case]).system
         d = build.design
@@ -98,7 +102,7 @@ def reproduce(output="reproduce-output", quick=False, log=print) -> dict:
                          "quick": quick}, indent=1)
     report = write_html(out / "report.html", claims=claims, metrics=metrics,
                         figures=[str(p.relative_to(out)) for p in figs if p.suffix == ".png"],
-                        designs=designs, meta={"version": __version__, "n_runs": len(metrics),
+                        designs=designs, notes=notes, meta={"version": __version__, "n_runs": len(metrics),
                                                "wall_s": wall, "mode": "quick" if quick else
                                                "full", "parameters": params})
     write_json_atomic(out / "claims.json", {"claims": claims, "weakgrid_version": __version__,
