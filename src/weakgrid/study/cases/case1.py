@@ -228,6 +228,19 @@ def build(load: str = "high", upqc: str = "conventional", variant: str = "upqc",
         "fault": dict(data["fault"]),
         "sources": "data/cases/case1-weak-grid.toml (values chosen; paper Tables I-II missing)",
     }
+    rel = info["relative_to_preset"]
+    info["notes"] = [
+        f"derived design model at {load} load: a {rel['a']:+.2%}, V̄r {rel['Vr_bar']:+.2%}, "
+        f"ϕs0 {rel['phi_s0']:+.2%} from the case1-paper preset (the data were solved for the "
+        "preset at high load; the low load moves the operating point)",
+        "B of (9) is |Y12| of the GTI coupling + feeder + series-transformer two-port; the "
+        "in-phase series voltage (Vuq) acts at about 0.6 of the design model's gain because "
+        "the weak shunt bus absorbs part of it (w reacts to u2), tests/study/test_case1.py",
+        "fault: bus 3 (the UPQC shunt bus), xf = 0.1 pu (≈ 250 MVA short-circuit level): with "
+        "the UPQC idle it keeps the GTI states inside the training region Ω; stiffer faults "
+        "drive υ outside Ω, and faults that nearly island the GTI have no network solution "
+        "with the simulator's ideal PLL",
+    ]
     f = data["fault"]
     gname, upname = g["name"], upqc_name
     signals = {"sg_speed": f"{sg['name']}.omega", "dc_voltage": f"{gname}.Vc",
