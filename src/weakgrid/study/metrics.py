@@ -16,7 +16,8 @@ Definitions used throughout the reports:
 * **settling time (2 % band)** — the last time after ``t_start`` at which
   ``|e(t)|`` exceeds 2 % of that peak, measured from ``t_start``;
 * **ITAE** — ``∫ (t − t_start)·|e(t)| dt`` (trapezoid rule);
-* **control cost** — ``Σ_k u_k'R u_k · T`` over the controller's samples;
+* **control cost** — ``Σ_k u_k'R u_k · T`` over the controller's samples, with ``u``
+  as applied (limited to the UPQC rating; the demanded one is reported too);
 * **running cost of (18)** — ``Σ_{j≤k} x_j'Qx_j + u_j'Ru_j`` along the samples.
 """
 

@@ -20,6 +20,7 @@ COLUMNS = [
     ("speed_verdict", "speed verdict"), ("vdc_peak_dev_pu", "Vdc peak dev. [pu]"),
     ("vdc_backswing_pu", "Vdc backswing [pu]"), ("vdc_settling_s", "Vdc settling (2 %) [s]"), ("vdc_itae", "Vdc ITAE [pu·s²]"),
     ("control_cost", "control cost Σu'Ru·T [pu²·s]"),
+    ("control_cost_demanded", "demanded Σu'Ru·T [pu²·s]"),
     ("running_cost_18", "running cost (18) [–]"), ("vu_peak_pu", "|Vu| peak [pu]"),
     ("vu_rms_pu", "|Vu| rms [pu]"), ("vu_rating_reached", "rating reached"),
     ("p_series_peak_mw", "P_series peak [MW]"),

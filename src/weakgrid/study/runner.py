@@ -73,14 +73,13 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
     if not choice.pss:
         _disable_pss(case.system)
     T = case.design.T
-    xs, us, ts = [], [], []
+    xs = []
     policy = choice.policy
 
     def K(m):
         m = np.asarray(m, float)
         u = np.zeros(2) if policy is None else np.asarray(policy(m), float).reshape(2)
         xs.append(m.copy())
-        us.append(u.copy())
         return u
 
     target = UPQCTarget(case.upqc_name) if case.upqc_name else _MeasureOnly()
@@ -131,8 +130,15 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
                             f"{label}_settling_s": float("nan"),
                             f"{label}_itae": float("nan"), f"{label}_verdict": "unstable"})
     xa = np.nan_to_num(xk)
-    metrics["control_cost"] = control_cost(uk, R_DESIGN, T)
-    rc = running_cost(xa, uk, Q_DESIGN, R_DESIGN)
+    # what the UPQC applied: |Vu| scaled down to its rating, as the simulator does
+    up = case.system.components.get("UPQC")
+    vmax = float(up.p["Vmax"][up.names.index(case.upqc_name)]) if up is not None and \
+        case.upqc_name in up.names else float("inf")
+    mag = np.hypot(uk[:, 0], uk[:, 1]) if uk.size else np.zeros(0)
+    ua = uk * np.minimum(1.0, vmax / np.where(mag > 0, mag, 1.0))[:, None] if uk.size else uk
+    metrics["control_cost"] = control_cost(ua, R_DESIGN, T)
+    metrics["control_cost_demanded"] = control_cost(uk, R_DESIGN, T)
+    rc = running_cost(xa, ua, Q_DESIGN, R_DESIGN)
     metrics["running_cost_18"] = float(rc[-1]) if rc.size else 0.0
     series["tk"], series["running_cost"] = tk, rc
     series["x_design"] = xk
@@ -141,9 +147,6 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
         series["vu"] = vu
         metrics["vu_peak_pu"] = float(np.nanmax(vu)) if vu.size else 0.0
         metrics["vu_rms_pu"] = float(np.sqrt(np.nanmean(vu[post] ** 2))) if post.any() else 0.0
-        up = case.system.components.get("UPQC")
-        vmax = float(up.p["Vmax"][up.names.index(case.upqc_name)]) if up is not None and \
-            case.upqc_name in up.names else float("inf")
         metrics["vu_rating_pu"] = vmax
         metrics["vu_rating_reached"] = bool(metrics["vu_peak_pu"] >= vmax * (1 - 1e-6))
     if "p_series" in series:
