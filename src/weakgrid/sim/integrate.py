@@ -168,6 +168,14 @@ class Simulator:
                 z[nx:] -= damp * dy
         raise SimulationError(t, "newton", "algebraic re-initialization after an event did not converge")
 
+    def _predict(self, lu, h, z_n, f_n, fi, limval):
+        """Linearly implicit trapezoidal step from ``z_n`` with the chord matrix ``lu``."""
+        R = np.zeros(len(z_n))
+        R[:self.nx] = -h * f_n
+        if fi is not None:
+            R[fi] = z_n[fi] - limval
+        return z_n - lu_solve(lu, R)
+
     def _newton(self, t1, h, z_n, f_n, z=None, corr=None):
         """Chord Newton for the trapezoidal step; returns ``(z, nit, last)``.
 
@@ -191,11 +199,7 @@ class Simulator:
             limval = np.where(self.frozen > 0, self.sys.lim_hi, self.sys.lim_lo)[fz]
         x_n = z_n[:nx]
         if z is None:
-            R = np.zeros(len(z_n))
-            R[:nx] = -h * f_n
-            if fi is not None:
-                R[fi] = x_n[fi] - limval
-            z = z_n - lu_solve(lu, R)
+            z = self._predict(lu, h, z_n, f_n, fi, limval)
             self._pred = z.copy()
             if corr is not None:
                 z += corr
@@ -265,12 +269,12 @@ class Simulator:
                 fl = f1[li]
                 rel = ((self.frozen > 0) & (fl < 0)) | ((self.frozen < 0) & (fl > 0))
                 self.frozen[rel] = 0
-            if nit > self.max_iter // 2 - 1:   # refresh the chord matrix after slow convergence (cheap: batched)
-                self._refresh_jacobian(t + h, z)
+            # nonlinear correction to the predictor, extrapolated to the next step
             self._corr = z - self._pred if guess is None else None
             self._corr_h = h
-            if nit > self.max_iter // 2 - 1:
-                self._corr = None
+            if nit > self.max_iter // 2 - 1:   # refresh the chord matrix after slow convergence (cheap: batched)
+                self._refresh_jacobian(t + h, z)
+                self._corr = None   # relative to the old chord matrix
             self.z, self._f, self._ctx = z, f1, ctx
             self.t = t + h
             self.stats["steps"] += 1
