@@ -93,6 +93,7 @@ class Simulator:
 
     # ----------------------------------------------------------- linear algebra
     def _refresh_jacobian(self, t, z):
+        self._refresh_next = False
         self._Jdev = self.sys.jacobian_devices(t, z)
         self.stats["jac"] += 1
         self.stats["evals"] += self.sys.ncolours + 1
@@ -203,6 +204,13 @@ class Simulator:
             self._pred = z.copy()
             if corr is not None:
                 z += corr
+            if self._refresh_next:
+                # refresh the chord matrix at the predicted point (close to the solution,
+                # so the chord iteration contracts fast)
+                self._refresh_jacobian(t1, z)
+                lu = self._iteration_lu(h)
+                # the predictor with the new matrix, for the next step's correction
+                self._pred = self._predict(lu, h, z_n, f_n, fi, limval)
         else:
             z = z.copy()
         if fi is not None:
@@ -273,8 +281,7 @@ class Simulator:
             self._corr = z - self._pred if guess is None else None
             self._corr_h = h
             if nit > self.max_iter // 2 - 1:   # refresh the chord matrix after slow convergence (cheap: batched)
-                self._refresh_jacobian(t + h, z)
-                self._corr = None   # relative to the old chord matrix
+                self._refresh_next = True   # at the next step's predicted point
             self.z, self._f, self._ctx = z, f1, ctx
             self.t = t + h
             self.stats["steps"] += 1
@@ -324,6 +331,7 @@ class Simulator:
             c.bind(sys)
         rec = Results.recorder(sys)
         self._corr = self._corr_h = None
+        self._refresh_next = False
         self.z = self.solve_algebraic(self.t, self.z) if self._Jdev is not None else self.z
         if self._Jdev is None:
             self._refresh_jacobian(self.t, self.z)
