@@ -204,6 +204,8 @@ class Simulator:
             self._pred = z.copy()
             if corr is not None:
                 z += corr
+            if fi is not None:
+                z[fi] = limval
             if self._refresh_next:
                 # refresh the chord matrix at the predicted point (close to the solution,
                 # so the chord iteration contracts fast)
