@@ -249,7 +249,7 @@ class Simulator:
         li = self.sys.lim_idx
         guess = None            # linearly implicit predictor (see _newton)
         refreshed = False
-        corr = self._corr if (self._corr is not None and self._corr_h == h) else None
+        corr = self._corr if (self._corr is not None and abs(self._corr_h - h) <= 1e-9 * h) else None
         while True:
             z, nit, last = self._newton(t + h, h, z_n, f_n, guess, corr)
             if z is None:
