@@ -66,6 +66,15 @@ class Context:
         self.out = {}
 
 
+def fast_index(idx):
+    """A slice equal to the integer index array ``idx`` when it is a contiguous increasing run
+    (basic indexing is cheaper than fancy indexing on small arrays), else ``idx`` itself."""
+    idx = np.asarray(idx, dtype=int)
+    if len(idx) and np.array_equal(idx, np.arange(idx[0], idx[0] + len(idx))):
+        return slice(int(idx[0]), int(idx[0]) + len(idx))
+    return idx
+
+
 def scatter_add(a, idx, v, unique):
     """``a[..., idx] += v`` along the last axis, also for repeated indices (``unique=False``)."""
     if unique:

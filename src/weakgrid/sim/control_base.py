@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .component import Component
+from .component import Component, fast_index
 
 
 class MachineControl(Component):
@@ -20,6 +20,7 @@ class MachineControl(Component):
     def setup(self, system):
         super().setup(system)
         self.mach = np.array([system.machine_number(lk["machine"]) for lk in self.links], dtype=int)
+        self._mi = fast_index(self.mach)
         self.bus = np.zeros(self.n, dtype=int)
         self.Sn = np.zeros(self.n)
         for i, m in enumerate(self.mach):

@@ -93,6 +93,7 @@ class Simulator:
 
     # ----------------------------------------------------------- linear algebra
     def _refresh_jacobian(self, t, z):
+        self._refresh_next = False
         self._Jdev = self.sys.jacobian_devices(t, z)
         self.stats["jac"] += 1
         self.stats["evals"] += self.sys.ncolours + 1
@@ -168,61 +169,103 @@ class Simulator:
                 z[nx:] -= damp * dy
         raise SimulationError(t, "newton", "algebraic re-initialization after an event did not converge")
 
-    def _newton(self, t1, h, z_n, f_n, z):
+    def _predict(self, lu, h, z_n, f_n, fi, limval):
+        """Linearly implicit trapezoidal step from ``z_n`` with the chord matrix ``lu``."""
+        R = np.zeros(len(z_n))
+        R[:self.nx] = -h * f_n
+        if fi is not None:
+            R[fi] = z_n[fi] - limval
+        return z_n - lu_solve(lu, R)
+
+    def _newton(self, t1, h, z_n, f_n, z=None, corr=None):
+        """Chord Newton for the trapezoidal step; returns ``(z, nit, last)``.
+
+        Without a starting point ``z`` the iteration starts from the linearly
+        implicit trapezoidal predictor: one chord-Newton update from ``z_n``,
+        whose residual ``[-h f_n; g(z_n) ~ 0]`` is known without an evaluation.
+        It is exact for linear dynamics, so stiff modes that ring under the
+        trapezoidal rule (high-gain exciters) are predicted correctly.
+
+        The accepted point is the last *evaluated* one (its Newton update is below
+        ``tol``, i.e. it is within ``tol`` of the solution), so ``last = (f, ctx)``,
+        its state derivative and evaluation context, need no further evaluation.
+        """
         nx = self.nx
         lu = self._iteration_lu(h)
         li = self.sys.lim_idx
-        fz = self.frozen != 0
-        limval = np.where(self.frozen > 0, self.sys.lim_hi, self.sys.lim_lo)[fz] if len(li) else None
+        fi = limval = None
+        if len(li) and self.frozen.any():
+            fz = self.frozen != 0
+            fi = li[fz]
+            limval = np.where(self.frozen > 0, self.sys.lim_hi, self.sys.lim_lo)[fz]
         x_n = z_n[:nx]
-        z = z.copy()
-        if len(li) and fz.any():
-            z[li[fz]] = limval
+        if z is None:
+            z = self._predict(lu, h, z_n, f_n, fi, limval)
+            self._pred = z.copy()
+            if corr is not None:
+                z += corr
+            if fi is not None:
+                z[fi] = limval
+            if self._refresh_next:
+                # refresh the chord matrix at the predicted point (close to the solution,
+                # so the chord iteration contracts fast)
+                self._refresh_jacobian(t1, z)
+                lu = self._iteration_lu(h)
+                # the predictor with the new matrix, for the next step's correction
+                self._pred = self._predict(lu, h, z_n, f_n, fi, limval)
+        else:
+            z = z.copy()
+        if fi is not None:
+            z[fi] = limval
+        residual = self.sys.residual
+        tol = self.tol
+        c = x_n + 0.5 * h * f_n
         for it in range(self.max_iter):
-            F, ctx = self.sys.residual(t1, z)
-            self.stats["evals"] += 1
+            F, ctx = residual(t1, z)
+            f = F[:nx].copy()
             R = F
-            R[:nx] = z[:nx] - x_n - 0.5 * h * (f_n + F[:nx])
-            if len(li) and fz.any():
-                R[li[fz]] = z[li[fz]] - limval
+            R[:nx] = z[:nx] - c - 0.5 * h * f
+            if fi is not None:
+                R[fi] = z[fi] - limval
             dz = lu_solve(lu, R)
+            nrm = np.max(np.abs(dz))
+            if not math.isfinite(nrm):
+                break
+            if nrm < tol:
+                # converged: the evaluated point is within tol of the solution; keep it
+                # with its derivative and outputs (no further evaluation needed)
+                self.stats["evals"] += it + 1
+                self.stats["newton"] += it + 1
+                return z, it + 1, (f, ctx)
             z -= dz
-            self.stats["newton"] += 1
-            if not np.all(np.isfinite(z)):
-                return None, it + 1
-            if np.max(np.abs(dz)) < self.tol:
-                return z, it + 1
-        return None, self.max_iter
+        self.stats["evals"] += it + 1
+        self.stats["newton"] += it + 1
+        return None, it + 1, None
 
     def _step(self, h):
         """Advance one step of size ``h`` (may be shortened on failure). Returns the step taken."""
         t, z_n, f_n = self.t, self.z, self._f
         nx = self.nx
         li = self.sys.lim_idx
-        guess = z_n.copy()
-        if self._zprev is not None and self._hprev:
-            # linear extrapolation of the previous step's increment (taken before any
-            # controller re-solve at the breakpoint, so the predictor survives ZOH samples)
-            guess = z_n + (self._zend - self._zprev) * (h / self._hprev)
+        guess = None            # linearly implicit predictor (see _newton)
         refreshed = False
+        corr = self._corr if (self._corr is not None and abs(self._corr_h - h) <= 1e-9 * h) else None
         while True:
-            z, nit = self._newton(t + h, h, z_n, f_n, guess)
+            z, nit, last = self._newton(t + h, h, z_n, f_n, guess, corr)
             if z is None:
                 if not refreshed:
                     self._refresh_jacobian(t, z_n)
                     refreshed = True
-                    guess = z_n.copy()
+                    guess = corr = None
                     continue
                 if h / 2 < self.min_step:
                     raise SimulationError(t, "newton",
                                           f"no convergence with step {h:.3g} s even with a fresh Jacobian")
                 h /= 2
                 refreshed = False
-                guess = z_n.copy()
+                guess = corr = None
                 continue
-            F, ctx = self.sys.residual(t + h, z)
-            self.stats["evals"] += 1
-            f1 = F[:nx]
+            f1, ctx = last      # evaluated at the accepted point
             if len(li):
                 xl = z[li]
                 new_hi = (self.frozen == 0) & (xl > self.sys.lim_hi + 1e-9)
@@ -236,10 +279,12 @@ class Simulator:
                 fl = f1[li]
                 rel = ((self.frozen > 0) & (fl < 0)) | ((self.frozen < 0) & (fl > 0))
                 self.frozen[rel] = 0
+            # nonlinear correction to the predictor, extrapolated to the next step
+            self._corr = z - self._pred if guess is None else None
+            self._corr_h = h
             if nit > self.max_iter // 2 - 1:   # refresh the chord matrix after slow convergence (cheap: batched)
-                self._refresh_jacobian(t + h, z)
-            self._zprev, self._zend, self._hprev = z_n, z, h
-            self.z, self._f, self._ctx = z, f1.copy(), ctx
+                self._refresh_next = True   # at the next step's predicted point
+            self.z, self._f, self._ctx = z, f1, ctx
             self.t = t + h
             self.stats["steps"] += 1
             return h
@@ -287,8 +332,8 @@ class Simulator:
         for c in controllers:
             c.bind(sys)
         rec = Results.recorder(sys)
-        self._zprev = None
-        self._hprev = None
+        self._corr = self._corr_h = None
+        self._refresh_next = False
         self.z = self.solve_algebraic(self.t, self.z) if self._Jdev is not None else self.z
         if self._Jdev is None:
             self._refresh_jacobian(self.t, self.z)
@@ -341,8 +386,8 @@ class Simulator:
                         guess = None
                         if new_jac:
                             self._refresh_jacobian(self.t, self.z)
-                            self._zprev = None     # events: restart the predictor
                             self._jump = None
+                            self._corr = None
                         elif self._jump is not None and self._jump_t > self.t - 1.5 * jump_gap:
                             # consecutive ZOH samples of a smooth control: the algebraic jump
                             # is close to the previous one; start the re-solve from there

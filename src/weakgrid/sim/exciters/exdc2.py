@@ -58,6 +58,7 @@ class EXDC2(MachineControl):
         self.LA = LagNonWindup(p["KA"], p["TA"], p["VRMIN"], p["VRMAX"])
         self.W = Washout(p["KF1"], p["TF1"])
         self.SA, self.SB = quad_saturation_coeffs(p["E1"], p["SE1"], p["E2"], p["SE2"])
+        self._nosat = bool(np.all(self.SB == 0))
 
     def limits(self):
         return [(self.idx("VR"), self.p["VRMIN"], self.p["VRMAX"])]
@@ -80,15 +81,16 @@ class EXDC2(MachineControl):
     def compute(self, ctx):
         p = self.p
         x = ctx.x
-        m = self.mach
-        ls, ll, vr, vp, w = (x[..., self._sls[k]] for k in range(5))
+        m = self._mi
+        sls = self._sls
+        ls, ll, vr, vp, w = x[..., sls[0]], x[..., sls[1]], x[..., sls[2]], x[..., sls[3]], x[..., sls[4]]
         v = ctx.sig["Vt"][..., m]
         omega = ctx.sig["omega"][..., m]
         W = self.W.output(w, vp)
         vi = self.vref0 - self.LS.output(ls, v) - W + ctx.sig["vs"][..., m]
         vll = self.LL.output(ll, vi)
         vout = omega * vp
-        sat = np.where(vout >= self.SA, quad_saturation(vp, self.SA, self.SB), 0.0)
+        sat = 0.0 if self._nosat else np.where(vout >= self.SA, quad_saturation(vp, self.SA, self.SB), 0.0)
         f = ctx.f
         f[..., self._sls[0]] = self.LS.deriv(ls, v)
         f[..., self._sls[1]] = self.LL.deriv(ll, vi)

@@ -59,7 +59,7 @@ class TGOV1(MachineControl):
 
     def compute(self, ctx):
         p = self.p
-        m = self.mach
+        m = self._mi
         lag, ll = ctx.x[..., self._sls[0]], ctx.x[..., self._sls[1]]
         wd = ctx.sig["omega"][..., m] - p["wref0"]
         pd = self.pref0 + (self.paux - wd) / p["R"]

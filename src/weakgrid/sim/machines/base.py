@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..component import Component
+from ..component import Component, fast_index
 from ..errors import DataError
 from ..network import GEN_BUS, GEN_STATUS
 from ..params import Param
@@ -64,6 +64,8 @@ class SyncMachine(Component):
                 self.p[prm.name] = self.p[prm.name] * coeff[prm.base]
         self.wb = 2 * np.pi * self.p["fn"]
         self.m = np.array([system.machine_number(nm) for nm in self.names], dtype=int)
+        self._mi = fast_index(self.m)
+        self._bi = fast_index(self.bus) if len(set(self.bus.tolist())) == self.n else self.bus
 
     def pattern(self, system):
         return None  # grouped with its controls by the system
@@ -80,7 +82,7 @@ class SyncMachine(Component):
         return (Id + 1j * Iq) * (np.sin(delta) - 1j * np.cos(delta))
 
     def publish(self, ctx, omega, delta, Pe, Qe, V, XadIfd):
-        m = self.m
+        m = self._mi
         sig = ctx.sig
         sig["omega"][..., m] = omega
         sig["delta"][..., m] = delta
