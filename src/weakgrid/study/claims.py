@@ -43,6 +43,8 @@ def _cost_vs_29(m):
         b = _get(m, f"c1-{load}-conv-nonlinear-29", "control_cost")
         da = _get(m, f"c1-{load}-conv-hji", "control_cost_demanded")
         db = _get(m, f"c1-{load}-conv-nonlinear-29", "control_cost_demanded")
+        ra = _get(m, f"c1-{load}-conv-hji", "running_cost_18")
+        rb = _get(m, f"c1-{load}-conv-nonlinear-29", "running_cost_18")
         sa = _get(m, f"c1-{load}-conv-hji", "vdc_settling_s")
         sb = _get(m, f"c1-{load}-conv-nonlinear-29", "vdc_settling_s")
         if a is None or b is None or b == 0:
@@ -51,7 +53,8 @@ def _cost_vs_29(m):
         same = sa is not None and sb is not None and abs(sa - sb) <= 0.25 * max(sb, 1e-9)
         out.append(f"{load} load: HJI control cost {_fmt(a)} vs (29) {_fmt(b)} "
                    f"({red * 100:+.0f} % less; demanded before the rating limit: {_fmt(da)} "
-                   f"vs {_fmt(db)}); dc-link settling {_fmt(sa, ' s')} vs {_fmt(sb, ' s')}")
+                   f"vs {_fmt(db)}); running cost of (18) {_fmt(ra)} vs {_fmt(rb)}; dc-link "
+                   f"settling {_fmt(sa, ' s')} vs {_fmt(sb, ' s')}")
         verdicts.append("reproduced" if red >= 0.2 and same else "partly" if red > 0 else "not")
     return _combine(verdicts), "; ".join(out)
 
