@@ -9,7 +9,6 @@ Steps used: SMIB 1/1920 s (lightly damped 10-s swing: trapezoid phase error need
 halving to 1/3840 s checked); kundur_full 1/60 s (halving to 1/120 s checked).
 """
 
-import numpy as np
 import pytest
 
 andes = pytest.importorskip("andes")

@@ -1,9 +1,8 @@
 """Bad input gets a clear error naming the element, the field and the fix."""
 
-import numpy as np
 import pytest
 
-from sim_cases import build_gti_upqc_sg, two_machine_case
+from sim_cases import two_machine_case
 from weakgrid.sim.errors import DataError, PowerFlowError
 from weakgrid.sim.events import Fault, LineTrip
 from weakgrid.sim.integrate import simulate

@@ -26,7 +26,6 @@ def test_initial_point_is_equilibrium():
 def test_energy_function_conserved():
     """Lossless two-machine system, no damping: W = sum(M wb dw^2/2) - sum(Pm d) - E1 E2/X cos(d12) is constant."""
     sys = _build()
-    g1, g2 = sys.components["GENCLS"], sys.components["GENCLS"]
     z0 = sys.z0.copy()
     iw1 = sys.components["GENCLS"].idx("omega")[0]
     z0[iw1] += 0.005                      # speed kick on machine 1

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -192,7 +192,6 @@ class _Problem:
     """
 
     def __init__(self, system, basis, cost, X):
-        self.X = X
         F = system.open_loop_dynamics(X) - X  # f(x) − x, (p, n)
         G = np.asarray(system.control_directions(X), float)  # (p, n, m)
         H = np.asarray(system.disturbance_directions(X), float)  # (p, n, q)
@@ -413,7 +412,7 @@ def solve_hji(
                 "linearization or a stabilizing nonlinear law."
             )
 
-    m, q = system.n_controls, system.n_disturbances
+    q = system.n_disturbances
     history: list[IterationRecord] = []
     u = np.ascontiguousarray(u.T)  # (m, p): per-point quantities are kept as planes
     g2 = cost.gamma**2

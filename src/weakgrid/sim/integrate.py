@@ -27,7 +27,6 @@ or, with ``on_failure="return"``, are recorded in ``Results.failure``.
 
 from __future__ import annotations
 
-import heapq
 import math
 
 import numpy as np
@@ -245,7 +244,6 @@ class Simulator:
     def _step(self, h):
         """Advance one step of size ``h`` (may be shortened on failure). Returns the step taken."""
         t, z_n, f_n = self.t, self.z, self._f
-        nx = self.nx
         li = self.sys.lim_idx
         guess = None            # linearly implicit predictor (see _newton)
         refreshed = False

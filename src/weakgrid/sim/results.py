@@ -126,8 +126,7 @@ class _Recorder:
     def __init__(self, sys):
         self.sys = sys
         net = sys.network
-        names, kinds, fac = [], [], []
-        fn = 60.0
+        names, kinds = [], []
         for nm, u in zip(sys.state_names(), sys.state_units()):
             names.append(nm)
             kinds.append(u)

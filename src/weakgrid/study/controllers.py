@@ -23,7 +23,7 @@ import numpy as np
 from ..game.errors import ParameterError
 from ..models import NonlinearInitialPolicy, load_preset, lqr_policy
 
-__all__ = ["CONTROLLERS", "PAPER_SETTINGS", "ControllerChoice", "make_controller",
+__all__ = ["CONTROLLERS", "PAPER_SETTINGS", "ControllerChoice", "case_variant", "make_controller",
            "train_hji_for"]
 
 CONTROLLERS = ("hji", "nonlinear-29", "lqr", "pq", "pss-only", "none")
@@ -40,8 +40,6 @@ class ControllerChoice:
     name : str
     policy : callable or None
         ``u = policy(x)`` for the design state x = [ϕ̂, υ] (None: UPQC idle).
-    variant : str
-        The case variant it needs ("upqc" or "pq").
     pss : bool
         Whether the SG's PSS stays in service.
     info : dict
@@ -50,9 +48,13 @@ class ControllerChoice:
 
     name: str
     policy: object
-    variant: str = "upqc"
     pss: bool = True
     info: dict = field(default_factory=dict)
+
+
+def case_variant(name: str) -> str:
+    """The case variant a controller needs: the PQ baseline has no UPQC."""
+    return "pq" if name == "pq" else "upqc"
 
 
 def train_hji_for(case_name: str, design, progress=None):
@@ -92,7 +94,7 @@ def make_controller(name: str, case_name: str, design, trained=None) -> Controll
         pol = lqr_policy(design, 0.01 * np.eye(2), np.eye(2))
         return ControllerChoice(name, pol, info=pol.to_dict())
     if name == "pq":
-        return ControllerChoice(name, None, variant="pq")
+        return ControllerChoice(name, None)
     if name == "pss-only":
         return ControllerChoice(name, None)
     return ControllerChoice(name, None, pss=False)

@@ -23,13 +23,11 @@ Definitions used throughout the reports:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..game.errors import ParameterError, ShapeError
 
-__all__ = ["ResponseMetrics", "response_metrics", "settling_time", "itae", "backswing", "control_cost",
+__all__ = ["settling_time", "itae", "backswing", "control_cost",
            "running_cost", "stability_verdict"]
 
 
@@ -137,23 +135,3 @@ def stability_verdict(t, y, t_start=0.0, tail=1.0, settled_fraction=0.05) -> str
     if amp_late > 1.2 * amp_prev:
         return "unstable"
     return "undamped" if amp_late > 0.8 * amp_prev else "stable"
-
-
-@dataclass
-class ResponseMetrics:
-    """Metrics of one signal's response (see the module docstring)."""
-
-    peak_deviation: float
-    settling_time: float
-    itae: float
-    final_value: float
-    verdict: str
-
-
-def response_metrics(t, y, t_start=0.0, tail=0.5) -> ResponseMetrics:
-    t, y = _check(t, y)
-    yf = _final(t, y, tail)
-    sel = t >= t_start
-    return ResponseMetrics(float(np.max(np.abs(y[sel] - yf))), settling_time(t, y, t_start,
-                           tail=tail), itae(t, y, t_start, tail=tail), yf,
-                           stability_verdict(t, y, t_start, tail=max(tail, 1.0)))

@@ -11,7 +11,7 @@ from ..sim.controllers import DigitalController, UPQCTarget
 from ..sim.events import Fault
 from ..sim.integrate import simulate
 from .cases import build_case
-from .controllers import make_controller
+from .controllers import case_variant, make_controller
 from .metrics import backswing, control_cost, itae, running_cost, settling_time, stability_verdict
 
 __all__ = ["RunRecord", "run_scenario", "FAULT_IMPEDANCE"]
@@ -65,8 +65,7 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
     dt : float, optional
         Integration step (default: the controller's sampling period T).
     """
-    choice_variant = "pq" if sc.controller == "pq" else "upqc"
-    case = build_case(sc.case, sc.load, sc.upqc, choice_variant)
+    case = build_case(sc.case, sc.load, sc.upqc, case_variant(sc.controller))
     key = (sc.case, sc.load, sc.upqc)
     ctl = (trained or {}).get(key)
     choice = make_controller(sc.controller, sc.case, case.design, ctl)

@@ -105,7 +105,6 @@ def from_andes(ss, include_events: bool = True):
                 c = (Sn / Sb) * (Vn_bus[i] / Vn) ** -2 if Vn > 0 else Sn / Sb
                 B[i, 4] += _raw(sh, "g")[k] * c * Sb
                 B[i, 5] += _raw(sh, "b")[k] * c * Sb
-    gens = []   # (model, k, idx)
     G = []
     gen_row = {}
     for mname, btype in (("Slack", 3), ("PV", 2)):

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..params import Param
 from .base import BASE_PARAMS, SyncMachine
 from .shaft import swing
 

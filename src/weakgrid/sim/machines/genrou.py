@@ -30,7 +30,6 @@ from ..blocks import quad_saturation_coeffs
 from ..errors import DataError
 from ..params import Param
 from .base import BASE_PARAMS, SyncMachine
-from .gencls import solve_stator
 from .shaft import swing
 
 

@@ -12,7 +12,6 @@ Torques are in pu on the system base; speed in pu of nominal.
 
 from __future__ import annotations
 
-import numpy as np
 
 
 def swing(omega, tm, te, M, D, wb):
