@@ -38,6 +38,6 @@ def test_gamma_preset_writes_controller_and_report(tmp_path, capsys):
 
 
 def test_gamma_bad_option_is_reported(capsys):
-    assert main(["gamma", "--preset", "case1-paper", "--rtol", "2"]) == 1
+    assert main(["gamma", "--preset", "case1-paper", "--rtol", "2"]) == 2
     err = capsys.readouterr().err
     assert "rtol" in err and "(0, 1)" in err

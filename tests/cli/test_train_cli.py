@@ -64,7 +64,7 @@ def test_config_errors_name_the_field(tmp_path, capsys):
                    'phi_s0 = 0.3\nfoo = 1\n[cost]\nQ=1\nR=1\nP=1\ngamma=5\n'
                    '[mesh]\nlower=[-1,-1]\nupper=[1,1]\nstep=[0.1,0.1]\n'
                    '[initial_policy]\nkind="lqr"\n')
-    assert main(["train", "--config", str(cfg)]) == 1
+    assert main(["train", "--config", str(cfg)]) == 2
     err = capsys.readouterr().err
     assert "model.foo" in err and "unknown key" in err
 

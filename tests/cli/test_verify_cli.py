@@ -59,12 +59,12 @@ degree = 2
 kind = "lqr"
 Q = 1.0
 """)
-    assert main(["verify", "--config", str(cfg)]) == 1
+    assert main(["verify", "--config", str(cfg)]) == 2
     assert "2-state" in capsys.readouterr().err
 
 
 def test_verify_refuses_a_controller_of_another_model(trained_presets, tmp_path, capsys):
     f = tmp_path / "c1.json"
     trained_presets["case1-paper"][1].save(f)
-    assert main(["verify", "--preset", "case2-paper", "--controller", str(f)]) == 1
+    assert main(["verify", "--preset", "case2-paper", "--controller", str(f)]) == 2
     assert "--controller" in capsys.readouterr().err

@@ -192,5 +192,5 @@ def test_export_cli_writes_files(trained_presets, tmp_path, capsys):
     assert main(["export", str(f), "--format", "json", "-d", str(tmp_path / "o")]) == 0
     d = json.loads((tmp_path / "o" / "case2_paper.export.json").read_text())
     assert d["model"]["kind"] == "upqc-design" and d["weights"] == ctl.weights.tolist()
-    assert main(["export", str(tmp_path / "missing.json")]) == 1
+    assert main(["export", str(tmp_path / "missing.json")]) == 2
     assert "does not exist" in capsys.readouterr().err

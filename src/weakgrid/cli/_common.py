@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import argparse
+import math
 from pathlib import Path
 
 from .. import __version__
@@ -12,7 +14,7 @@ def add_problem_arguments(p):
     """``--preset NAME`` or ``--config FILE`` (one of them required)."""
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--preset", choices=preset_names(), help="a shipped preset")
-    src.add_argument("--config", type=Path, help="a problem file (TOML), see the README")
+    src.add_argument("--config", type=input_file, help="a problem file (TOML), see the README")
 
 
 def problem_of(args):
@@ -26,3 +28,85 @@ def provenance(problem, command: str, **parameters) -> dict:
             "source": problem.source, "parameters": parameters}
 
 
+
+
+# ------------------------------------------------------------------ argument types
+# argparse turns an ArgumentTypeError into "argument --NAME: MESSAGE" and exit code 2.
+
+def _number(text, what):
+    try:
+        v = float(text)
+    except (TypeError, ValueError):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number ({what})") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"{text!r} is not finite: give {what}")
+    return v
+
+
+def finite_float(text) -> float:
+    """A finite number."""
+    return _number(text, "a finite number")
+
+
+def positive_float(text) -> float:
+    """A finite number > 0."""
+    v = _number(text, "a number > 0")
+    if v <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r} must be > 0")
+    return v
+
+
+def nonnegative_float(text) -> float:
+    """A finite number ≥ 0."""
+    v = _number(text, "a number ≥ 0")
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} must be ≥ 0")
+    return v
+
+
+def positive_int(text) -> int:
+    """An integer ≥ 1."""
+    try:
+        v = int(text)
+    except (TypeError, ValueError):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number (give an integer "
+                                         "≥ 1)") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} must be ≥ 1")
+    return v
+
+
+def output_file(*suffixes):
+    """A path to write, whose suffix must be one of ``suffixes`` (checked before any work)."""
+    def parse(text) -> Path:
+        p = Path(text)
+        if not text or text.endswith(("/", "\\")):
+            raise argparse.ArgumentTypeError(f"{text!r} is a folder: give a file name "
+                                             f"ending in {' or '.join(suffixes)}")
+        if suffixes and p.suffix.lower() not in suffixes:
+            raise argparse.ArgumentTypeError(
+                f"{text!r}: unsupported file type {p.suffix or '(none)'!r}; use "
+                f"{' or '.join(suffixes)}")
+        if p.is_dir():
+            raise argparse.ArgumentTypeError(f"{text!r} is a folder: give a file name")
+        return p
+    parse.__name__ = "output file"
+    return parse
+
+
+def input_file(text) -> Path:
+    """An existing, readable file."""
+    p = Path(text)
+    if not p.exists():
+        raise argparse.ArgumentTypeError(f"{text!r} does not exist")
+    if p.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
+    return p
+
+
+def output_folder(text) -> Path:
+    """A folder to write into (created if missing); must not be an existing file."""
+    p = Path(text)
+    if p.exists() and not p.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
+    return p

@@ -12,7 +12,8 @@ from ..game.errors import ParameterError
 from ..game.export_c import generate_c, valid_c_name
 from ..game.export_json import describe_controller
 from ..models import load_controller
-from ..fileio import write_text_atomic
+from ..fileio import write_texts_atomic
+from ._common import input_file, output_folder
 
 NAME = "export"
 
@@ -29,12 +30,12 @@ def add_parser(sub):
                     "Supported model kinds: 'upqc-design' (the paper's model (10)) and "
                     "'linear'.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    p.add_argument("file", type=Path, help="controller file (JSON)")
+    p.add_argument("file", type=input_file, help="controller file (JSON)")
     p.add_argument("--format", choices=("c", "json"), default="c", help="what to write")
     p.add_argument("--name", default=None,
                    help="C symbol/file prefix (default: the file name up to its first dot, "
                         "made a C identifier)")
-    p.add_argument("--output-dir", "-d", type=Path, default=None,
+    p.add_argument("--output-dir", "-d", type=output_folder, default=None,
                    help="folder for the output (default: the controller file's folder)")
     p.set_defaults(func=run)
     return p
@@ -58,8 +59,7 @@ def run(args) -> int:
     if args.format == "c":
         prov = f"From {path.name} (weakgrid {__version__}; model kind {kind})."
         src, hdr = generate_c(ctl, name, prov)
-        write_text_atomic(out / f"{name}.h", hdr)
-        write_text_atomic(out / f"{name}.c", src)
+        write_texts_atomic({out / f"{name}.h": hdr, out / f"{name}.c": src})
         print(f"weakgrid export: wrote {out / (name + '.c')} and {out / (name + '.h')}")
         print(f"  int {name}_saddle(const double x[{ctl.system.n_states}], "
               f"double u[{ctl.system.n_controls}], double w[{ctl.system.n_disturbances}]);"

@@ -8,7 +8,8 @@ from pathlib import Path
 
 from ..fileio import write_json_atomic
 from ..game.gamma_search import SearchSettings, search_min_gamma
-from ._common import add_problem_arguments, problem_of, provenance
+from ._common import (add_problem_arguments, output_file, positive_float, positive_int,
+                      problem_of, provenance)
 
 NAME = "gamma"
 
@@ -25,22 +26,22 @@ def add_parser(sub):
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     add_problem_arguments(p)
     d = SearchSettings()
-    p.add_argument("--rtol", type=float, default=d.rtol, help="relative width of the bracket")
-    p.add_argument("--max-trials", type=int, default=d.max_trials, help="cap on gammas tried")
-    p.add_argument("--rollout-steps", type=int, default=d.rollout_steps,
+    p.add_argument("--rtol", type=positive_float, default=d.rtol, help="relative width of the bracket")
+    p.add_argument("--max-trials", type=positive_int, default=d.max_trials, help="cap on gammas tried")
+    p.add_argument("--rollout-steps", type=positive_int, default=d.rollout_steps,
                    help="length of the worst-case rollouts (steps)")
-    p.add_argument("--escape-factor", type=float, default=d.escape_factor,
+    p.add_argument("--escape-factor", type=positive_float, default=d.escape_factor,
                    help="rollouts must stay inside the region enlarged this many times")
-    p.add_argument("--return-fraction", type=float, default=d.return_fraction,
+    p.add_argument("--return-fraction", type=positive_float, default=d.return_fraction,
                    help="final state within this fraction of the region's half-widths")
     p.add_argument("--starts", nargs="+", default=list(d.starts),
                    choices=("continuation", "game-riccati", "initial"),
                    help="starts of the policy iteration tried for each gamma, in order")
-    p.add_argument("--tol", type=float, default=None,
+    p.add_argument("--tol", type=positive_float, default=None,
                    help="δu = δw of the policy iteration (default: the problem's)")
-    p.add_argument("--output", "-o", type=Path, default=None,
+    p.add_argument("--output", "-o", type=output_file(".json"), default=None,
                    help="write the controller trained at gamma* (JSON)")
-    p.add_argument("--report", type=Path, default=None,
+    p.add_argument("--report", type=output_file(".json"), default=None,
                    help="write the search (bracket, history, parameters) as JSON")
     p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
     p.set_defaults(func=run)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ._common import output_folder
+
 NAME = "reproduce"
 
 
@@ -16,7 +18,7 @@ def add_parser(sub):
                     "18–25; PNG and SVG), a metrics table (CSV and Markdown) and report.html "
                     "with a verdict for each claim of the paper.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    p.add_argument("--output", "-o", type=Path, default=Path("reproduce-output"),
+    p.add_argument("--output", "-o", type=output_folder, default=Path("reproduce-output"),
                    help="output folder")
     p.add_argument("--quick", action="store_true",
                    help="shorter runs and the essential subset of scenarios")

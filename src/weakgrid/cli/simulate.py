@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
+
+from ._common import nonnegative_float, output_file, positive_float
 
 NAME = "simulate"
 
@@ -21,24 +22,39 @@ def add_parser(sub):
     p.add_argument("--controller", "-c", choices=CONTROLLERS, default="hji")
     p.add_argument("--load", choices=("high", "low"), default="high")
     p.add_argument("--upqc", choices=("conventional", "reduced"), default="conventional")
-    p.add_argument("--fault", nargs=2, type=float, metavar=("T_ON", "T_OFF"), default=None,
+    p.add_argument("--fault", nargs=2, type=nonnegative_float, metavar=("T_ON", "T_OFF"), default=None,
                    help="fault application and clearance [s] (default: the paper's)")
-    p.add_argument("--t-end", type=float, default=None, help="simulated time [s]")
-    p.add_argument("--output", "-o", type=Path, default=None,
+    p.add_argument("--t-end", type=positive_float, default=None, help="simulated time [s]")
+    p.add_argument("--output", "-o", type=output_file(".csv", ".parquet"), default=None,
                    help="write the run's signals (.csv or .parquet)")
     p.set_defaults(func=run)
     return p
 
 
+def check_time_window(t_on: float, t_off: float, t_end: float):
+    """The fault must start before it clears, and clear before the end of the run."""
+    from ..game.errors import ParameterError
+
+    if not t_on < t_off:
+        raise ParameterError("--fault", [t_on, t_off], "the fault must clear after it starts "
+                             "(T_ON < T_OFF)")
+    if not t_off < t_end:
+        raise ParameterError("--fault", [t_on, t_off], f"the fault clears at or after the end "
+                             f"of the run (--t-end {t_end:g} s): use T_OFF < --t-end or a "
+                             "longer --t-end")
+
+
 def run(args) -> int:
     import pandas as pd
 
+    from ..fileio import replace_atomic
     from ..study.runner import run_scenario
     from ..study.scenarios import Scenario
 
     c1 = args.case.startswith("case1")
     t_on, t_off = args.fault or ((0.2, 0.25) if c1 else (3.0, 3.1))
-    t_end = args.t_end or (6.0 if c1 else 10.0)
+    t_end = args.t_end if args.t_end is not None else (6.0 if c1 else 10.0)
+    check_time_window(t_on, t_off, t_end)
     sc = Scenario(f"{args.case}-{args.load}-{args.upqc}-{args.controller}", args.case,
                   args.load, args.upqc, args.controller, t_on, t_off, t_end)
     rec = run_scenario(sc)
@@ -48,9 +64,9 @@ def run(args) -> int:
         t = rec.series["t"]
         df = pd.DataFrame({k: v for k, v in rec.series.items()
                            if hasattr(v, "shape") and v.shape == t.shape})
-        if args.output.suffix == ".parquet":
-            df.to_parquet(args.output)
+        if args.output.suffix.lower() == ".parquet":
+            replace_atomic(args.output, df.to_parquet)
         else:
-            df.to_csv(args.output, index=False)
+            replace_atomic(args.output, lambda tmp: df.to_csv(tmp, index=False))
         print(f"  wrote {args.output}")
     return 0 if not rec.metrics["failed"] else 3

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..game.hji import closed_loop_spectral_radius
-from ._common import add_problem_arguments, problem_of
+from ._common import add_problem_arguments, output_file, positive_float, problem_of
 
 NAME = "train"
 
@@ -21,9 +21,9 @@ def add_parser(sub):
                     "diagnostics, and write the controller file (JSON).",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     add_problem_arguments(p)
-    p.add_argument("--output", "-o", type=Path, default=None,
+    p.add_argument("--output", "-o", type=output_file(".json"), default=None,
                    help="controller file to write (default: NAME.controller.json)")
-    p.add_argument("--tol", type=float, default=None,
+    p.add_argument("--tol", type=positive_float, default=None,
                    help="δu = δw (default: the problem's [solver] values)")
     p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
     p.set_defaults(func=run)

@@ -12,7 +12,8 @@ from ..game.dynamic_programming import DPSettings, solve_game_dp
 from ..game.errors import ParameterError
 from ..game.optimality import closed_loop_gap, default_starts, value_error
 from ..models import load_controller
-from ._common import add_problem_arguments, problem_of, provenance
+from ._common import (add_problem_arguments, input_file, nonnegative_float, output_file,
+                      positive_float, positive_int, problem_of, provenance)
 
 NAME = "verify"
 
@@ -30,21 +31,21 @@ def add_parser(sub):
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     add_problem_arguments(p)
     d = DPSettings()
-    p.add_argument("--controller", type=Path, default=None,
+    p.add_argument("--controller", type=input_file, default=None,
                    help="a controller file to verify (default: train the problem's)")
-    p.add_argument("--points", type=int, default=d.n_points[0], help="grid nodes per state "
+    p.add_argument("--points", type=positive_int, default=d.n_points[0], help="grid nodes per state "
                    "(odd)")
-    p.add_argument("--hold-steps", type=int, default=d.hold_steps,
+    p.add_argument("--hold-steps", type=positive_int, default=d.hold_steps,
                    help="k of the k-step lifting (inputs held k steps); 1 = no lifting")
-    p.add_argument("--margin", type=float, nargs="+", default=[d.margin],
+    p.add_argument("--margin", type=nonnegative_float, nargs="+", default=[d.margin],
                    help="grid box = region enlarged by this fraction of its width per side "
                         "(one value, or one per state)")
     p.add_argument("--interpolation", choices=("cubic", "linear"), default=d.interpolation)
-    p.add_argument("--max-iterations", type=int, default=d.max_iterations)
-    p.add_argument("--steps", type=int, default=4000, help="closed-loop horizon (steps)")
-    p.add_argument("--start-fraction", type=float, default=0.5,
+    p.add_argument("--max-iterations", type=positive_int, default=d.max_iterations)
+    p.add_argument("--steps", type=positive_int, default=4000, help="closed-loop horizon (steps)")
+    p.add_argument("--start-fraction", type=positive_float, default=0.5,
                    help="starts: corners/edge midpoints of the region shrunk by this")
-    p.add_argument("--report", type=Path, default=None, help="write the report (JSON)")
+    p.add_argument("--report", type=output_file(".json"), default=None, help="write the report (JSON)")
     p.set_defaults(func=run)
     return p
 

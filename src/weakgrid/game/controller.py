@@ -164,15 +164,59 @@ class GameController:
         return write_json_atomic(path, self.to_dict())
 
 
+def _field(d, key, where):
+    if not isinstance(d, dict) or key not in d:
+        raise ParameterError(f"{where}{key}", None,
+                             "missing: the file is not a complete controller file; write it "
+                             "again with `weakgrid train --output FILE`")
+    return d[key]
+
+
+def _numbers(v, field):
+    try:
+        a = np.asarray(v, float)
+    except (TypeError, ValueError):
+        raise ParameterError(field, v, "must be numbers") from None
+    if not np.all(np.isfinite(a)):
+        raise ParameterError(field, v if a.size < 20 else "…", "must be finite numbers "
+                             "(NaN or infinity found): write the file again with `weakgrid "
+                             "train`")
+    return a
+
+
 def controller_from_dict(d: dict, system: ControlAffineSystem | None = None) -> GameController:
+    """Rebuild a controller from its record, validating every field on the way."""
+    if not isinstance(d, dict):
+        raise ParameterError("controller file", type(d).__name__,
+                             "must be a JSON object written by `weakgrid train`")
     if d.get("format") != FILE_FORMAT:
         raise ParameterError("format", d.get("format"),
                              f"not a weakgrid controller file (expected {FILE_FORMAT!r})")
-    problem = d["problem"]
-    system = system or system_from_dict(problem["model"])
-    basis = PolynomialBasis.from_dict(problem["basis"])
-    cost = GameCost.from_dict(problem["cost"])
-    return GameController(system=system, basis=basis, weights=np.asarray(d["weights"], float),
+    problem = _field(d, "problem", "")
+    model = _field(problem, "model", "problem.")
+    if not isinstance(model, dict):
+        raise ParameterError("problem.model", model, "must be an object with a 'kind'")
+    system = system or system_from_dict(model)
+    b = _field(problem, "basis", "problem.")
+    exps = _numbers(_field(b, "exponents", "problem.basis."), "problem.basis.exponents")
+    if exps.ndim != 2 or exps.shape[1] != system.n_states or np.any(exps < 0) \
+            or np.any(exps != np.round(exps)):
+        raise ParameterError("problem.basis.exponents", exps.tolist(),
+                             f"one row of {system.n_states} whole numbers ≥ 0 per basis term")
+    basis = PolynomialBasis.from_dict(b)
+    c = _field(problem, "cost", "problem.")
+    for k in ("Q", "R", "P", "gamma"):
+        _numbers(_field(c, k, "problem.cost."), f"problem.cost.{k}")
+    gamma = float(c["gamma"]) if np.ndim(c["gamma"]) == 0 else np.nan
+    if not gamma > 0:
+        raise ParameterError("problem.cost.gamma", c["gamma"], "the attenuation level gamma "
+                             "must be a number > 0")
+    cost = GameCost.from_dict(c)
+    w = _numbers(_field(d, "weights", ""), "weights")
+    if w.shape != (basis.size,):
+        raise ShapeError("weights", w.shape, f"({basis.size},): one weight per basis term "
+                         f"({basis.size} in problem.basis)")
+    return GameController(system=system, basis=basis, weights=w,
                           cost=cost, problem=problem, history=[],
                           train_seconds=d.get("train_seconds", float("nan")),
                           iterations=d.get("iterations"))
@@ -182,13 +226,27 @@ def load_controller(path, system: ControlAffineSystem | None = None) -> GameCont
     """Read a controller file; the system is rebuilt from its record unless given.
 
     Systems of :mod:`weakgrid.models` are rebuilt once that module is imported
-    (``weakgrid.models.load_controller`` does it for you).
+    (``weakgrid.models.load_controller`` does it for you). Every field is
+    validated (finite weights, gamma > 0, sizes consistent with the basis, known
+    model kind); errors name the file and the field.
     """
     path = Path(path)
     if not path.exists():
-        raise FileNotFoundError(f"controller file {path} does not exist")
+        raise FileNotFoundError(2, "controller file does not exist", str(path))
     try:
-        d = json.loads(path.read_text())
+        d = json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
         raise ParameterError("controller file", str(path), f"is not valid JSON ({exc})") from None
-    return controller_from_dict(d, system)
+    except UnicodeDecodeError:
+        raise ParameterError("controller file", str(path), "is not UTF-8 text (JSON written "
+                             "by `weakgrid train` expected)") from None
+    try:
+        return controller_from_dict(d, system)
+    except (ParameterError, ShapeError) as exc:
+        raise _in_file(exc, path) from None
+
+
+def _in_file(exc, path):
+    """The same error with the file named in front."""
+    exc.args = (f"{path}: {exc.args[0]}",) + exc.args[1:]
+    return exc

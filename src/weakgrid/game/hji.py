@@ -341,6 +341,30 @@ def _lstsq(At, b, check_rank=True):
 
 
 _EPS = float(np.finfo(float).eps)
+_ROUNDOFF = 1e4 * _EPS  # changes below this fraction of the magnitude are round-off
+
+
+def check_mesh_for_basis(mesh, basis):
+    """Refuse a grid with too few points along an axis for the basis' degree in that state.
+
+    A polynomial of degree d in x_k is determined by the values at d + 1 distinct
+    x_k; with fewer, the regression (27) is underdetermined or ill-conditioned
+    and its failures later look like a convexity or gamma problem.
+    """
+    axes = getattr(mesh, "axes", None)
+    if axes is None:
+        return
+    deg = np.asarray(basis.exponents).max(axis=0)
+    for k, ax in enumerate(axes()):
+        if len(ax) < deg[k] + 1:
+            width = mesh.upper[k] - mesh.lower[k]
+            raise ParameterError(
+                "mesh.step", list(mesh.step),
+                f"only {len(ax)} mesh points along state {k + 1} for a basis of degree "
+                f"{int(deg[k])} in it: the regression (27) is underdetermined/ill-conditioned "
+                f"(too few mesh points for the basis, not a convexity or gamma problem). Use "
+                f"at least {int(deg[k]) + 1} points: step ≤ {width / deg[k]:.3g} along state "
+                f"{k + 1} (a few times more points is safer)")
 
 
 def solve_hji(
@@ -391,6 +415,7 @@ def solve_hji(
         raise ParameterError("cost", type(cost).__name__, "pass a GameCost")
     X = np.asarray(mesh.points, float)
     p = X.shape[0]
+    check_mesh_for_basis(mesh, basis)
     if p < basis.size:
         raise ParameterError("mesh", f"{p} points", f"need at least {basis.size} points "
                              f"(one per basis term): use a finer mesh")
@@ -461,6 +486,13 @@ def solve_hji(
             if dw <= settings.tol_w:
                 break
             if j >= 40 and min(dws[-10:]) >= min(dws[:-10]):
+                floor = _ROUNDOFF * max(float(np.abs(w).max()), 1e-300)
+                if min(dws) <= floor:
+                    raise ConvergenceError(
+                        f"settings.tol_w = {settings.tol_w:g} is below what double-precision "
+                        f"arithmetic can reach: max|Δw| stalls at {min(dws):.2e} (round-off of "
+                        f"|w| ≈ {float(np.abs(w).max()):.2e}) at outer iteration {i}. Fix: use "
+                        f"tol_w ≥ {10 * min(dws):.0e} (e.g. 1e-7)", history)
                 # for a fixed control the inner loop is a policy iteration of the
                 # maximizing player: it contracts when gamma exceeds the attenuation
                 # level of that control; no progress in 10 iterations means it does not
@@ -504,6 +536,13 @@ def solve_hji(
         u = u_new
         if du <= settings.tol_u:
             break
+        if (i >= 20 and du <= _ROUNDOFF * max(float(np.abs(u).max()), 1e-300)
+                and min(r.max_du for r in history[-10:]) >= min(r.max_du for r in history[:-10])):
+            raise ConvergenceError(
+                f"settings.tol_u = {settings.tol_u:g} is below what double-precision arithmetic "
+                f"can reach: max|Δu| stalls at {du:.2e} (round-off of |u| ≈ "
+                f"{float(np.abs(u).max()):.2e}). Fix: use tol_u ≥ {10 * du:.0e} (e.g. 1e-7)",
+                history)
     else:
         raise ConvergenceError(
             f"the outer (control) loop did not converge in {settings.max_outer} iterations: "

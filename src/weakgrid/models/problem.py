@@ -36,6 +36,7 @@ from ..game import (
     paper_basis,
     solve_hji,
 )
+from ..fileio import safe_name
 from ..game.bases import PolynomialBasis
 from .design import UPQCDesignModel, gti_design_model, sg_design_model
 from .policies import NonlinearInitialPolicy, lqr_policy
@@ -56,9 +57,12 @@ def _read_toml(path) -> dict:
         with open(path, "rb") as fh:
             return tomllib.load(fh)
     except FileNotFoundError:
-        raise FileNotFoundError(f"problem file {path} does not exist") from None
+        raise FileNotFoundError(2, "problem file does not exist", str(path)) from None
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError("config", str(path), f"is not valid TOML ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise ParameterError("config", str(path), f"is not UTF-8 text (byte {exc.start}): give "
+                             "a TOML problem file") from None
 
 
 def load_preset(name: str) -> "TrainingProblem":
@@ -93,6 +97,33 @@ def _num(d, key, section, default=None):
     return v
 
 
+def _array(d, key, section, default=None):
+    """A number or a (nested) list of finite numbers, as a float array."""
+    v = d.get(key, default) if default is not None else _need(d, key, section)
+    try:
+        a = np.asarray(v, float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{section}.{key}", v, "must be a number or a list of numbers "
+                             "(rows of equal length)") from None
+    if not np.all(np.isfinite(a)):
+        raise ParameterError(f"{section}.{key}", v, "must be finite numbers")
+    return a
+
+
+def _int(d, key, section):
+    v = d[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or int(v) != v or v < 1:
+        raise ParameterError(f"{section}.{key}", v, "must be a whole number ≥ 1")
+    return int(v)
+
+
+def _table(d, key):
+    v = d.get(key, {})
+    if not isinstance(v, dict):
+        raise ParameterError(key, v, f"must be a table: write it as [{key}] with key = value lines")
+    return v
+
+
 def _check_keys(d: dict, allowed: set, section: str):
     extra = set(d) - allowed
     if extra:
@@ -121,8 +152,8 @@ def _model(d: dict):
         return sg_design_model(**kw)
     if kind == "linear":
         _check_keys(d, {"kind", "A", "B", "E", "state_names"}, "model")
-        return LinearSystem(_need(d, "A", "model"), _need(d, "B", "model"),
-                            _need(d, "E", "model"), d.get("state_names"))
+        return LinearSystem(_array(d, "A", "model"), _array(d, "B", "model"),
+                            _array(d, "E", "model"), d.get("state_names"))
     raise ParameterError("model.kind", kind, "use 'upqc-design', 'gti', 'sg' or 'linear'")
 
 
@@ -136,9 +167,14 @@ def _basis(d: dict, n: int) -> PolynomialBasis:
     if kind == "even":
         return even_monomials(n, int(_num(d, "degree", "basis")))
     if kind == "generator":
-        return from_generator(n, d.get("powers", [2, 4]), d.get("coefficients"))
+        coef = d.get("coefficients")
+        return from_generator(n, _array(d, "powers", "basis", [2, 4]),
+                              None if coef is None else _array(d, "coefficients", "basis"))
     if kind == "custom":
-        return PolynomialBasis(np.asarray(_need(d, "exponents", "basis")), name="custom")
+        e = _array(d, "exponents", "basis")
+        if np.any(e < 0) or np.any(e != np.round(e)):
+            raise ParameterError("basis.exponents", e.tolist(), "exponents are whole numbers ≥ 0")
+        return PolynomialBasis(e.astype(int), name="custom")
     raise ParameterError("basis.kind", kind, "use 'paper', 'even', 'generator' or 'custom'")
 
 
@@ -151,10 +187,10 @@ def _policy(d: dict, system):
         return NonlinearInitialPolicy.on_design_model(
             system, _num(d, "gain", "initial_policy"), _num(d, "phase", "initial_policy"), chi)
     if kind == "lqr":
-        return lqr_policy(system, _weight(d.get("Q", 0.01), system.n_states),
-                          _weight(d.get("R", 1.0), system.n_controls))
+        return lqr_policy(system, _weight(_array(d, "Q", "initial_policy", 0.01), system.n_states),
+                          _weight(_array(d, "R", "initial_policy", 1.0), system.n_controls))
     if kind == "linear":
-        return LinearPolicy(_need(d, "K", "initial_policy"))
+        return LinearPolicy(_array(d, "K", "initial_policy"))
     raise ParameterError("initial_policy.kind", kind, "use 'nonlinear-29', 'lqr' or 'linear'")
 
 
@@ -217,14 +253,20 @@ def problem_from_dict(d: dict, source: str = "") -> TrainingProblem:
     for sec in ("model", "cost", "mesh", "initial_policy"):
         if sec not in d:
             raise ParameterError(sec, None, f"missing table [{sec}]")
+    for sec in _SECTIONS:
+        _table(d, sec)
     system = _model(d["model"])
     c = d["cost"]
     _check_keys(c, {"Q", "R", "P", "gamma"}, "cost")
-    cost = GameCost.for_system(system, _need(c, "Q", "cost"), _need(c, "R", "cost"),
-                               _need(c, "P", "cost"), _num(c, "gamma", "cost"))
+    gamma = _num(c, "gamma", "cost")
+    if gamma <= 0:
+        raise ParameterError("cost.gamma", gamma, "the attenuation level must be > 0")
+    cost = GameCost.for_system(system, _array(c, "Q", "cost"), _array(c, "R", "cost"),
+                               _array(c, "P", "cost"), gamma)
     m = d["mesh"]
     _check_keys(m, {"lower", "upper", "step"}, "mesh")
-    mesh = GridMesh(_need(m, "lower", "mesh"), _need(m, "upper", "mesh"), _need(m, "step", "mesh"))
+    mesh = GridMesh(_array(m, "lower", "mesh"), _array(m, "upper", "mesh"),
+                    _array(m, "step", "mesh"))
     if mesh.n_states != system.n_states:
         raise ParameterError("mesh.lower", list(mesh.lower),
                              f"give one bound per state ({system.n_states})")
@@ -232,7 +274,10 @@ def problem_from_dict(d: dict, source: str = "") -> TrainingProblem:
     policy = _policy(d["initial_policy"], system)
     s = d.get("solver", {})
     _check_keys(s, {"tol_u", "tol_w", "max_outer", "max_inner"}, "solver")
+    s = {k: (_num(s, k, "solver") if k.startswith("tol") else _int(s, k, "solver")) for k in s}
     settings = SolverSettings(**s)
-    name = d.get("preset", {}).get("name", Path(source).stem if source else "custom")
+    # a name read from a file becomes part of output file names: keep it inside the folder
+    name = safe_name(d.get("preset", {}).get("name", Path(source).stem if source else "custom"),
+                     "custom")
     return TrainingProblem(name, system, basis, cost, mesh, policy, settings,
                            d.get("published", {}), d, source)

@@ -320,6 +320,18 @@ class Simulator:
         sys = self.sys
         from .events import flatten
 
+        try:
+            t_end = float(t_end)
+        except (TypeError, ValueError):
+            raise DataError("simulation", "t_end", t_end, "give the final time in seconds") from None
+        if not (math.isfinite(t_end) and t_end > self.t):
+            raise DataError("simulation", "t_end", t_end,
+                            f"give a finite final time after the current time {self.t:g} s")
+        events = list(events)
+        for ev in flatten(events):
+            if ev.t > t_end:
+                raise DataError(repr(ev), "t", ev.t, f"the event comes after the end of the run "
+                                f"(t_end = {t_end:g} s): move it earlier or simulate longer")
         for ev in events:
             if hasattr(ev, "parts"):
                 ev.validate(sys)

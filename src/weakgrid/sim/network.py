@@ -94,8 +94,25 @@ class Network:
         for k, row in enumerate(branch):
             for col, nm in ((F_BUS, "F_BUS"), (T_BUS, "T_BUS")):
                 self.index_of(int(row[col]), f"branch {k}", nm)
+            el = f"branch {k} ({int(row[F_BUS])}-{int(row[T_BUS])})"
+            for col, nm in ((BR_R, "BR_R"), (BR_X, "BR_X"), (BR_B, "BR_B"), (TAP, "TAP"),
+                            (SHIFT, "SHIFT")):
+                if not np.isfinite(row[col]):
+                    raise DataError(el, nm, row[col], "give a finite number (per unit)")
             if row[BR_R] == 0 and row[BR_X] == 0:
                 raise DataError(f"branch {k}", "BR_X", 0.0, "a branch needs a non-zero impedance R + jX")
+            if row[BR_R] < 0:
+                raise DataError(el, "BR_R", row[BR_R], "a series resistance cannot be negative: "
+                                "check the sign and the per-unit base")
+            if row[BR_X] < 0 and k not in set(self.case.get("series_capacitors", ())):
+                raise DataError(el, "BR_X", row[BR_X], "a negative series reactance is a series "
+                                f"capacitor: declare it with series_capacitors = [{k}] in the "
+                                "case, or correct the sign")
+        for name, table in (("bus", bus), ("gen", gen)):
+            bad = np.argwhere(~np.isfinite(table[:, :10] if name == "bus" else table[:, :8]))
+            if len(bad):
+                r, c = bad[0]
+                raise DataError(f"{name} {r}", f"column {c}", table[r, c], "give a finite number")
         for k, row in enumerate(gen):
             self.index_of(int(row[GEN_BUS]), f"gen {k}", "GEN_BUS")
         kv = bus[:, BASE_KV]
@@ -186,6 +203,8 @@ class Network:
         import pandapower as pp
         from pandapower.converter.pypower import from_ppc
 
+        self.check_connected()
+
         ppc = {"version": "2", "baseMVA": self.Sb, "bus": self.bus.copy(),
                "gen": self.gen.copy(), "branch": self.branch.copy()}
         with warnings.catch_warnings():
@@ -202,6 +221,26 @@ class Network:
         rb = net.res_bus.loc[self.bus_ids]
         V = rb.vm_pu.to_numpy() * np.exp(1j * np.deg2rad(rb.va_degree.to_numpy()))
         return self._finish_pf(V, check_tol)
+
+    def check_connected(self, branch_status=None):
+        """Raise :class:`DataError` naming a bus that no in-service branch links to a slack bus."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        st = self.branch[:, BR_STATUS] > 0 if branch_status is None else np.asarray(branch_status, bool)
+        f = np.array([self._pos[int(b)] for b in self.branch[st, F_BUS]], dtype=int)
+        t = np.array([self._pos[int(b)] for b in self.branch[st, T_BUS]], dtype=int)
+        g = coo_matrix((np.ones(len(f)), (f, t)), shape=(self.nb, self.nb))
+        _, label = connected_components(g, directed=False)
+        slack = np.nonzero(self.bus[:, BUS_TYPE] == 3)[0]
+        live = np.isin(label, label[slack]) | (self.bus[:, BUS_TYPE] == 4)
+        if not live.all():
+            i = int(np.nonzero(~live)[0][0])
+            n = int((~live).sum())
+            raise DataError(f"bus {self.bus_ids[i]}", "branches", "none in service to a slack bus",
+                            f"the bus is islanded ({n} bus(es) cut off from the slack): connect "
+                            "it with an in-service branch, add a slack bus to its island, or "
+                            "set BUS_TYPE = 4 (isolated)")
 
     def _finish_pf(self, V, check_tol):
         Y = self.ybus()
