@@ -110,3 +110,34 @@ def output_folder(text) -> Path:
     if p.exists() and not p.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
     return p
+
+
+# ------------------------------------------------------------------ long work
+def add_force_argument(p):
+    p.add_argument("--force", action="store_true",
+                   help="run even if the estimated memory/time exceeds the limits "
+                        "(4 GiB or half the available memory, 30 min; WEAKGRID_MAX_GIB)")
+
+
+def guard_training(problem, force: bool, log=print):
+    """Print the estimate of a training and refuse it beyond the limits unless ``force``."""
+    from ..game.estimate import training_estimate
+
+    n = int(problem.mesh.points.shape[0])
+    est = training_estimate(n, problem.basis.size, problem.system.n_states)
+    if n >= 20000 or force:
+        log(f"  {est.describe()}")
+    est.check("mesh.step", list(problem.mesh.step),
+              f"use a larger step in [mesh] of {problem.source} (doubling every step divides "
+              f"the {n} points by {2 ** problem.system.n_states})", force)
+    return est
+
+
+def guard_dp(n_nodes: int, force: bool, log=print):
+    from ..game.estimate import dp_estimate
+
+    est = dp_estimate(n_nodes)
+    if n_nodes >= 10000 or force:
+        log(f"  {est.describe()}")
+    est.check("--points", int(round(n_nodes**0.5)), "use fewer --points", force)
+    return est

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import replace
-from pathlib import Path
 
 from ..fileio import write_json_atomic
 from ..game.gamma_search import SearchSettings, search_min_gamma
-from ._common import (add_problem_arguments, output_file, positive_float, positive_int,
-                      problem_of, provenance)
+from ._common import (add_force_argument, add_problem_arguments, guard_training, output_file,
+                      positive_float, positive_int, problem_of, provenance)
 
 NAME = "gamma"
 
@@ -44,6 +43,7 @@ def add_parser(sub):
     p.add_argument("--report", type=output_file(".json"), default=None,
                    help="write the search (bracket, history, parameters) as JSON")
     p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
+    add_force_argument(p)
     p.set_defaults(func=run)
     return p
 
@@ -60,6 +60,7 @@ def run(args) -> int:
     print(f"weakgrid gamma: {problem.name}  ({problem.source})")
     print(f"  problem's gamma = {problem.cost.gamma:g};  bracket rtol = {settings.rtol:g}; "
           f"rollouts of {settings.rollout_steps} steps from the corners/edge midpoints of Ω")
+    guard_training(problem, args.force)
     if not args.quiet:
         print("\n  trial      gamma     decision  start           seconds  reason")
     count = [0]

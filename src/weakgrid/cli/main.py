@@ -147,6 +147,8 @@ def main(argv=None) -> int:
     except BaseException as exc:  # the one error boundary
         if isinstance(exc, SystemExit):
             raise
+        if isinstance(exc, BrokenPipeError):  # `weakgrid … | head`: the reader left
+            return EXIT_RUN
         msg, code = describe_error(exc)
         sys.stdout.flush()
         if debug:

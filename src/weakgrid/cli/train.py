@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from ..game.hji import closed_loop_spectral_radius
-from ._common import add_problem_arguments, output_file, positive_float, problem_of
+from ._common import (add_force_argument, add_problem_arguments, guard_training, output_file,
+                      positive_float, problem_of)
 
 NAME = "train"
 
@@ -26,6 +28,7 @@ def add_parser(sub):
     p.add_argument("--tol", type=positive_float, default=None,
                    help="δu = δw (default: the problem's [solver] values)")
     p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
+    add_force_argument(p)
     p.set_defaults(func=run)
     return p
 
@@ -50,17 +53,28 @@ def run(args) -> int:
     print(f"  mesh    {list(problem.mesh.lower)} .. {list(problem.mesh.upper)} step "
           f"{list(problem.mesh.step)}  ({mesh_n} points);  basis {problem.basis.size} terms")
     print(f"  solver  δu = {settings.tol_u:g}, δw = {settings.tol_w:g}")
+    guard_training(problem, args.force)
     if not args.quiet:
         print("\n  outer  inner    max|Δu|     max|Δw| (last)   residual    min J     "
               "max eig Yw  min eig Yu")
 
-    def progress(rec):
-        if not args.quiet:
-            print(f"  {rec.outer:5d}  {rec.inner:5d}  {rec.max_du:10.3e}  {rec.max_dw[-1]:12.3e}"
-                  f"     {rec.residual:9.2e}  {rec.min_J:9.3g}  {rec.max_eig_Yw:10.3g}  "
-                  f"{rec.min_eig_Yu:10.3g}")
+    from tqdm.auto import tqdm
 
-    ctl = problem.train(settings, progress=progress)
+    # the bar (stderr, only on a terminal) counts outer iterations and shows max|Δu| vs δu
+    bar = tqdm(desc="  training", unit=" outer it", leave=False, disable=None)
+
+    def progress(rec):
+        bar.update(1)
+        bar.set_postfix_str(f"max|Δu| {rec.max_du:.2e} → δu {settings.tol_u:g}", refresh=False)
+        if not args.quiet:
+            tqdm.write(f"  {rec.outer:5d}  {rec.inner:5d}  {rec.max_du:10.3e}  "
+                       f"{rec.max_dw[-1]:12.3e}     {rec.residual:9.2e}  {rec.min_J:9.3g}  "
+                       f"{rec.max_eig_Yw:10.3g}  {rec.min_eig_Yu:10.3g}", file=sys.stdout)
+
+    try:
+        ctl = problem.train(settings, progress=progress)
+    finally:
+        bar.close()
     it = ctl.iterations
     print(f"\n  converged: {it['outer']} outer iterations, at most {max(it['inner'])} inner "
           f"({sum(it['inner'])} least-squares fits) in {ctl.train_seconds * 1e3:.1f} ms")

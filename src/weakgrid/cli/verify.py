@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
 
@@ -12,8 +11,9 @@ from ..game.dynamic_programming import DPSettings, solve_game_dp
 from ..game.errors import ParameterError
 from ..game.optimality import closed_loop_gap, default_starts, value_error
 from ..models import load_controller
-from ._common import (add_problem_arguments, input_file, nonnegative_float, output_file,
-                      positive_float, positive_int, problem_of, provenance)
+from ._common import (add_force_argument, add_problem_arguments, guard_dp, guard_training,
+                      input_file, nonnegative_float, output_file, positive_float, positive_int,
+                      problem_of, provenance)
 
 NAME = "verify"
 
@@ -46,6 +46,7 @@ def add_parser(sub):
     p.add_argument("--start-fraction", type=positive_float, default=0.5,
                    help="starts: corners/edge midpoints of the region shrunk by this")
     p.add_argument("--report", type=output_file(".json"), default=None, help="write the report (JSON)")
+    add_force_argument(p)
     p.set_defaults(func=run)
     return p
 
@@ -65,6 +66,9 @@ def run(args) -> int:
                           margin=tuple(args.margin), interpolation=args.interpolation,
                           max_iterations=args.max_iterations)
     print(f"weakgrid verify: {problem.name}  ({problem.source})")
+    guard_dp(args.points ** 2, args.force)
+    if not args.controller:
+        guard_training(problem, args.force)
     if args.controller:
         ctl = load_controller(args.controller)
         mine, theirs = problem.system.to_dict(), ctl.problem.get("model", {})

@@ -89,12 +89,18 @@ class Results:
         return pd.DataFrame(cols)
 
     def to_csv(self, path, si: bool = False, names=None):
-        """Write the trajectories to CSV."""
-        self.to_frame(si, names).to_csv(path, index=False)
+        """Write the trajectories to CSV (atomically: the previous file survives a failure)."""
+        from ..fileio import replace_atomic
+
+        df = self.to_frame(si, names)
+        return replace_atomic(path, lambda tmp: df.to_csv(tmp, index=False))
 
     def to_parquet(self, path, si: bool = False, names=None):
-        """Write the trajectories to Parquet (pyarrow)."""
-        self.to_frame(si, names).to_parquet(path, index=False)
+        """Write the trajectories to Parquet (pyarrow; atomically)."""
+        from ..fileio import replace_atomic
+
+        df = self.to_frame(si, names)
+        return replace_atomic(path, lambda tmp: df.to_parquet(tmp, index=False))
 
     def plot(self, names, si: bool = False, ax=None, title=None):
         """Plot variables against time; axes labelled with units. Returns the matplotlib axes."""

@@ -15,6 +15,8 @@ matplotlib.use("Agg")
 matplotlib.rcParams["svg.fonttype"] = "none"  # keep text as text: labels stay searchable
 import matplotlib.pyplot as plt  # noqa: E402
 
+from ..fileio import savefig_atomic  # noqa: E402
+
 __all__ = ["FIGURES", "write_figures"]
 
 SPEED = ("sg_speed", "SG speed [pu]")
@@ -120,7 +122,7 @@ def write_figures(records: dict, folder, formats=("png", "svg")) -> list[Path]:
         fig.tight_layout(rect=(0, 0.02, 1, 1))
         for fmt in formats:
             p = folder / f"{fig_id}.{fmt}"
-            fig.savefig(p, dpi=110)
+            savefig_atomic(fig, p, dpi=110)
             written.append(p)
         plt.close(fig)
     return written

@@ -8,48 +8,36 @@ import time
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 from .. import __version__
-from ..fileio import replace_atomic, write_json_atomic
-from ..models import load_preset
+from ..fileio import write_json_atomic
+from ..models import load_controller, load_preset
+from .cache import inputs_key, load_run, remove_stale, save_run
 from .cases import build_case
 from .claims import judge_all
 from .controllers import train_hji_for
 from .figures import write_figures
 from .report import write_html, write_tables
-from .runner import run_scenario
+from .runner import RunRecord, run_scenario
 from .scenarios import paper_scenarios
 
 __all__ = ["reproduce", "Progress"]
 
 
 class Progress:
-    """A text progress bar on stderr (one line, redrawn)."""
+    """A progress bar on stderr (tqdm)."""
 
-    def __init__(self, total, stream=None, width=30):
-        self.total, self.n, self.width = total, 0, width
-        self.stream = stream or sys.stderr
-        self.t0 = time.perf_counter()
+    def __init__(self, total, stream=None):
+        from tqdm.auto import tqdm
+
+        self.bar = tqdm(total=total, file=stream or sys.stderr, unit="step",
+                        dynamic_ncols=True, disable=None)
 
     def step(self, label):
-        self.n += 1
-        frac = self.n / max(self.total, 1)
-        bar = "#" * int(frac * self.width)
-        el = time.perf_counter() - self.t0
-        self.stream.write(f"\r[{bar:<{self.width}}] {self.n}/{self.total} {el:5.0f} s  "
-                          f"{label[:40]:<40}")
-        self.stream.flush()
-        if self.n == self.total:
-            self.stream.write("\n")
-
-
-def _save_series(rec, folder: Path):
-    s = rec.series
-    t = s["t"]
-    cols = {k: v for k, v in s.items() if isinstance(v, np.ndarray) and v.shape == t.shape}
-    df = pd.DataFrame(cols)
-    replace_atomic(folder / f"{rec.scenario.id}.parquet", df.to_parquet)
+        self.bar.set_postfix_str(label[:40], refresh=False)
+        self.bar.update(1)
+        if self.bar.n >= self.bar.total:
+            self.bar.close()
 
 
 def reproduce(output="reproduce-output", quick=False, log=print) -> dict:
@@ -63,11 +51,34 @@ def reproduce(output="reproduce-output", quick=False, log=print) -> dict:
     t0 = time.perf_counter()
     scenarios = paper_scenarios(quick)
     keys = sorted({(s.case, s.load, s.upqc) for s in scenarios if s.controller == "hji"})
+    # a used folder: runs this plan does not make are stale; finished runs with the same
+    # inputs are kept and not redone (an interrupted reproduce continues where it stopped)
+    remove_stale(runs_dir, [s.id for s in scenarios], log)
+    remove_stale(out / "controllers", [f"{c}-{ld}-{u}" for c, ld, u in keys], log,
+                 suffix=".controller.json")
     prog = Progress(len(keys) + len(scenarios))
-    trained, designs, notes = {}, [], {}
+    trained, designs, notes, ctl_keys, n_kept = {}, [], {}, {}, 0
     for case, load, upqc in keys:
         build = build_case(case, load, upqc)
-        problem, ctl = train_hji_for(case, build.design)
+        d = build.design
+        ckey = inputs_key(case=case, design=[d.T, d.a, d.Vr_bar, d.phi_s0],
+                          machine=getattr(d, "machine", None), upqc=getattr(d, "upqc", None))
+        cpath = out / "controllers" / f"{case}-{load}-{upqc}.controller.json"
+        ctl = None
+        if cpath.is_file():
+            try:
+                ctl = load_controller(cpath)
+            except (ValueError, OSError):
+                ctl = None
+            if ctl is not None and ctl.problem.get("inputs_key") != ckey:
+                ctl = None
+        if ctl is None:
+            problem, ctl = train_hji_for(case, build.design)
+            ctl.problem["inputs_key"] = ckey
+            ctl.save(cpath)
+        else:
+            n_kept += 1
+        ctl_keys[(case, load, upqc)] = ckey
         trained[(case, load, upqc)] = ctl
         info = build.info
         case_notes = [info[k] for k in ("difference",) if isinstance(info.get(k), str)]
@@ -82,18 +93,22 @@ def reproduce(output="reproduce-output", quick=False, log=print) -> dict:
                         f"{preset.phi_s0:.4g}",
                         f"{ctl.iterations['outer']} outer, W = "
                         f"{np.array2string(ctl.weights, precision=3, max_line_width=200)}"))
-        ctl.save(out / "controllers" / f"{case}-{load}-{upqc}.controller.json")
         prog.step(f"trained {case} {load} {upqc}")
     records, metrics = {}, []
     for sc in scenarios:
-        rec = run_scenario(sc, trained)
+        rkey = inputs_key(scenario=sc.to_dict(),
+                          controller=ctl_keys.get((sc.case, sc.load, sc.upqc)))
+        rec = load_run(runs_dir, sc, rkey, RunRecord)
+        if rec is None:
+            rec = run_scenario(sc, trained)
+            save_run(rec, runs_dir, rkey)
+        else:
+            n_kept += 1
         records[sc.id] = rec
         metrics.append(rec.metrics)
-        _save_series(rec, runs_dir)
-        write_json_atomic(runs_dir / f"{sc.id}.json", {
-            "scenario": sc.to_dict(), "metrics": rec.metrics, "info": rec.info,
-            "weakgrid_version": __version__})
         prog.step(sc.id)
+    if n_kept:
+        log(f"kept {n_kept} finished result(s) of an earlier run with the same inputs")
     figs = write_figures(records, out / "figures")
     csv, md = write_tables(metrics, out)
     claims = judge_all({m["id"]: m for m in metrics})

@@ -1,0 +1,105 @@
+"""Finished runs on disk, keyed by a content hash of their inputs: resume, never redo.
+
+A run is written as its series (``ID.parquet``, ``ID.samples.parquet``) and then
+its record ``ID.json``, each atomically; the record is written last and carries
+``inputs_key``, a hash of everything the run depends on (scenario, controller,
+package version). A re-run with the same inputs loads the run instead of
+simulating it again; a changed input gives another key and the run is redone.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import __version__
+from ..fileio import json_safe, replace_atomic, write_json_atomic
+
+__all__ = ["inputs_key", "save_run", "load_run", "remove_stale"]
+
+
+def inputs_key(**inputs) -> str:
+    """A short hash of ``inputs`` (JSON-serializable) and the package version."""
+    text = json.dumps(json_safe({"inputs": inputs, "version": __version__}), sort_keys=True,
+                      default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+
+def _frame(series: dict, length_of: str):
+    n = np.shape(series.get(length_of, ()))
+    cols = {}
+    for k, v in series.items():
+        if isinstance(v, np.ndarray) and v.ndim >= 1 and v.shape[0] == n[0] and n:
+            if v.ndim == 1:
+                cols[k] = v
+            elif v.ndim == 2:
+                for j in range(v.shape[1]):
+                    cols[f"{k}[{j}]"] = v[:, j]
+    return pd.DataFrame(cols)
+
+
+def _unframe(df) -> dict:
+    out, parts = {}, {}
+    for c in df.columns:
+        if c.endswith("]") and "[" in c:
+            k, j = c[:-1].split("[")
+            parts.setdefault(k, {})[int(j)] = df[c].to_numpy()
+        else:
+            out[c] = df[c].to_numpy()
+    for k, cols in parts.items():
+        out[k] = np.column_stack([cols[j] for j in sorted(cols)])
+    return out
+
+
+def save_run(rec, folder, key: str, version: str = __version__) -> Path:
+    """Write one finished run: series first, the record (with ``key``) last."""
+    folder = Path(folder)
+    sid = rec.scenario.id
+    t_frame = _frame(rec.series, "t")
+    replace_atomic(folder / f"{sid}.parquet", t_frame.to_parquet)
+    s_frame = _frame({k: v for k, v in rec.series.items() if k not in t_frame.columns}, "tk")
+    replace_atomic(folder / f"{sid}.samples.parquet", s_frame.to_parquet)
+    return write_json_atomic(folder / f"{sid}.json", {
+        "scenario": rec.scenario.to_dict(), "metrics": rec.metrics, "info": rec.info,
+        "weakgrid_version": version, "inputs_key": key})
+
+
+def load_run(folder, scenario, key: str, record_class):
+    """The finished run of ``scenario`` if its record matches ``key``, else None."""
+    folder = Path(folder)
+    sid = scenario.id
+    paths = [folder / f"{sid}.json", folder / f"{sid}.parquet", folder / f"{sid}.samples.parquet"]
+    if not all(p.is_file() for p in paths):
+        return None
+    try:
+        d = json.loads(paths[0].read_text(encoding="utf-8"))
+        if not isinstance(d, dict) or d.get("inputs_key") != key:
+            return None
+        series = _unframe(pd.read_parquet(paths[1]))
+        series.update(_unframe(pd.read_parquet(paths[2])))
+    except (OSError, ValueError):  # unreadable: run it again
+        return None
+    metrics = {k: (math.nan if v is None else v) for k, v in d.get("metrics", {}).items()}
+    return record_class(scenario, metrics, series, d.get("info", {}))
+
+
+def remove_stale(folder, keep_ids, log=print, suffix=".json") -> list[str]:
+    """Remove the runs in ``folder`` whose id is not in ``keep_ids``; say so."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    keep = set(keep_ids)
+    stale = sorted(p.name[:-len(suffix)] for p in folder.glob(f"*{suffix}")
+                   if p.name[:-len(suffix)] not in keep)
+    for sid in stale:
+        for p in folder.glob(f"{sid}.*"):
+            p.unlink()
+    if stale:
+        log(f"warning: removed {len(stale)} stale run(s) of an earlier reproduce in {folder} "
+            f"that this one does not make: {', '.join(stale[:6])}{' …' if len(stale) > 6 else ''}")
+    return stale
