@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from pathlib import Path
 
 from .. import __version__
@@ -83,15 +84,27 @@ def output_file(*suffixes):
         if not text or text.endswith(("/", "\\")):
             raise argparse.ArgumentTypeError(f"{text!r} is a folder: give a file name "
                                              f"ending in {' or '.join(suffixes)}")
+        if p.is_dir():
+            raise argparse.ArgumentTypeError(f"{text!r} is a folder: give a file name")
         if suffixes and p.suffix.lower() not in suffixes:
             raise argparse.ArgumentTypeError(
                 f"{text!r}: unsupported file type {p.suffix or '(none)'!r}; use "
                 f"{' or '.join(suffixes)}")
-        if p.is_dir():
-            raise argparse.ArgumentTypeError(f"{text!r} is a folder: give a file name")
+        _check_writable_folder(p.parent, text)
         return p
     parse.__name__ = "output file"
     return parse
+
+
+def _check_writable_folder(folder: Path, text):
+    """The nearest existing ancestor of ``folder`` must be a folder we may write into."""
+    q = folder if str(folder) else Path(".")
+    while not q.exists() and q != q.parent:
+        q = q.parent
+    if not q.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r}: {str(q)!r} is a file, not a folder")
+    if not os.access(q, os.W_OK | os.X_OK):
+        raise argparse.ArgumentTypeError(f"{text!r}: no permission to write in {str(q)!r}")
 
 
 def input_file(text) -> Path:
@@ -109,6 +122,7 @@ def output_folder(text) -> Path:
     p = Path(text)
     if p.exists() and not p.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
+    _check_writable_folder(p, text)
     return p
 
 

@@ -30,9 +30,14 @@ class GridMesh:
     step: tuple
 
     def __post_init__(self):
-        lo = np.atleast_1d(np.asarray(self.lower, float))
-        hi = np.atleast_1d(np.asarray(self.upper, float))
-        st = np.atleast_1d(np.asarray(self.step, float))
+        arrays = []
+        for nm in ("lower", "upper", "step"):
+            try:
+                arrays.append(np.atleast_1d(np.asarray(getattr(self, nm), float)))
+            except (TypeError, ValueError):
+                raise ParameterError(f"mesh.{nm}", getattr(self, nm),
+                                     "must be a list of numbers, one per state") from None
+        lo, hi, st = arrays
         if not (lo.shape == hi.shape == st.shape) or lo.ndim != 1:
             raise ShapeError("mesh.step", st.shape, f"one value per state, like lower {lo.shape}")
         for nm, v in (("lower", lo), ("upper", hi), ("step", st)):

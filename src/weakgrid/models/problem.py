@@ -38,6 +38,7 @@ from ..game import (
 )
 from ..fileio import safe_name
 from ..game.bases import PolynomialBasis
+from ..game.errors import ShapeError
 from .design import UPQCDesignModel, gti_design_model, sg_design_model
 from .policies import NonlinearInitialPolicy, lqr_policy
 
@@ -77,7 +78,12 @@ def load_preset(name: str) -> "TrainingProblem":
 
 def load_problem(path) -> "TrainingProblem":
     """A user's problem from a TOML file (``weakgrid train --config FILE``)."""
-    return problem_from_dict(_read_toml(path), source=str(Path(path)))
+    d = _read_toml(path)
+    try:
+        return problem_from_dict(d, source=str(Path(path)))
+    except (ParameterError, ShapeError) as exc:  # name the file in front of the field
+        exc.args = (f"{path}: {exc.args[0]}",) + exc.args[1:]
+        raise exc from None
 
 
 def _need(d: dict, key: str, section: str):

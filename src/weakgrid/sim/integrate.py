@@ -99,6 +99,25 @@ class Simulator:
         self._lu_key = None
         self._alg_key = None
 
+    def _step_diagnosis(self, t, z):
+        """If dt is large against the fastest time constant, say so (the real cause)."""
+        try:
+            self._refresh_jacobian(t, z)
+            J = self._full_jac()
+            nx = self.nx
+            A = J[:nx, :nx] - J[:nx, nx:] @ np.linalg.solve(J[nx:, nx:], J[nx:, :nx])
+            lam, vec = np.linalg.eig(A)
+            k = int(np.argmax(np.abs(lam)))
+            tau = 1.0 / abs(lam[k])
+            name = self.sys.var_name(int(np.argmax(np.abs(vec[:, k]))))
+        except Exception:  # the diagnosis must never hide the failure
+            return ""
+        if self.dt <= 5 * tau:
+            return ""
+        return (f"; the step dt = {self.dt:g} s is too large relative to the fastest time "
+                f"constant of the system, ≈ {tau:.3g} s (mode dominated by {name}): use dt ≤ "
+                f"{2 * tau:.2g} s")
+
     def _full_jac(self):
         J = self._Jdev.copy()
         J[self.nx:, self.nx:] += self.sys.Yr
@@ -258,7 +277,8 @@ class Simulator:
                     continue
                 if h / 2 < self.min_step:
                     raise SimulationError(t, "newton",
-                                          f"no convergence with step {h:.3g} s even with a fresh Jacobian")
+                                          f"no convergence with step {h:.3g} s even with a fresh "
+                                          f"Jacobian{self._step_diagnosis(t, z_n)}")
                 h /= 2
                 refreshed = False
                 guess = corr = None
