@@ -70,6 +70,12 @@ def _finish(tmp):
     os.chmod(tmp, 0o666 & ~_umask())
 
 
+def _name_target(exc, path):
+    """An OSError without a file name (ENOSPC from write/fsync) gets the target's."""
+    if isinstance(exc, OSError) and (exc.filename is None or str(exc.filename).endswith(".tmp")):
+        exc.filename = str(path)
+
+
 def replace_atomic(path, write) -> Path:
     """Call ``write(tmp_path)`` on a temporary file beside ``path``, fsync it, rename it.
 
@@ -82,9 +88,10 @@ def replace_atomic(path, write) -> Path:
         write(tmp)
         _finish(tmp)
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        _name_target(exc, path)
         raise
     _fsync_dir(path.parent)
     return path
@@ -107,10 +114,11 @@ def replace_many_atomic(writers: dict) -> list[Path]:
             tmps.append(tmp)
             write(tmp)
             _finish(tmp)
-    except BaseException:
+    except BaseException as exc:
         for t in tmps:
             if os.path.exists(t):
                 os.unlink(t)
+        _name_target(exc, targets[len(tmps) - 1] if tmps else targets[0])
         raise
     backups, done = {}, []
     try:
