@@ -50,6 +50,18 @@ class GameCost:
     P: np.ndarray
     gamma: float
 
+    def __post_init__(self):
+        try:
+            g = float(self.gamma)
+        except (TypeError, ValueError):
+            g = float("nan")
+        if not np.isfinite(g) or g <= 0:
+            raise ParameterError("cost.gamma", self.gamma, "gamma must be a positive finite number")
+        for nm, strict in (("Q", False), ("R", True), ("P", True)):
+            M = np.atleast_2d(np.asarray(getattr(self, nm), float))
+            object.__setattr__(self, nm, _sym(M, M.shape[0], nm, strict))
+        object.__setattr__(self, "gamma", g)
+
     @classmethod
     def for_system(cls, system, Q, R, P, gamma) -> "GameCost":
         g = float(gamma)

@@ -72,6 +72,8 @@ class Network:
             if key not in case:
                 raise DataError("case", key, None, "a MATPOWER case needs baseMVA, bus, gen and branch")
         self.case = copy.deepcopy({k: case[k] for k in ("baseMVA", "bus", "gen", "branch")})
+        # branches with a negative series reactance on purpose (series capacitors)
+        self.series_capacitors = {int(k) for k in case.get("series_capacitors", ())}
         self.Sb = float(self.case["baseMVA"])
         if not self.Sb > 0:
             raise DataError("case", "baseMVA", self.Sb, "must be > 0 MVA")
@@ -98,21 +100,28 @@ class Network:
             for col, nm in ((BR_R, "BR_R"), (BR_X, "BR_X"), (BR_B, "BR_B"), (TAP, "TAP"),
                             (SHIFT, "SHIFT")):
                 if not np.isfinite(row[col]):
-                    raise DataError(el, nm, row[col], "give a finite number (per unit)")
+                    raise DataError(el, nm, float(row[col]), "give a finite number (per unit)")
             if row[BR_R] == 0 and row[BR_X] == 0:
                 raise DataError(f"branch {k}", "BR_X", 0.0, "a branch needs a non-zero impedance R + jX")
             if row[BR_R] < 0:
-                raise DataError(el, "BR_R", row[BR_R], "a series resistance cannot be negative: "
+                raise DataError(el, "BR_R", float(row[BR_R]), "a series resistance cannot be negative: "
                                 "check the sign and the per-unit base")
-            if row[BR_X] < 0 and k not in set(self.case.get("series_capacitors", ())):
-                raise DataError(el, "BR_X", row[BR_X], "a negative series reactance is a series "
+            if row[BR_X] < 0 and k not in self.series_capacitors:
+                raise DataError(el, "BR_X", float(row[BR_X]), "a negative series reactance is a series "
                                 f"capacitor: declare it with series_capacitors = [{k}] in the "
                                 "case, or correct the sign")
-        for name, table in (("bus", bus), ("gen", gen)):
-            bad = np.argwhere(~np.isfinite(table[:, :10] if name == "bus" else table[:, :8]))
-            if len(bad):
-                r, c = bad[0]
-                raise DataError(f"{name} {r}", f"column {c}", table[r, c], "give a finite number")
+        # the columns the power flow and the simulator read must be finite (others, e.g.
+        # MBASE from pandapower's converter, may be NaN)
+        for name, table, cols in (
+                ("bus", bus, {BUS_I: "BUS_I", BUS_TYPE: "BUS_TYPE", PD: "PD", QD: "QD", GS: "GS",
+                              BS: "BS", BASE_KV: "BASE_KV"}),
+                ("gen", gen, {GEN_BUS: "GEN_BUS", PG: "PG", VG: "VG", GEN_STATUS: "GEN_STATUS"})):
+            for c, nm in cols.items():
+                bad = np.nonzero(~np.isfinite(table[:, c]))[0] if table.size else []
+                if len(bad):
+                    r = int(bad[0])
+                    label = f"bus {table[r, BUS_I]:g}" if name == "bus" else f"gen {r}"
+                    raise DataError(label, nm, float(table[r, c]), "give a finite number")
         for k, row in enumerate(gen):
             self.index_of(int(row[GEN_BUS]), f"gen {k}", "GEN_BUS")
         kv = bus[:, BASE_KV]

@@ -1,0 +1,43 @@
+"""Resume by content hash: a finished run is loaded only when its inputs are the same."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from weakgrid.study.cache import inputs_key, load_run, remove_stale, save_run
+from weakgrid.study.runner import RunRecord
+from weakgrid.study.scenarios import C1, Scenario
+
+
+def _rec(sc):
+    t = np.linspace(0, 1, 11)
+    tk = np.linspace(0, 1, 4)
+    return RunRecord(sc, {"id": sc.id, "failed": False, "settling": float("nan")},
+                     {"t": t, "speed": np.sin(t), "tk": tk, "running_cost": tk**2,
+                      "x_design": np.column_stack([tk, -tk])}, {"note": "x"})
+
+
+def test_a_finished_run_round_trips_and_a_changed_input_is_redone(tmp_path):
+    sc = Scenario("a", C1, "high", "conventional", "pq", 0.2, 0.25, 1.0)
+    key = inputs_key(scenario=sc.to_dict())
+    save_run(_rec(sc), tmp_path, key)
+    got = load_run(tmp_path, sc, key, RunRecord)
+    assert got is not None and np.isnan(got.metrics["settling"])
+    np.testing.assert_array_equal(got.series["x_design"], _rec(sc).series["x_design"])
+    np.testing.assert_array_equal(got.series["speed"], np.sin(np.linspace(0, 1, 11)))
+    longer = Scenario("a", C1, "high", "conventional", "pq", 0.2, 0.25, 2.0)
+    assert inputs_key(scenario=longer.to_dict()) != key
+    assert load_run(tmp_path, longer, inputs_key(scenario=longer.to_dict()), RunRecord) is None
+    (tmp_path / "a.samples.parquet").unlink()  # an incomplete run is redone
+    assert load_run(tmp_path, sc, key, RunRecord) is None
+
+
+def test_stale_runs_of_an_earlier_plan_are_removed_with_a_warning(tmp_path):
+    for sid in ("keep", "old"):
+        sc = Scenario(sid, C1, "high", "conventional", "pq", 0.2, 0.25, 1.0)
+        save_run(_rec(sc), tmp_path, "k")
+    said = []
+    assert remove_stale(tmp_path, ["keep"], said.append) == ["old"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "keep.json", "keep.parquet", "keep.samples.parquet"]
+    assert "stale" in said[0] and "old" in said[0]
