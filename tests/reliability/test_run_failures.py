@@ -53,6 +53,20 @@ def test_interrupted_training_exits_130_with_one_line(ws, cli, monkeypatch):
     ws.check_untouched()
 
 
+def test_sigterm_is_an_interruption(ws, cli, monkeypatch):
+    import signal
+
+    def terminated(self, *a, **k):
+        os.kill(os.getpid(), signal.SIGTERM)  # the CLI's handler turns it into an interruption
+        raise AssertionError("SIGTERM was not handled")
+
+    monkeypatch.setattr(TrainingProblem, "train", terminated)
+    previous = signal.getsignal(signal.SIGTERM)
+    code, _, err = cli(["train", "--preset", "case1-paper", "-q", "-o", ws.precious])
+    assert code == 130 and "interrupted" in err
+    assert signal.getsignal(signal.SIGTERM) == previous  # restored after the command
+
+
 def test_simulator_error_is_a_run_failure(ws, cli, monkeypatch):
     from weakgrid.sim.errors import SimulationError
     import weakgrid.study.runner as runner

@@ -218,7 +218,7 @@ def controller_from_dict(d: dict, system: ControlAffineSystem | None = None) -> 
                          f"({basis.size} in problem.basis)")
     return GameController(system=system, basis=basis, weights=w,
                           cost=cost, problem=problem, history=[],
-                          train_seconds=d.get("train_seconds", float("nan")),
+                          train_seconds=float(d.get("train_seconds") or float("nan")),
                           iterations=d.get("iterations"))
 
 
