@@ -15,6 +15,7 @@ import json
 import math
 import os
 import re
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -126,7 +127,10 @@ def replace_many_atomic(writers: dict) -> list[Path]:
             if path.exists():
                 bak = f"{_temp_beside(path)}.bak"
                 os.unlink(bak[:-4])
-                os.link(path, bak)  # a second name for the previous content
+                try:
+                    os.link(path, bak)  # a second name for the previous content
+                except OSError:  # file systems without hard links
+                    shutil.copy2(path, bak)
                 backups[path] = bak
         for path, tmp in zip(targets, tmps):
             os.replace(tmp, path)
