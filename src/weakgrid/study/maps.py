@@ -126,8 +126,7 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
     if title or legend:
         fig.suptitle("\n".join(t for t in (title, legend) if t), fontsize=10)
     if path is not None:
-        from ..fileio import replace_atomic
+        from ..fileio import savefig_atomic
 
-        fmt = str(path).rsplit(".", 1)[-1]
-        replace_atomic(path, lambda tmp: fig.savefig(tmp, format=fmt, dpi=120))
+        savefig_atomic(fig, path, dpi=120)
     return fig
