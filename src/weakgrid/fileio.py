@@ -31,6 +31,7 @@ def replace_atomic(path, write) -> Path:
 
 
 def write_text_atomic(path, text: str) -> Path:
+    """Write ``text`` to ``path`` atomically (temporary file + rename); return the path."""
     def w(tmp):
         with open(tmp, "w") as fh:
             fh.write(text)
@@ -39,4 +40,5 @@ def write_text_atomic(path, text: str) -> Path:
 
 
 def write_json_atomic(path, obj) -> Path:
+    """Write ``obj`` as indented JSON to ``path`` atomically; return the path."""
     return write_text_atomic(path, json.dumps(obj, indent=1) + "\n")

@@ -13,6 +13,7 @@ SUBCOMMANDS = [train, gamma, verify, export, simulate, reproduce]
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``weakgrid`` argument parser with every subcommand (the CLI reference is made from it)."""
     parser = argparse.ArgumentParser(
         prog="weakgrid",
         description="Game-theoretic (HJI) nonlinear optimal stabilizers with a UPQC for weak "
@@ -25,6 +26,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    """Entry point of the ``weakgrid`` command; returns the exit status (1 on a clear input error)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "command", None):
