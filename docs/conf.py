@@ -11,7 +11,6 @@ sys.path.insert(0, str(ROOT / "src"))          # document the source tree beside
 # the tutorials' kernels import the same tree
 os.environ["PYTHONPATH"] = os.pathsep.join(
     [str(ROOT / "src")] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])
-os.environ.setdefault("MPLBACKEND", "Agg")
 
 import weakgrid  # noqa: E402
 
@@ -29,6 +28,7 @@ extensions = [
     "numpydoc",
     "myst_nb",            # MyST markdown pages and executed MyST text notebooks (includes myst_parser)
     "sphinxarg.ext",      # the CLI reference from weakgrid.cli.main.build_parser()
+    "sphinx-mathjax-offline",  # MathJax served from _static: the pages need no network
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb"}
@@ -65,8 +65,10 @@ html_theme_options = {
     "navigation_with_keys": False,
     "show_toc_level": 2,
     "navbar_align": "left",
+    "header_links_before_dropdown": 7,
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version"],
 }
-html_sidebars = {"index": []}
+html_sidebars = {p: [] for p in ("index", "theory", "findings", "beyond", "simulator", "cli",
+                                  "tutorials/*")}
 html_show_sourcelink = False
