@@ -1,6 +1,6 @@
 """Training time of both presets: weakgrid vs a plain NumPy implementation, same run.
 
-The baseline is the algorithm of SPEC §3 written the obvious way: every iteration
+The baseline is the algorithm of (25)–(28) (docs/theory.md) written the obvious way: every iteration
 evaluates f, g, h and the basis derivatives at the mesh again, forms the regression
 rows with ``einsum`` over the mesh, and solves the least-squares problem with
 ``numpy.linalg.lstsq`` (SVD, normal-equation-free). Both must give the same weights.
@@ -20,7 +20,7 @@ from weakgrid.models import load_preset
 
 
 def plain_numpy_train(problem):
-    """SPEC §3 two-loop policy iteration, straightforward NumPy (the peer)."""
+    """Two-loop policy iteration, straightforward NumPy (the peer)."""
     sysm, basis, cost, s = problem.system, problem.basis, problem.cost, problem.settings
     X = problem.mesh.points
     R, P, Q, g2 = cost.R, cost.P, cost.Q, cost.gamma**2

@@ -47,7 +47,7 @@ def test_values_are_the_monomials(bp):
 
 
 def test_paper_basis_order():
-    # SPEC §3: [ϕ̂⁴, ϕ̂³υ, ϕ̂²υ², ϕ̂², ϕ̂υ³, ϕ̂υ, υ⁴, υ²]
+    # docs/theory.md, (25): [ϕ̂⁴, ϕ̂³υ, ϕ̂²υ², ϕ̂², ϕ̂υ³, ϕ̂υ, υ⁴, υ²]
     assert paper_basis().exponents.tolist() == [
         [4, 0], [3, 1], [2, 2], [2, 0], [1, 3], [1, 1], [0, 4], [0, 2]]
 

@@ -1,4 +1,4 @@
-"""The LQ game is the exact special case of the HJI solver (SPEC §2)."""
+"""The LQ game is the exact special case of the HJI solver (docs/theory.md, "The LQ game")."""
 
 import numpy as np
 import pytest

@@ -19,6 +19,7 @@ NAME = "export"
 
 
 def add_parser(sub):
+    """Add ``weakgrid export`` to the subcommand parsers ``sub``; return its parser."""
     p = sub.add_parser(
         NAME, help="export a trained controller as C99 source or portable JSON",
         description="Export a controller file written by `weakgrid train` (or `weakgrid "
@@ -42,12 +43,14 @@ def add_parser(sub):
 
 
 def default_name(path: Path) -> str:
+    """C symbol prefix from a controller file name: its part up to the first dot, made a C identifier."""
     stem = path.name.split(".")[0] or "controller"
     name = re.sub(r"[^A-Za-z0-9_]", "_", stem)
     return name if re.match(r"[A-Za-z_]", name) else f"c_{name}"
 
 
 def run(args) -> int:
+    """Run ``weakgrid export`` with the parsed ``args``; return the exit status."""
     path = Path(args.file)
     if not path.exists():
         raise FileNotFoundError(f"controller file {path} does not exist (write one with "

@@ -14,6 +14,7 @@ NAME = "gamma"
 
 
 def add_parser(sub):
+    """Add ``weakgrid gamma`` to the subcommand parsers ``sub``; return its parser."""
     p = sub.add_parser(
         NAME, help="bisect for the minimum attenuation level gamma",
         description="Bisect gamma between the linearization's game-Riccati attenuation limit "
@@ -49,6 +50,7 @@ def add_parser(sub):
 
 
 def run(args) -> int:
+    """Run ``weakgrid gamma`` with the parsed ``args``; return the exit status."""
     problem = problem_of(args)
     settings = SearchSettings(rtol=args.rtol, max_trials=args.max_trials,
                               rollout_steps=args.rollout_steps, escape_factor=args.escape_factor,

@@ -40,6 +40,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``weakgrid`` argument parser with every subcommand (the CLI reference is made from it)."""
     parser = _Parser(
         prog="weakgrid",
         description="Game-theoretic (HJI) nonlinear optimal stabilizers with a UPQC for weak "
@@ -126,6 +127,8 @@ def _sigterm(signum, frame):
 
 
 def main(argv=None) -> int:
+    """Entry point of the ``weakgrid`` command; returns the exit status (0 ok, 2 bad input,
+    3 failure during a run, 4 internal error, 130 interrupted)."""
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv
     argv = [a for a in argv if a != "--debug"]

@@ -11,6 +11,7 @@ NAME = "reproduce"
 
 
 def add_parser(sub):
+    """Add ``weakgrid reproduce`` to the subcommand parsers ``sub``; return its parser."""
     p = sub.add_parser(
         NAME, help="reproduce the paper's case studies (figures, metrics, report)",
         description="Train the HJI controllers on the design models derived from both grids, "
@@ -27,6 +28,7 @@ def add_parser(sub):
 
 
 def run(args) -> int:
+    """Run ``weakgrid reproduce`` with the parsed ``args``; return the exit status."""
     from ..study.reproduce import reproduce
 
     summary = reproduce(args.output, quick=args.quick)

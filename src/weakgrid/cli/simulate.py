@@ -10,6 +10,7 @@ NAME = "simulate"
 
 
 def add_parser(sub):
+    """Add ``weakgrid simulate`` to the subcommand parsers ``sub``; return its parser."""
     from ..study.cases import case_names
     from ..study.controllers import CONTROLLERS
 
@@ -18,10 +19,12 @@ def add_parser(sub):
         description="Build a case at a load level, attach a controller to the UPQC (or the "
                     "PQ baseline), apply the paper's three-phase fault and print the metrics.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    p.add_argument("case", choices=case_names())
-    p.add_argument("--controller", "-c", choices=CONTROLLERS, default="hji")
-    p.add_argument("--load", choices=("high", "low"), default="high")
-    p.add_argument("--upqc", choices=("conventional", "reduced"), default="conventional")
+    p.add_argument("case", choices=case_names(), help="the detailed grid to simulate")
+    p.add_argument("--controller", "-c", choices=CONTROLLERS, default="hji",
+                   help="controller of the UPQC series voltage (or the PQ baseline)")
+    p.add_argument("--load", choices=("high", "low"), default="high", help="load level of the case")
+    p.add_argument("--upqc", choices=("conventional", "reduced"), default="conventional",
+                   help="UPQC structure: with its shunt branch, or series branch fed by the GTI dc link")
     p.add_argument("--fault", nargs=2, type=nonnegative_float, metavar=("T_ON", "T_OFF"), default=None,
                    help="fault application and clearance [s] (default: the paper's)")
     p.add_argument("--t-end", type=positive_float, default=None, help="simulated time [s]")
@@ -45,6 +48,7 @@ def check_time_window(t_on: float, t_off: float, t_end: float):
 
 
 def run(args) -> int:
+    """Run ``weakgrid simulate`` with the parsed ``args``; return the exit status."""
     import pandas as pd
 
     from ..fileio import replace_atomic

@@ -16,6 +16,7 @@ NAME = "train"
 
 
 def add_parser(sub):
+    """Add ``weakgrid train`` to the subcommand parsers ``sub``; return its parser."""
     p = sub.add_parser(
         NAME, help="train the HJI controller (two-loop policy iteration)",
         description="Train the game-theoretic controller of a preset or a TOML problem file, "
@@ -38,6 +39,7 @@ def _fmt_row(cells, widths):
 
 
 def run(args) -> int:
+    """Run ``weakgrid train`` with the parsed ``args``; return the exit status."""
     problem = problem_of(args)
     settings = problem.settings
     if args.tol is not None:

@@ -19,6 +19,7 @@ NAME = "verify"
 
 
 def add_parser(sub):
+    """Add ``weakgrid verify`` to the subcommand parsers ``sub``; return its parser."""
     p = sub.add_parser(
         NAME, help="compare the controller with a grid dynamic-programming ground truth",
         description="Solve the zero-sum game of a 2-state problem on a grid (policy iteration "
@@ -40,8 +41,11 @@ def add_parser(sub):
     p.add_argument("--margin", type=nonnegative_float, nargs="+", default=[d.margin],
                    help="grid box = region enlarged by this fraction of its width per side "
                         "(one value, or one per state)")
-    p.add_argument("--interpolation", choices=("cubic", "linear"), default=d.interpolation)
-    p.add_argument("--max-iterations", type=positive_int, default=d.max_iterations)
+    p.add_argument("--interpolation", choices=("cubic", "linear"), default=d.interpolation,
+                   help="interpolation of the value residual between grid nodes (cubic: Keys' "
+                        "cubic convolution, O(h^4); linear: multilinear, O(h^2))")
+    p.add_argument("--max-iterations", type=positive_int, default=d.max_iterations,
+                   help="cap on the DP policy iterations")
     p.add_argument("--steps", type=positive_int, default=4000, help="closed-loop horizon (steps)")
     p.add_argument("--start-fraction", type=positive_float, default=0.5,
                    help="starts: corners/edge midpoints of the region shrunk by this")
@@ -56,6 +60,7 @@ def _pct(v):
 
 
 def run(args) -> int:
+    """Run ``weakgrid verify`` with the parsed ``args``; return the exit status."""
     problem = problem_of(args)
     if problem.system.n_states != 2:
         raise ParameterError("model", f"{problem.system.n_states} states",

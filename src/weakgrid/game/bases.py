@@ -263,7 +263,7 @@ def _compositions(k: int, n: int):
 
 
 def paper_basis() -> PolynomialBasis:
-    """The paper's 8-term basis, ``[ϕ̂⁴, ϕ̂³υ, ϕ̂²υ², ϕ̂², ϕ̂υ³, ϕ̂υ, υ⁴, υ²]`` (SPEC §3)."""
+    """The paper's 8-term basis, ``[ϕ̂⁴, ϕ̂³υ, ϕ̂²υ², ϕ̂², ϕ̂υ³, ϕ̂υ, υ⁴, υ²]`` (docs/theory.md, (25))."""
     return from_generator(2, powers=(2, 4), name="paper: (x1+x2)^2 + (x1+x2)^4")
 
 

@@ -1,7 +1,7 @@
-"""The trained game controller: the saddle point (u*, w*) of SPEC §2, J and ∇J, and its file.
+"""The trained game controller: the saddle point (u*, w*) of (23)–(24), J and ∇J, and its file.
 
 At a state ``x`` the deployed control and worst-case disturbance are the joint
-solution of the block system (SPEC §2, from (23)–(24))
+solution of the block system (from (23)–(24); docs/theory.md, "The saddle point")::
 
     [[Yu, g'∇²J h], [h'∇²J g, Yw]] · [u; w] = −[g'(∇J + ∇²J(f − x)); h'(∇J + ∇²J(f − x))]
 

@@ -1,7 +1,7 @@
 """Code generation: a dependency-free C99 saddle point ``(u*, w*)`` of a trained controller.
 
 The generated function evaluates, at one state ``x``, exactly what
-:meth:`~weakgrid.game.controller.GameController.saddle_point` does (SPEC §2):
+:meth:`~weakgrid.game.controller.GameController.saddle_point` does (the joint block system of (23)–(24), docs/theory.md, "The saddle point")::
 
     ∇J, ∇²J  of  J = W'σ(x)            (polynomial, weights and exponents inlined)
     f, g, h  of the model               (model constants inlined)
@@ -193,7 +193,7 @@ extern "C" {{
 #define {up}_N_CONTROLS {m}
 #define {up}_N_DISTURBANCES {q}
 
-/* Control u* and worst-case disturbance w* at state x (SPEC §2, joint block system).
+/* Control u* and worst-case disturbance w* at state x (the paper's (23)-(24) solved jointly as one block system).
  * Returns 0, or -1 if the block system is singular at x (outputs then undefined). */
 int {name}_saddle(const double x[{n}], double u[{m}], double w[{q}]);
 

@@ -2,7 +2,7 @@
 
 The cost is approximated by ``J(x) = W'σ(x)`` and the weights are fitted by
 weighted residuals on a mesh of the training region Ω (27)–(28). The outer loop
-updates the control by (24), the inner loop the disturbance by (23):
+updates the control by (24), the inner loop the disturbance by (23)::
 
     u⁽⁰⁾ = an initial stabilizing policy;  i = 0
     repeat (outer):
@@ -16,7 +16,7 @@ Everything that does not change across iterations (f, g, h and the basis
 derivatives at the mesh) is evaluated once. Each fit solves the least-squares
 problem by a QR factorization of the regression matrix with normalized columns
 (for a monomial basis, scaling the states is a diagonal column scaling, so the
-normalization subsumes it); the normal equations are never formed (SPEC §3).
+normalization subsumes it); the normal equations are never formed (docs/theory.md, "Two-loop policy iteration").
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 For ``x+ = A x + B u + E w`` and the cost ``Σ x'Qx + u'Ru − γ² w'Pw`` the value is
 ``J(x) = x'Sx`` with ``S`` the stabilizing solution of the discrete game Riccati
-equation (SPEC §2)
+equation (docs/theory.md, "The LQ game")
 
     S = Q + A'SA − A'SB̃ (R̃ + B̃'SB̃)⁻¹ B̃'SA,   B̃ = [B E],  R̃ = blkdiag(R, −γ²P)
 

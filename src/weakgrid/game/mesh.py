@@ -136,6 +136,8 @@ class PointMesh:
 
 
 def mesh_from_dict(d: dict):
+    """The mesh of a ``to_dict()`` record: ``{"kind": "grid", lower, upper, step}`` or
+    ``{"kind": "points", points}`` (:class:`GridMesh` or :class:`PointMesh`)."""
     if d.get("kind") == "grid":
         return GridMesh(d["lower"], d["upper"], d["step"])
     if d.get("kind") == "points":

@@ -29,6 +29,8 @@ def register_system(kind: str, factory: Callable[[dict], "ControlAffineSystem"])
 
 
 def system_from_dict(d: dict) -> "ControlAffineSystem":
+    """The system of a ``to_dict()`` record, built by the factory registered for ``d["kind"]``
+    (see :func:`register_system`)."""
     kind = d.get("kind")
     if kind not in _REGISTRY:
         raise ParameterError(

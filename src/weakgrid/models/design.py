@@ -50,7 +50,7 @@ class UPQCDesignModel(ControlAffineSystem):
     Vr_bar : float
         Known part of the shunt-bus voltage magnitude, pu.
     phi_s0 : float
-        Equilibrium angle of the source w.r.t. the UPQC shunt bus, rad (|ϕs0| < π/2).
+        Equilibrium angle of the source w.r.t. the UPQC shunt bus, rad (``|ϕs0| < π/2``).
     machine : {"gti", "sg"}
         What the states describe (GTI phase / dc-link energy, or SG angle / speed).
     upqc : {"conventional", "reduced"}

@@ -236,7 +236,7 @@ class TrainingProblem:
     source: str = ""
 
     def train(self, settings: SolverSettings | None = None, progress=None) -> GameController:
-        """Run the two-loop policy iteration (SPEC §3)."""
+        """Run the two-loop policy iteration (docs/theory.md, (25)–(28))."""
         extra = {"name": self.name, "source": self.source}
         if self.published:
             extra["published"] = self.published

@@ -88,8 +88,8 @@ def scatter_add(a, idx, v, unique):
 class Component:
     """Base class of a vectorized component type.
 
-    Class attributes to define in subclasses
-    ----------------------------------------
+    Attributes
+    ----------
     kind : str
         ``"machine"``, ``"pss"``, ``"exciter"``, ``"governor"`` or ``"device"``.
     order : int

@@ -1,4 +1,4 @@
-"""The paper's claims (SPEC §4), each with the measurement that judges it.
+"""The paper's claims (Section V), each with the measurement that judges it.
 
 A claim's ``judge(m)`` receives ``{scenario id: metrics}`` and returns
 ``(verdict, measured text)`` with verdict ``reproduced`` / ``partly`` / ``not`` /
@@ -197,6 +197,11 @@ CLAIMS = [
 
 
 def judge_all(metrics_by_id: dict) -> list[dict]:
+    """Judge every claim of :data:`CLAIMS` on ``{scenario id: metrics}``.
+
+    Returns one dict per claim: ``id``, ``case``, ``paper`` (the claim), ``rule``,
+    ``verdict`` and ``measured`` (the numbers behind the verdict).
+    """
     out = []
     for c in CLAIMS:
         verdict, measured = c.judge(metrics_by_id)

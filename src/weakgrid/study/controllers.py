@@ -1,17 +1,17 @@
 """The controllers the paper compares, built for a case's design model.
 
-=============  ===============================================================
-name           what
-=============  ===============================================================
-``hji``        the game-theoretic controller (24)/(23) trained on the design model
-               derived from the grid's operating point, with the paper's settings
+================  ===============================================================
+name              what
+================  ===============================================================
+``hji``           the game-theoretic controller (24)/(23) trained on the design model
+                  derived from the grid's operating point, with the paper's settings
 ``nonlinear-29``  the paper's initial nonlinear controller (29) (case 1)
-``lqr``        discrete LQR of the design model's linearization (case 2's
-               initial policy), Q = 0.01·I, R = I
-``pq``         conventional PQ control of the GTI (PID, paper's gains), no UPQC (case 1)
-``pss-only``   UPQC idle (u = 0): the SG's PSS and governor alone
-``none``       UPQC idle and the PSS out of service: no supplementary control
-=============  ===============================================================
+``lqr``           discrete LQR of the design model's linearization (case 2's
+                  initial policy), Q = 0.01·I, R = I
+``pq``            conventional PQ control of the GTI (PID, paper's gains), no UPQC (case 1)
+``pss-only``      UPQC idle (u = 0): the SG's PSS and governor alone
+``none``          UPQC idle and the PSS out of service: no supplementary control
+================  ===============================================================
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Performance metrics of a simulated response (issue: case studies).
+"""Performance metrics of a simulated response (the tables of ``weakgrid reproduce``).
 
 All functions take sampled signals ``(t, y)`` with ``t`` in seconds. A response
 is measured from ``t_start`` (e.g. the fault clearance) against its final value

@@ -30,6 +30,7 @@ COLUMNS = [
 
 
 def metrics_frame(metrics: list[dict]) -> pd.DataFrame:
+    """A table of run metrics, one row per run, the report's columns first (missing ones NaN)."""
     df = pd.DataFrame(metrics)
     for key, _ in COLUMNS:
         if key not in df:

@@ -72,6 +72,7 @@ def paper_scenarios(quick: bool = False) -> list[Scenario]:
 
 
 def scenario_by_id(sid: str, quick: bool = False) -> Scenario:
+    """The scenario of :func:`paper_scenarios` with id ``sid``; a clear error if there is none."""
     for s in paper_scenarios(quick):
         if s.id == sid:
             return s

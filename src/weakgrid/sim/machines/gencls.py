@@ -33,8 +33,9 @@ def solve_stator(psi2d, psi2q, vd, vq, ra, xd2, xq2):
 class GENCLS(SyncMachine):
     """Classical machine model (PSS/E and ANDES ``GENCLS``).
 
-    Parameters (machine base unless stated)
-    ----------------------------------------
+    Notes
+    -----
+    Parameters, on the machine base unless stated:
     Sn [MVA], Vn [kV], fn [Hz], M = 2H [s], D [pu], ra [pu], xd1 = x'd [pu].
     """
 

@@ -36,8 +36,9 @@ from .shaft import swing
 class GENROU(SyncMachine):
     """Round-rotor synchronous machine with quadratic saturation.
 
-    Parameters (machine base unless stated)
-    ----------------------------------------
+    Notes
+    -----
+    Parameters, on the machine base unless stated:
     Sn, Vn, fn, M, D, ra, xd1 as in :class:`~weakgrid.sim.machines.gencls.GENCLS`;
     xl, xd, xq, xd2, xq1, xq2 [pu]; Td10, Td20, Tq10, Tq20 [s]; S10, S12 [pu].
     """

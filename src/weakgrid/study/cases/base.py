@@ -91,6 +91,7 @@ class CaseBuild:
 
 
 def case_names() -> list[str]:
+    """Names of the registered cases (keys of :data:`CASES`)."""
     return list(CASES)
 
 

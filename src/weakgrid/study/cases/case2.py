@@ -13,7 +13,7 @@ residential feeder (islanded at the open MV/LV transformer), with
 Design model (10), Remark 5, from the power-flow operating point of the built system. In the
 simulator's UPQC (``weakgrid.sim.upqc``) the series voltage is added at the r-end of the
 branch: ``I = (Vr + Vu − V1)/Zu``. Hence the SG's internal voltage E' (behind x'd) sees the
-point ``Vr + Vu`` through ``x'd + Xu``:
+point ``Vr + Vu`` through ``x'd + Xu``::
 
     B = 1/(x'd + Xu),  V̄r = |Vr|,  ϕs0 = ∠E' − ∠Vr,  a = E'·B/M,  M = 2H/ωs (system base).
 
@@ -45,7 +45,7 @@ def load_data() -> dict:
 
 
 def _preset_model():
-    """The calibrated ``case2-paper`` design model (SPEC §4), for comparison in ``info``."""
+    """The calibrated ``case2-paper`` design model (docs/findings.md), for comparison in ``info``."""
     from ...models import UPQCDesignModel
 
     path = resources.files("weakgrid") / "data" / "presets" / "case2-paper.toml"
