@@ -47,6 +47,14 @@ Design choices (and why)
   unbounded: γ too small there) and the Schur complement in ``u`` ``≻ 0`` — and
   nodes that fail keep their policy (counted as ``n_bad_inertia``).
 
+* **Input bound** (a cost with :class:`~weakgrid.game.input_bound.InputBound`): the
+  stage cost charges ``W(u)`` and the controls stay in the bound. The finite-difference
+  model is then of ``ψ − W`` (smooth, defined for any u) and ``∇W``, ``∇²W`` are added
+  exactly; Newton steps in u stop at 90 % of the way to the boundary (W's gradient
+  is infinite there, so the minimizer is inside). The initial policies are mapped
+  into the bound by ``ū·tanh(·/ū)``; the interpolated grid policy of
+  :meth:`DPSolution.saddle_point` is a convex combination of admissible nodes.
+
 Everything is vectorized over the nodes (NumPy/SciPy; no Python loop per node).
 """
 
@@ -304,12 +312,16 @@ def _interp_weights(axes, X, cubic=True):
     return W, idx
 
 
-def _lift(system, cost, X, Z, k):
-    """``Φ_k`` and ``ℓ_k`` for states (p, n) and held inputs (p, m+q)."""
+def _lift(system, cost, X, Z, k, control_penalty=True):
+    """``Φ_k`` and ``ℓ_k`` for states (p, n) and held inputs (p, m+q).
+
+    ``control_penalty=False`` leaves ``u'Ru`` (or ``W(u)``) out of ``ℓ_k``.
+    """
     m = system.n_controls
     U, Wd = Z[:, :m], Z[:, m:]
-    inputs = (np.einsum("pi,ij,pj->p", U, cost.R, U)
-              - cost.gamma**2 * np.einsum("pi,ij,pj->p", Wd, cost.P, Wd))
+    inputs = -cost.gamma**2 * np.einsum("pi,ij,pj->p", Wd, cost.P, Wd)
+    if control_penalty:
+        inputs = inputs + cost.control_penalty(U)
     x = X
     ell = np.zeros(X.shape[0])
     for _ in range(k):
@@ -335,8 +347,8 @@ class _Grid:
         W, idx = _interp_weights(self.axes, Y, self.cubic)
         return self.quad(Y) + (W * r[idx]).sum(1)
 
-    def psi(self, X, Z, r):
-        Y, ell = _lift(self.system, self.cost, X, Z, self.k)
+    def psi(self, X, Z, r, control_penalty=True):
+        Y, ell = _lift(self.system, self.cost, X, Z, self.k, control_penalty)
         if not np.all(np.isfinite(Y)):
             Y = np.where(np.isfinite(Y), Y, 1e300)
         return ell + self.V(Y, r)
@@ -383,10 +395,11 @@ class _Grid:
                 offs.append(e)
         offs = np.array(offs)  # (S, K)
         n_bad = 0
+        bound, R = self.cost.bound, self.cost.R
         for _ in range(newton_steps):
             Zs = Z[None] + offs[:, None, :] * delta[None]  # (S, N, K)
-            vals = self.psi(np.tile(X, (len(offs), 1)), Zs.reshape(-1, K), r).reshape(
-                len(offs), N)
+            vals = self.psi(np.tile(X, (len(offs), 1)), Zs.reshape(-1, K), r,
+                            control_penalty=bound is None).reshape(len(offs), N)
             f0 = vals[0]
             g = np.empty((N, K))
             H = np.empty((N, K, K))
@@ -399,6 +412,9 @@ class _Grid:
                 v = vals[base + 4 * p_: base + 4 * p_ + 4]
                 H[:, a, b] = H[:, b, a] = (v[0] - v[1] - v[2] + v[3]) / (
                     4 * delta[:, a] * delta[:, b])
+            if bound is not None:  # ψ = (ψ − W) + W: W's derivatives exactly
+                g[:, :m] += bound.penalty_gradient(Z[:, :m], R)
+                H[:, :m, :m] += bound.penalty_hessian(Z[:, :m], R)
             ok = np.all(np.isfinite(H), axis=(1, 2)) & np.all(np.isfinite(g), axis=1)
             Hww = H[:, m:, m:]
             ok &= np.linalg.eigvalsh(np.where(ok[:, None, None], Hww, -1.0))[:, -1] < 0
@@ -410,7 +426,11 @@ class _Grid:
             step = -np.linalg.solve(np.where(ok[:, None, None], H, np.eye(K)),
                                     np.where(ok[:, None], g, 0.0)[..., None])[..., 0]
             step = np.clip(step, -4 * delta, 4 * delta)  # trust region: 2 cells
-            Z = Z + np.where(ok[:, None], step, 0.0)
+            step = np.where(ok[:, None], step, 0.0)
+            if bound is not None:  # fraction to the boundary: stay inside the bound
+                amax = bound._max_step(Z[:, :m], step[:, :m])
+                step[:, :m] *= np.where(amax > 1.0 / 0.9, 1.0, 0.9 * amax)[:, None]
+            Z = Z + step
         Z[self.origin] = 0.0
         return Z, n_bad
 
@@ -482,6 +502,9 @@ def solve_game_dp(system, cost, lower, upper, settings: DPSettings | None = None
     except GammaTooSmallError:
         bias = float("nan")
     Z = -X @ KL.T  # the lifted linearization's saddle policies
+    if cost.bound is not None:
+        Z[:, :system.n_controls] = cost.bound._interior(cost.bound.squash(
+            Z[:, :system.n_controls]))
     history = []
     r = grid.evaluate(Z)
     Vold = grid.quad(X) + r
