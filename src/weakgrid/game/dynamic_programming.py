@@ -49,9 +49,10 @@ Design choices (and why)
 
 * **Input bound** (a cost with :class:`~weakgrid.game.input_bound.InputBound`): the
   stage cost charges ``W(u)`` and the controls stay in the bound. The finite-difference
-  model is then of ``ψ − W`` (smooth, defined for any u) and ``∇W``, ``∇²W`` are added
-  exactly; Newton steps in u stop at 90 % of the way to the boundary (W's gradient
-  is infinite there, so the minimizer is inside). The initial policies are mapped
+  model is then of ``ψ − W`` (smooth, defined for any u); w is eliminated from it and
+  the reduced ``½u'Mu + b'u + W(u)`` is minimized exactly over the bound by the
+  same bounded minimizer as the controller (a Newton step in u against W's barrier
+  would crawl away from the boundary). The initial policies are mapped
   into the bound by ``ū·tanh(·/ū)``; the interpolated grid policy of
   :meth:`DPSolution.saddle_point` is a convex combination of admissible nodes.
 
@@ -412,9 +413,9 @@ class _Grid:
                 v = vals[base + 4 * p_: base + 4 * p_ + 4]
                 H[:, a, b] = H[:, b, a] = (v[0] - v[1] - v[2] + v[3]) / (
                     4 * delta[:, a] * delta[:, b])
-            if bound is not None:  # ψ = (ψ − W) + W: W's derivatives exactly
-                g[:, :m] += bound.penalty_gradient(Z[:, :m], R)
-                H[:, :m, :m] += bound.penalty_hessian(Z[:, :m], R)
+            if bound is not None:
+                Z, n_bad = self._bounded_step(Z, g, H, delta, m)
+                continue
             ok = np.all(np.isfinite(H), axis=(1, 2)) & np.all(np.isfinite(g), axis=1)
             Hww = H[:, m:, m:]
             ok &= np.linalg.eigvalsh(np.where(ok[:, None, None], Hww, -1.0))[:, -1] < 0
@@ -426,14 +427,45 @@ class _Grid:
             step = -np.linalg.solve(np.where(ok[:, None, None], H, np.eye(K)),
                                     np.where(ok[:, None], g, 0.0)[..., None])[..., 0]
             step = np.clip(step, -4 * delta, 4 * delta)  # trust region: 2 cells
-            step = np.where(ok[:, None], step, 0.0)
-            if bound is not None:  # fraction to the boundary: stay inside the bound
-                amax = bound._max_step(Z[:, :m], step[:, :m])
-                step[:, :m] *= np.where(amax > 1.0 / 0.9, 1.0, 0.9 * amax)[:, None]
-            Z = Z + step
+            Z = Z + np.where(ok[:, None], step, 0.0)
         Z[self.origin] = 0.0
         return Z, n_bad
 
+
+    def _bounded_step(self, Z, g, H, delta, m):
+        """Saddle point of (quadratic model of ψ − W) + W(u) over the bound, per node.
+
+        ``g``, ``H`` model ``ψ − W`` about ``Z`` (finite differences). w is eliminated
+        (``Hww ≺ 0``) and the reduced ``½u'Mu + b'u + W(u)`` is minimized exactly by
+        :meth:`InputBound.minimize` (needs ``M + 2R ≻ 0``): the step may leave the
+        boundary region in one go, unlike a Newton step in u against W's barrier.
+        """
+        bound, R = self.cost.bound, self.cost.R
+        N, K = Z.shape
+        ok = np.all(np.isfinite(H), axis=(1, 2)) & np.all(np.isfinite(g), axis=1)
+        Hs = np.where(ok[:, None, None], H, np.eye(K) * np.r_[np.ones(m), -np.ones(K - m)])
+        gs = np.where(ok[:, None], g, 0.0)
+        Hww, Hwu = Hs[:, m:, m:], Hs[:, m:, :m]
+        ok &= np.linalg.eigvalsh(Hww)[:, -1] < 0
+        Hww = np.where(ok[:, None, None], Hww, -np.eye(K - m))
+        Xs = np.linalg.solve(Hww, np.concatenate([Hwu, gs[:, m:, None]], -1))
+        Xu, Xg = Xs[..., :m], Xs[..., m]
+        M = Hs[:, :m, :m] - np.swapaxes(Hwu, 1, 2) @ Xu
+        M = 0.5 * (M + np.swapaxes(M, 1, 2))
+        ok &= np.linalg.eigvalsh(M + 2.0 * R)[:, 0] > 0
+        M = np.where(ok[:, None, None], M, 0.0)
+        u0 = Z[:, :m]
+        gh = gs[:, :m] - np.einsum("pwu,pw->pu", Hwu, Xg)
+        b = gh - np.einsum("pij,pj->pi", M, u0)
+        u_new = bound.minimize(M, b, R)
+        du = u_new - u0
+        # trust region (2 cells) by scaling the whole u step: stays on the segment, inside
+        lim = np.min(4 * delta[:, :m] / np.maximum(np.abs(du), 1e-300), axis=1)
+        du *= np.minimum(1.0, lim)[:, None]
+        dw = -(Xg + np.einsum("pwu,pu->pw", Xu, du))
+        dw = np.clip(dw, -4 * delta[:, m:], 4 * delta[:, m:])
+        step = np.where(ok[:, None], np.concatenate([du, dw], 1), 0.0)
+        return Z + step, int((~ok).sum())
 
 def solve_game_dp(system, cost, lower, upper, settings: DPSettings | None = None, *,
                   progress=None) -> DPSolution:
