@@ -6,14 +6,20 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 from scipy.special import xlogy
+from test_export import c_saddle, compile_controller, needs_cc
 
-from weakgrid.game import GameCost, GridMesh, LinearPolicy, LinearSystem, dlqr, even_monomials
-from weakgrid.game import solve_hji
+from weakgrid.game import (
+    GameCost,
+    GridMesh,
+    LinearPolicy,
+    LinearSystem,
+    dlqr,
+    even_monomials,
+    solve_hji,
+)
 from weakgrid.game.controller import controller_from_dict
 from weakgrid.game.export_json import describe_controller
 from weakgrid.game.input_bound import InputBound
-
-from test_export import c_saddle, compile_controller, needs_cc
 
 
 @pytest.fixture(scope="module")
@@ -85,7 +91,9 @@ def _bounded_from_json(d, X):
     r_ = np.diag(R)
 
     def Wpen(u):
-        psi = lambda q: 0.5 * (xlogy(1 + q, 1 + q) + xlogy(1 - q, 1 - q))  # noqa: E731
+        def psi(q):
+            return 0.5 * (xlogy(1 + q, 1 + q) + xlogy(1 - q, 1 - q))
+
         if shape == "box":
             return float(np.sum(2 * r_ * lim**2 * psi(np.abs(u) / lim)))
         return float(2 * r_[0] * lim[0] ** 2 * psi(np.linalg.norm(u) / lim[0]))
@@ -116,17 +124,21 @@ def _bounded_from_json(d, X):
         Xr = np.linalg.solve(Yw, H.T @ r)
         M = G.T @ hess @ G - G.T @ hess @ H @ Xg
         b = G.T @ r - G.T @ hess @ H @ Xr
-        F = lambda u: 0.5 * u @ M @ u + b @ u + Wpen(u)  # noqa: E731
+        def F(u, M=M, b=b):
+            return 0.5 * u @ M @ u + b @ u + Wpen(u)
+
         opts = {"ftol": 1e-15, "gtol": 1e-13, "maxiter": 2000}
         if shape == "box":  # bounded quasi-Newton directly in u
             u = minimize(F, np.zeros(2), method="L-BFGS-B", options=opts,
                          bounds=[(-v * (1 - 1e-15), v * (1 - 1e-15)) for v in lim]).x
         else:  # polar coordinates, radius bounded
             th0 = np.arctan2(-b[1], -b[0])
-            pol = lambda z: np.array([z[0] * np.cos(z[1]), z[0] * np.sin(z[1])])  # noqa: E731
-            z = minimize(lambda z: F(pol(z)), [0.5 * lim[0], th0], method="L-BFGS-B",
+            def Fp(z, F=F):
+                return F(np.array([z[0] * np.cos(z[1]), z[0] * np.sin(z[1])]))
+
+            z = minimize(Fp, [0.5 * lim[0], th0], method="L-BFGS-B",
                          options=opts, bounds=[(0, lim[0] * (1 - 1e-15)), (None, None)]).x
-            u = pol(z)
+            u = np.array([z[0] * np.cos(z[1]), z[0] * np.sin(z[1])])
         out.append(np.concatenate([u, -(Xr + Xg @ u)]))
     return np.array(out)
 

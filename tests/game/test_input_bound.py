@@ -7,8 +7,14 @@ from hypothesis import strategies as st
 from scipy.integrate import quad
 
 from weakgrid.game import (
-    GameController, GameCost, GridMesh, LinearPolicy, LinearSystem, ParameterError,
-    even_monomials, solve_game_riccati, solve_hji,
+    GameCost,
+    GridMesh,
+    LinearPolicy,
+    LinearSystem,
+    ParameterError,
+    even_monomials,
+    solve_game_riccati,
+    solve_hji,
 )
 from weakgrid.game.controller import controller_from_dict
 from weakgrid.game.dynamic_programming import DPSettings, solve_game_dp
@@ -94,9 +100,9 @@ def test_bounded_minimizer_is_inside_and_optimal(shape, seed, log_b, ubar):
 
 def test_bound_settings_are_checked():
     s = LinearSystem(np.eye(2), np.eye(2), np.ones((2, 1)))
-    for kw, field in ((dict(bound=-1.0), "u_bound"), (dict(bound=0.1, bound_shape="ring"),
-                                                     "u_bound_shape"),
-                      (dict(bound=[0.1, 0.2, 0.3], bound_shape="box"), "u_bound")):
+    for kw, field in (({"bound": -1.0}, "u_bound"),
+                      ({"bound": 0.1, "bound_shape": "ring"}, "u_bound_shape"),
+                      ({"bound": [0.1, 0.2, 0.3], "bound_shape": "box"}, "u_bound")):
         with pytest.raises(ParameterError, match=field):
             GameCost.for_system(s, 1.0, 1.0, 1.0, 2.0, **kw)
     with pytest.raises(ParameterError, match="R"):  # the disk needs R = r·I
@@ -122,7 +128,7 @@ def case1_bounded():
 @settings(max_examples=200, deadline=None)
 @given(st.sampled_from(["disk", "box"]), st.floats(-1, 1), st.floats(-10, 10))
 def test_no_policy_exceeds_the_bound_on_omega(case1_bounded, shape, phi, ups):
-    ctl, p = case1_bounded[shape]
+    ctl, _ = case1_bounded[shape]
     x = np.array([[phi, ups]])
     assert ctl.cost.bound.ratio(ctl.control(x))[0] <= 1.0
 

@@ -396,7 +396,7 @@ class _Grid:
                 offs.append(e)
         offs = np.array(offs)  # (S, K)
         n_bad = 0
-        bound, R = self.cost.bound, self.cost.R
+        bound = self.cost.bound
         for _ in range(newton_steps):
             Zs = Z[None] + offs[:, None, :] * delta[None]  # (S, N, K)
             vals = self.psi(np.tile(X, (len(offs), 1)), Zs.reshape(-1, K), r,
@@ -441,7 +441,7 @@ class _Grid:
         boundary region in one go, unlike a Newton step in u against W's barrier.
         """
         bound, R = self.cost.bound, self.cost.R
-        N, K = Z.shape
+        K = Z.shape[1]
         ok = np.all(np.isfinite(H), axis=(1, 2)) & np.all(np.isfinite(g), axis=1)
         Hs = np.where(ok[:, None, None], H, np.eye(K) * np.r_[np.ones(m), -np.ones(K - m)])
         gs = np.where(ok[:, None], g, 0.0)

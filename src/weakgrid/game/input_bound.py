@@ -39,7 +39,7 @@ import numpy as np
 
 from .errors import ParameterError
 
-__all__ = ["InputBound", "SHAPES"]
+__all__ = ["SHAPES", "InputBound"]
 
 SHAPES = ("box", "disk")
 _SMALL = 0.1  # below this ρ the series are used (10 terms reach rounding)
@@ -108,7 +108,7 @@ class InputBound:
     limit: np.ndarray
 
     @classmethod
-    def for_inputs(cls, m: int, limit, shape: str = "disk") -> "InputBound":
+    def for_inputs(cls, m: int, limit, shape: str = "disk") -> InputBound:
         """Check and build a bound for ``m`` inputs (a scalar box limit applies to each)."""
         if shape not in SHAPES:
             raise ParameterError("cost.u_bound_shape", shape, "use 'disk' (‖u‖ ≤ ū) or 'box' "
@@ -361,7 +361,7 @@ class InputBound:
         return {"shape": self.shape, "limit": self.limit.tolist()}
 
     @classmethod
-    def from_dict(cls, d: dict, m: int | None = None) -> "InputBound":
+    def from_dict(cls, d: dict, m: int | None = None) -> InputBound:
         lim = np.asarray(d["limit"], float)
         return cls.for_inputs(m if m is not None else lim.size, lim, d["shape"])
 
