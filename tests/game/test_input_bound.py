@@ -231,3 +231,17 @@ def test_unbounded_controller_is_not_the_bounded_optimum(linear_bounded):
     s, c = linear_cost(0.2)
     dp = solve_game_dp(s, c, LO, HI, DPSettings(n_points=(41, 41), margin=0.5))
     assert value_error(free, dp, LO, HI)["sup_error_over_max_V"] > 0.05
+
+
+def test_radial_diagnostic_flags_the_ridge_of_the_bounded_case1_cost(case1_bounded):
+    """With the paper's basis the bounded J of case 1 has a ridge at |ϕ̂| ≈ 1.03 (just past Ω):
+    the diagnostic sees it, and the closed loop from ϕ̂ = 1 crosses it and diverges."""
+    from weakgrid.game.rollout import rollout
+    from weakgrid.models import load_preset
+
+    ctl, p = case1_bounded["disk"]
+    assert ctl.diagnostics(1.25 * p.mesh.points)["n_radial_decrease"] > 0
+    assert load_preset("case1-paper").train().diagnostics(
+        1.25 * p.mesh.points)["n_radial_decrease"] == 0
+    r = rollout(p.system, ctl.control, [[1.0, 0.0]], 3000, bound=1e3)
+    assert r.diverged[0]

@@ -113,6 +113,11 @@ def run(args) -> int:
               f"point of this J lies outside; up to {b['max_unbounded_ratio']:.3g}× the "
               f"bound); u* uses ≥ 90 % of it on {100 * b['fraction_saturated']:.1f} %; "
               f"max ‖u*‖/ū = {b['max_ratio']:.6f}")
+    wide = ctl.diagnostics(1.25 * problem.mesh.points)["n_radial_decrease"]
+    print(f"    J grows along rays from 0 (x·∇J > 0) on the mesh and on it scaled ×1.25: "
+          f"{'ok' if d['n_radial_decrease'] == 0 and wide == 0 else 'NO'} "
+          f"({d['n_radial_decrease']} and {wide} points fail; past such a ridge u* drives the "
+          "state away)")
     rho = closed_loop_spectral_radius(problem.system, ctl.control)
     print(f"    closed loop under u* linearized at 0: spectral radius {rho:.6f} "
           f"({'stable' if rho < 1 else 'UNSTABLE'})")

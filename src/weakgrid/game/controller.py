@@ -184,10 +184,13 @@ class GameController:
         """The conditions of the method at states ``x`` (e.g. the mesh): Yu ≻ 0, Yw ≺ 0, J ≥ 0."""
         eu, ew = self.block_eigenvalues(x)
         J = self.value(x)
+        xa = np.asarray(x, float)
+        radial = np.einsum("...n,...n->...", xa, self.gradient(xa))  # x·∇J: J grows outward
         d = {"min_eig_Yu": float(eu.min()), "max_eig_Yw": float(ew.max()),
-             "min_J": float(J.min()), "n_points": int(np.asarray(x).shape[0]),
+             "min_J": float(J.min()), "n_points": int(xa.shape[0]),
              "n_bad_Yu": int((eu <= 0).sum()), "n_bad_Yw": int((ew >= 0).sum()),
-             "n_negative_J": int((J < 0).sum())}
+             "n_negative_J": int((J < 0).sum()),
+             "n_radial_decrease": int(((radial <= 0) & (np.abs(xa).sum(-1) > 0)).sum())}
         if self.cost.bound is not None:
             d["bound"] = self.bound_activity(x)
         return d
