@@ -5,6 +5,10 @@ evaluates f, g, h and the basis derivatives at the mesh again, forms the regress
 rows with ``einsum`` over the mesh, and solves the least-squares problem with
 ``numpy.linalg.lstsq`` (SVD, normal-equation-free). Both must give the same weights.
 
+Then the constrained-input problem (beyond the paper): ``case1-paper`` with the UPQC
+rating 0.15 pu as a disk bound ‖u‖ ≤ ū (and as a box), timed beside the unconstrained
+``case1-paper`` in the same run.
+
 Run:  python benchmarks/bench_train.py [--repeat N]
 """
 
@@ -85,6 +89,21 @@ def main():
         print(f"{name:14s} {t_fast * 1e3:14.1f} {t_plain * 1e3:17.1f} {t_plain / t_fast:6.1f}× "
               f"{ctl.iterations['outer']:6d} {dW:10.2e}")
         assert outer_b == ctl.iterations["outer"], "baseline and weakgrid iterate differently"
+
+    print(f"\n{'constrained':32s} {'weakgrid [ms]':>14s} {'vs unconstrained':>17s} "
+          f"{'outer':>6s} {'binds on Ω':>11s}")
+    p = load_preset("case1-paper")
+    t_free = median_time(p.train, args.repeat)
+    print(f"{'case1-paper (no bound)':32s} {t_free * 1e3:14.1f} {1.0:16.2f}× "
+          f"{p.train().iterations['outer']:6d} {'':>11s}")
+    for shape in ("disk", "box"):
+        pb = p.with_input_bound(0.15, shape)
+        ctl = pb.train()
+        t_b = median_time(pb.train, args.repeat)
+        act = ctl.bound_activity(pb.mesh.points)["fraction_binding"]
+        label = f"case1-paper {ctl.cost.bound.describe()}"
+        print(f"{label:32s} {t_b * 1e3:14.1f} {t_b / t_free:16.2f}× "
+              f"{ctl.iterations['outer']:6d} {100 * act:10.1f} %")
 
 
 if __name__ == "__main__":

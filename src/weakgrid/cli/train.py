@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..game.hji import closed_loop_spectral_radius
+from ..game.errors import ParameterError
 from ._common import (add_force_argument, add_problem_arguments, guard_training, output_file,
                       positive_float, problem_of)
 
@@ -28,6 +29,11 @@ def add_parser(sub):
                    help="controller file to write (default: NAME.controller.json)")
     p.add_argument("--tol", type=positive_float, default=None,
                    help="δu = δw (default: the problem's [solver] values)")
+    p.add_argument("--u-bound", type=positive_float, nargs="+", default=None, metavar="UBAR",
+                   help="bound the control (beyond the paper): ‖u‖ ≤ UBAR (disk) or "
+                        "|u_i| ≤ UBAR_i (box), replacing the problem's [cost] u_bound")
+    p.add_argument("--u-bound-shape", choices=("disk", "box"), default=None,
+                   help="shape of --u-bound (default: the problem's, else disk)")
     p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
     add_force_argument(p)
     p.set_defaults(func=run)
@@ -41,6 +47,15 @@ def _fmt_row(cells, widths):
 def run(args) -> int:
     """Run ``weakgrid train`` with the parsed ``args``; return the exit status."""
     problem = problem_of(args)
+    if args.u_bound is not None:
+        problem = problem.with_input_bound(
+            args.u_bound[0] if len(args.u_bound) == 1 else args.u_bound, args.u_bound_shape)
+    elif args.u_bound_shape is not None:
+        if problem.input_bound is None:
+            raise ParameterError("--u-bound-shape", args.u_bound_shape,
+                                 "give the bound too (--u-bound UBAR)")
+        problem = problem.with_input_bound(problem.input_bound.limit.tolist(),
+                                           args.u_bound_shape)
     settings = problem.settings
     if args.tol is not None:
         from dataclasses import replace
@@ -51,6 +66,9 @@ def run(args) -> int:
     c = problem.cost
     print(f"  cost    Q = {np.diag(c.Q).tolist()}, R = {np.diag(c.R).tolist()}, "
           f"P = {np.diag(c.P).tolist()}, gamma = {c.gamma:g}")
+    if c.bound is not None:
+        print(f"  bound   {c.bound.describe()} ({c.bound.shape}; non-quadratic penalty "
+              "W(u) in place of u'Ru)")
     mesh_n = problem.mesh.points.shape[0]
     print(f"  mesh    {list(problem.mesh.lower)} .. {list(problem.mesh.upper)} step "
           f"{list(problem.mesh.step)}  ({mesh_n} points);  basis {problem.basis.size} terms")
@@ -58,7 +76,7 @@ def run(args) -> int:
     guard_training(problem, args.force)
     if not args.quiet:
         print("\n  outer  inner    max|Δu|     max|Δw| (last)   residual    min J     "
-              "max eig Yw  min eig Yu")
+              "max eig Yw  min eig Yu" + ("  bound binds" if c.bound is not None else ""))
 
     from tqdm.auto import tqdm
 
@@ -71,7 +89,9 @@ def run(args) -> int:
         if not args.quiet:
             tqdm.write(f"  {rec.outer:5d}  {rec.inner:5d}  {rec.max_du:10.3e}  "
                        f"{rec.max_dw[-1]:12.3e}     {rec.residual:9.2e}  {rec.min_J:9.3g}  "
-                       f"{rec.max_eig_Yw:10.3g}  {rec.min_eig_Yu:10.3g}", file=sys.stdout)
+                       f"{rec.max_eig_Yw:10.3g}  {rec.min_eig_Yu:10.3g}"
+                       + (f"  {100 * rec.bound_active:9.1f} %" if rec.bound_active is not None
+                          else ""), file=sys.stdout)
 
     try:
         ctl = problem.train(settings, progress=progress)
@@ -102,6 +122,18 @@ def run(args) -> int:
     print(f"    min eig Yu = {d['min_eig_Yu']:.4g} (> 0 {'ok' if d['min_eig_Yu'] > 0 else 'FAIL'})"
           f";  max eig Yw = {d['max_eig_Yw']:.4g} (< 0 {'ok' if d['max_eig_Yw'] < 0 else 'FAIL'})"
           f";  min J = {d['min_J']:.4g} (≥ 0 {'ok' if d['min_J'] >= 0 else 'FAIL'})")
+    if "bound" in d:
+        b = d["bound"]
+        print(f"    input bound {ctl.cost.bound.describe()}: binds on "
+              f"{100 * b['fraction_binding']:.1f} % of the mesh of Ω (the unbounded saddle "
+              f"point of this J lies outside; up to {b['max_unbounded_ratio']:.3g}× the "
+              f"bound); u* uses ≥ 90 % of it on {100 * b['fraction_saturated']:.1f} %; "
+              f"max ‖u*‖/ū = {b['max_ratio']:.6f}")
+    wide = ctl.diagnostics(1.25 * problem.mesh.points)["n_radial_decrease"]
+    print(f"    J grows along rays from 0 (x·∇J > 0) on the mesh and on it scaled ×1.25: "
+          f"{'ok' if d['n_radial_decrease'] == 0 and wide == 0 else 'NO'} "
+          f"({d['n_radial_decrease']} and {wide} points fail; past such a ridge u* drives the "
+          "state away)")
     rho = closed_loop_spectral_radius(problem.system, ctl.control)
     print(f"    closed loop under u* linearized at 0: spectral radius {rho:.6f} "
           f"({'stable' if rho < 1 else 'UNSTABLE'})")

@@ -49,6 +49,11 @@ def add_parser(sub):
     p.add_argument("--steps", type=positive_int, default=4000, help="closed-loop horizon (steps)")
     p.add_argument("--start-fraction", type=positive_float, default=0.5,
                    help="starts: corners/edge midpoints of the region shrunk by this")
+    p.add_argument("--u-bound", type=positive_float, nargs="+", default=None, metavar="UBAR",
+                   help="bound the control in the game (as `weakgrid train --u-bound`): the "
+                        "DP then optimizes over the same bounded set with the same penalty")
+    p.add_argument("--u-bound-shape", choices=("disk", "box"), default=None,
+                   help="shape of --u-bound (default: the problem's, else disk)")
     p.add_argument("--report", type=output_file(".json"), default=None, help="write the report (JSON)")
     add_force_argument(p)
     p.set_defaults(func=run)
@@ -62,6 +67,9 @@ def _pct(v):
 def run(args) -> int:
     """Run ``weakgrid verify`` with the parsed ``args``; return the exit status."""
     problem = problem_of(args)
+    if args.u_bound is not None:
+        problem = problem.with_input_bound(
+            args.u_bound[0] if len(args.u_bound) == 1 else args.u_bound, args.u_bound_shape)
     if problem.system.n_states != 2:
         raise ParameterError("model", f"{problem.system.n_states} states",
                              "the grid ground truth is for 2-state problems")

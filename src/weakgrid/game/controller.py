@@ -6,6 +6,12 @@ solution of the block system (from (23)–(24); docs/theory.md, "The saddle poin
     [[Yu, g'∇²J h], [h'∇²J g, Yw]] · [u; w] = −[g'(∇J + ∇²J(f − x)); h'(∇J + ∇²J(f − x))]
 
 with ``Yu = g'∇²J g + 2R`` and ``Yw = h'∇²J h − 2γ²P``.
+
+With an input bound in the cost (beyond the paper), ``u'Ru`` is ``W(u)``: for each u
+the maximizing w is still affine, ``w(u) = −Yw⁻¹ h'[∇J + ∇²J(f + g·u − x)]``, and u*
+minimizes the resulting ``½u'M u + b'u + W(u)`` (``M = g'∇²J g − g'∇²J h Yw⁻¹ h'∇²J g``)
+over the bound (:meth:`~weakgrid.game.input_bound.InputBound.minimize`); then
+``w* = w(u*)``.
 """
 
 from __future__ import annotations
@@ -102,10 +108,50 @@ class GameController:
         reg = np.zeros((m + q, m + q))
         reg[:m, :m] = 2 * self.cost.R
         reg[m:, m:] = -2 * self.cost.gamma**2 * self.cost.P
-        M = M + reg
         rhs = np.einsum("...ni,...n->...i", B, gJ + np.einsum("...ij,...j->...i", HJ, f - x))
+        if self.cost.bound is not None:
+            return self._bounded_saddle_point(M, rhs, m)
+        M = M + reg
         z = -np.linalg.solve(M, rhs[..., None])[..., 0]
         return z[..., :m], z[..., m:]
+
+    def _bounded_saddle_point(self, M, rhs, m):
+        """``u* = argmin_{bound} max_w`` of (22) with ``W(u)``; ``M = B'∇²J B``, ``rhs = B'r``."""
+        c = self.cost
+        Yw = M[..., m:, m:] - 2 * c.gamma**2 * c.P
+        Ghg = M[..., m:, :m]
+        Xs = np.linalg.solve(Yw, np.concatenate([Ghg, rhs[..., m:, None]], -1))
+        Xg, Xr = Xs[..., :m], Xs[..., m]
+        Meff = M[..., :m, :m] - np.einsum("...iq,...qj->...ij", M[..., :m, m:], Xg)
+        beff = rhs[..., :m] - np.einsum("...iq,...q->...i", M[..., :m, m:], Xr)
+        u = c.bound.minimize(0.5 * (Meff + np.swapaxes(Meff, -1, -2)), beff, c.R)
+        w = -(Xr + np.einsum("...qj,...j->...q", Xg, u))
+        return u, w
+
+    def unbounded_control(self, x) -> np.ndarray:
+        """The saddle point of (24) with ``u'Ru`` from this J (what the bound changes)."""
+        if self.cost.bound is None:
+            return self.control(x)
+        ctl = GameController(self.system, self.basis, self.weights,
+                             self.cost.with_bound(None), self.problem)
+        return ctl.control(x)
+
+    def bound_activity(self, x) -> dict:
+        """Where the input bound acts, at states ``x`` (e.g. the mesh of Ω).
+
+        ``fraction_binding``: the share of states where the unbounded saddle point of
+        the same J lies outside the bound; ``fraction_saturated``: where ``u*`` uses
+        ≥ 90 % of it; ``max_ratio``: the largest ``‖u*‖/ū`` (≤ 1 by construction).
+        """
+        if self.cost.bound is None:
+            raise ParameterError("cost.u_bound", None, "this controller has no input bound")
+        b = self.cost.bound
+        r_unb = b.ratio(self.unbounded_control(x))
+        r = b.ratio(self.control(x))
+        return {"bound": b.to_dict(), "n_points": int(r.size),
+                "fraction_binding": float(np.mean(r_unb > 1.0)),
+                "fraction_saturated": float(np.mean(r >= 0.9)),
+                "max_ratio": float(r.max()), "max_unbounded_ratio": float(r_unb.max())}
 
     def control(self, x) -> np.ndarray:
         """``u*(x)``."""
@@ -138,10 +184,16 @@ class GameController:
         """The conditions of the method at states ``x`` (e.g. the mesh): Yu ≻ 0, Yw ≺ 0, J ≥ 0."""
         eu, ew = self.block_eigenvalues(x)
         J = self.value(x)
-        return {"min_eig_Yu": float(eu.min()), "max_eig_Yw": float(ew.max()),
-                "min_J": float(J.min()), "n_points": int(np.asarray(x).shape[0]),
-                "n_bad_Yu": int((eu <= 0).sum()), "n_bad_Yw": int((ew >= 0).sum()),
-                "n_negative_J": int((J < 0).sum())}
+        xa = np.asarray(x, float)
+        radial = np.einsum("...n,...n->...", xa, self.gradient(xa))  # x·∇J: J grows outward
+        d = {"min_eig_Yu": float(eu.min()), "max_eig_Yw": float(ew.max()),
+             "min_J": float(J.min()), "n_points": int(xa.shape[0]),
+             "n_bad_Yu": int((eu <= 0).sum()), "n_bad_Yw": int((ew >= 0).sum()),
+             "n_negative_J": int((J < 0).sum()),
+             "n_radial_decrease": int(((radial <= 0) & (np.abs(xa).sum(-1) > 0)).sum())}
+        if self.cost.bound is not None:
+            d["bound"] = self.bound_activity(x)
+        return d
 
     # -------------------------------------------------------------- files
     def to_dict(self) -> dict:

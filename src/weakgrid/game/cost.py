@@ -1,4 +1,6 @@
-"""The game cost (18): ``Σ x'Qx + u'Ru − γ² w'Pw``."""
+"""The game cost (18): ``Σ x'Qx + u'Ru − γ² w'Pw`` — or, with an input bound,
+``Σ x'Qx + W(u) − γ² w'Pw`` with the constrained-input penalty W of
+:mod:`weakgrid.game.input_bound` in place of ``u'Ru``."""
 
 from __future__ import annotations
 
@@ -7,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import ParameterError, ShapeError
+from .input_bound import InputBound
 
 __all__ = ["GameCost"]
 
@@ -43,12 +46,16 @@ class GameCost:
         Disturbance weight, positive definite.
     gamma : float
         Attenuation level γ > 0.
+    bound : InputBound or None
+        The admissible control set; its penalty ``W(u)`` replaces ``u'Ru``
+        (beyond the paper; None: the paper's cost).
     """
 
     Q: np.ndarray
     R: np.ndarray
     P: np.ndarray
     gamma: float
+    bound: InputBound | None = None
 
     def __post_init__(self):
         try:
@@ -63,24 +70,50 @@ class GameCost:
         object.__setattr__(self, "gamma", g)
 
     @classmethod
-    def for_system(cls, system, Q, R, P, gamma) -> "GameCost":
+    def for_system(cls, system, Q, R, P, gamma, bound=None, bound_shape="disk") -> "GameCost":
+        """Checked weights; ``bound`` an :class:`InputBound`, a limit ``ū`` or None."""
         g = float(gamma)
         if not np.isfinite(g) or g <= 0:
             raise ParameterError("cost.gamma", gamma, "gamma must be a positive finite number")
-        return cls(_sym(Q, system.n_states, "Q", False), _sym(R, system.n_controls, "R", True),
-                   _sym(P, system.n_disturbances, "P", True), g)
+        Rm = _sym(R, system.n_controls, "R", True)
+        if bound is not None and not isinstance(bound, InputBound):
+            bound = InputBound.for_inputs(system.n_controls, bound, bound_shape)
+        if bound is not None:
+            if bound.shape == "box" and bound.limit.size != system.n_controls:
+                raise ParameterError("cost.u_bound", bound.limit.tolist(),
+                                     f"give one value or one per input ({system.n_controls})")
+            bound.check_weight(Rm)
+        return cls(_sym(Q, system.n_states, "Q", False), Rm,
+                   _sym(P, system.n_disturbances, "P", True), g, bound)
+
+    def with_bound(self, bound) -> "GameCost":
+        """The same weights with another input bound (an :class:`InputBound` or None)."""
+        if bound is not None:
+            bound.check_weight(self.R)
+        return GameCost(self.Q, self.R, self.P, self.gamma, bound)
+
+    def control_penalty(self, u) -> np.ndarray:
+        """``u'Ru``, or ``W(u)`` with an input bound, for a batch ``(..., m)``."""
+        if self.bound is None:
+            return np.einsum("...i,ij,...j->...", u, self.R, u)
+        return self.bound.penalty(u, self.R)
 
     def stage(self, x, u, w) -> np.ndarray:
-        """``x'Qx + u'Ru − γ² w'Pw`` for a batch."""
+        """``x'Qx + u'Ru − γ² w'Pw`` (``W(u)`` for ``u'Ru`` with a bound) for a batch."""
         return (np.einsum("...i,ij,...j->...", x, self.Q, x)
-                + np.einsum("...i,ij,...j->...", u, self.R, u)
+                + self.control_penalty(u)
                 - self.gamma**2 * np.einsum("...i,ij,...j->...", w, self.P, w))
 
     def to_dict(self) -> dict:
-        return {"Q": self.Q.tolist(), "R": self.R.tolist(), "P": self.P.tolist(),
-                "gamma": self.gamma}
+        d = {"Q": self.Q.tolist(), "R": self.R.tolist(), "P": self.P.tolist(),
+             "gamma": self.gamma}
+        if self.bound is not None:
+            d["u_bound"] = self.bound.to_dict()
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> "GameCost":
-        return cls(np.asarray(d["Q"], float), np.asarray(d["R"], float),
-                   np.asarray(d["P"], float), float(d["gamma"]))
+        R = np.asarray(d["R"], float)
+        bound = InputBound.from_dict(d["u_bound"], R.shape[0]) if d.get("u_bound") else None
+        return cls(np.asarray(d["Q"], float), R,
+                   np.asarray(d["P"], float), float(d["gamma"]), bound)

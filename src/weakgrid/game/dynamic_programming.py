@@ -47,6 +47,15 @@ Design choices (and why)
   unbounded: γ too small there) and the Schur complement in ``u`` ``≻ 0`` — and
   nodes that fail keep their policy (counted as ``n_bad_inertia``).
 
+* **Input bound** (a cost with :class:`~weakgrid.game.input_bound.InputBound`): the
+  stage cost charges ``W(u)`` and the controls stay in the bound. The finite-difference
+  model is then of ``ψ − W`` (smooth, defined for any u); w is eliminated from it and
+  the reduced ``½u'Mu + b'u + W(u)`` is minimized exactly over the bound by the
+  same bounded minimizer as the controller (a Newton step in u against W's barrier
+  would crawl away from the boundary). The initial policies are mapped
+  into the bound by ``ū·tanh(·/ū)``; the interpolated grid policy of
+  :meth:`DPSolution.saddle_point` is a convex combination of admissible nodes.
+
 Everything is vectorized over the nodes (NumPy/SciPy; no Python loop per node).
 """
 
@@ -304,12 +313,16 @@ def _interp_weights(axes, X, cubic=True):
     return W, idx
 
 
-def _lift(system, cost, X, Z, k):
-    """``Φ_k`` and ``ℓ_k`` for states (p, n) and held inputs (p, m+q)."""
+def _lift(system, cost, X, Z, k, control_penalty=True):
+    """``Φ_k`` and ``ℓ_k`` for states (p, n) and held inputs (p, m+q).
+
+    ``control_penalty=False`` leaves ``u'Ru`` (or ``W(u)``) out of ``ℓ_k``.
+    """
     m = system.n_controls
     U, Wd = Z[:, :m], Z[:, m:]
-    inputs = (np.einsum("pi,ij,pj->p", U, cost.R, U)
-              - cost.gamma**2 * np.einsum("pi,ij,pj->p", Wd, cost.P, Wd))
+    inputs = -cost.gamma**2 * np.einsum("pi,ij,pj->p", Wd, cost.P, Wd)
+    if control_penalty:
+        inputs = inputs + cost.control_penalty(U)
     x = X
     ell = np.zeros(X.shape[0])
     for _ in range(k):
@@ -335,8 +348,8 @@ class _Grid:
         W, idx = _interp_weights(self.axes, Y, self.cubic)
         return self.quad(Y) + (W * r[idx]).sum(1)
 
-    def psi(self, X, Z, r):
-        Y, ell = _lift(self.system, self.cost, X, Z, self.k)
+    def psi(self, X, Z, r, control_penalty=True):
+        Y, ell = _lift(self.system, self.cost, X, Z, self.k, control_penalty)
         if not np.all(np.isfinite(Y)):
             Y = np.where(np.isfinite(Y), Y, 1e300)
         return ell + self.V(Y, r)
@@ -383,10 +396,11 @@ class _Grid:
                 offs.append(e)
         offs = np.array(offs)  # (S, K)
         n_bad = 0
+        bound = self.cost.bound
         for _ in range(newton_steps):
             Zs = Z[None] + offs[:, None, :] * delta[None]  # (S, N, K)
-            vals = self.psi(np.tile(X, (len(offs), 1)), Zs.reshape(-1, K), r).reshape(
-                len(offs), N)
+            vals = self.psi(np.tile(X, (len(offs), 1)), Zs.reshape(-1, K), r,
+                            control_penalty=bound is None).reshape(len(offs), N)
             f0 = vals[0]
             g = np.empty((N, K))
             H = np.empty((N, K, K))
@@ -399,6 +413,9 @@ class _Grid:
                 v = vals[base + 4 * p_: base + 4 * p_ + 4]
                 H[:, a, b] = H[:, b, a] = (v[0] - v[1] - v[2] + v[3]) / (
                     4 * delta[:, a] * delta[:, b])
+            if bound is not None:
+                Z, n_bad = self._bounded_step(Z, g, H, delta, m)
+                continue
             ok = np.all(np.isfinite(H), axis=(1, 2)) & np.all(np.isfinite(g), axis=1)
             Hww = H[:, m:, m:]
             ok &= np.linalg.eigvalsh(np.where(ok[:, None, None], Hww, -1.0))[:, -1] < 0
@@ -414,6 +431,41 @@ class _Grid:
         Z[self.origin] = 0.0
         return Z, n_bad
 
+
+    def _bounded_step(self, Z, g, H, delta, m):
+        """Saddle point of (quadratic model of ψ − W) + W(u) over the bound, per node.
+
+        ``g``, ``H`` model ``ψ − W`` about ``Z`` (finite differences). w is eliminated
+        (``Hww ≺ 0``) and the reduced ``½u'Mu + b'u + W(u)`` is minimized exactly by
+        :meth:`InputBound.minimize` (needs ``M + 2R ≻ 0``): the step may leave the
+        boundary region in one go, unlike a Newton step in u against W's barrier.
+        """
+        bound, R = self.cost.bound, self.cost.R
+        K = Z.shape[1]
+        ok = np.all(np.isfinite(H), axis=(1, 2)) & np.all(np.isfinite(g), axis=1)
+        Hs = np.where(ok[:, None, None], H, np.eye(K) * np.r_[np.ones(m), -np.ones(K - m)])
+        gs = np.where(ok[:, None], g, 0.0)
+        Hww, Hwu = Hs[:, m:, m:], Hs[:, m:, :m]
+        ok &= np.linalg.eigvalsh(Hww)[:, -1] < 0
+        Hww = np.where(ok[:, None, None], Hww, -np.eye(K - m))
+        Xs = np.linalg.solve(Hww, np.concatenate([Hwu, gs[:, m:, None]], -1))
+        Xu, Xg = Xs[..., :m], Xs[..., m]
+        M = Hs[:, :m, :m] - np.swapaxes(Hwu, 1, 2) @ Xu
+        M = 0.5 * (M + np.swapaxes(M, 1, 2))
+        ok &= np.linalg.eigvalsh(M + 2.0 * R)[:, 0] > 0
+        M = np.where(ok[:, None, None], M, 0.0)
+        u0 = Z[:, :m]
+        gh = gs[:, :m] - np.einsum("pwu,pw->pu", Hwu, Xg)
+        b = gh - np.einsum("pij,pj->pi", M, u0)
+        u_new = bound.minimize(M, b, R)
+        du = u_new - u0
+        # trust region (2 cells) by scaling the whole u step: stays on the segment, inside
+        lim = np.min(4 * delta[:, :m] / np.maximum(np.abs(du), 1e-300), axis=1)
+        du *= np.minimum(1.0, lim)[:, None]
+        dw = -(Xg + np.einsum("pwu,pu->pw", Xu, du))
+        dw = np.clip(dw, -4 * delta[:, m:], 4 * delta[:, m:])
+        step = np.where(ok[:, None], np.concatenate([du, dw], 1), 0.0)
+        return Z + step, int((~ok).sum())
 
 def solve_game_dp(system, cost, lower, upper, settings: DPSettings | None = None, *,
                   progress=None) -> DPSolution:
@@ -482,6 +534,9 @@ def solve_game_dp(system, cost, lower, upper, settings: DPSettings | None = None
     except GammaTooSmallError:
         bias = float("nan")
     Z = -X @ KL.T  # the lifted linearization's saddle policies
+    if cost.bound is not None:
+        Z[:, :system.n_controls] = cost.bound._interior(cost.bound.squash(
+            Z[:, :system.n_controls]))
     history = []
     r = grid.evaluate(Z)
     Vold = grid.quad(X) + r

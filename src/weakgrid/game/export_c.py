@@ -8,6 +8,12 @@ The generated function evaluates, at one state ``x``, exactly what
     [[g'∇²J g + 2R,  g'∇²J h], [h'∇²J g,  h'∇²J h − 2γ²P]]·[u; w]
         = −[g'; h']·(∇J + ∇²J (f − x))   (Gaussian elimination, partial pivoting)
 
+With an input bound in the cost (beyond the paper) the u-block carries no ``2R``:
+the generated code eliminates w (``w(u) = −Yw⁻¹(h'r + h'∇²J g u)``) and minimizes
+``½u'Mu + b'u + W(u)`` over the bound by the same damped Newton iteration in
+``u = ū·tanh(v/ū)`` as :meth:`~weakgrid.game.input_bound.InputBound.minimize`
+(see :func:`_bounded_c`), so that the result is inside the bound by construction.
+
 No allocation, no globals, no library beyond ``<math.h>``. Models are emitted by
 *emitters* registered per system kind (:func:`register_c_model`); the game layer
 ships the ``linear`` one, :mod:`weakgrid.models` registers ``upqc-design``.
@@ -276,8 +282,10 @@ double {name}_value(const double x[{n}]);
             if terms:
                 t_rows.add((j, b))
                 L.append(f"    const double T{j}_{b} = {' + '.join(terms)};")
+    bound = getattr(cost, "bound", None)
     reg = np.zeros((K, K))
-    reg[:m, :m] = 2.0 * cost.R
+    if bound is None:
+        reg[:m, :m] = 2.0 * cost.R
     reg[m:, m:] = -2.0 * cost.gamma**2 * cost.P
     L.append(f"    double M[{K}][{K + 1}];")
     L.append("    /* M = B' HJ B + blkdiag(2R, -2 gamma^2 P); last column -B' r */")
@@ -290,6 +298,18 @@ double {name}_value(const double x[{n}]);
             L.append(f"    M[{a}][{b}] = {' + '.join(terms) if terms else '0.0'};")
         terms = [f"B{j}_{a} * r{j}" for j in range(n) if model.B[j][a] is not None]
         L.append(f"    M[{a}][{K}] = -({' + '.join(terms) if terms else '0.0'});")
+    if bound is not None:
+        helpers, body = _bounded_c(name, bound, cost.R, m, q)
+        start = next(i for i, ln in enumerate(L) if ln.startswith(f"int {name}_saddle("))
+        L[start:start] = helpers
+        L.extend(body)
+        L.append("}")
+        header = header.replace(
+            "/* Control u* and worst-case disturbance w* at state x (docs/theory.md, joint block "
+            "system).",
+            f"/* Control u* (inside the input bound {bound.describe()}) and worst-case "
+            "disturbance w* at state x.")
+        return "\n".join(L) + "\n", header
     L.append(f"""    /* Gaussian elimination with partial pivoting */
     for (int k = 0; k < {K}; ++k) {{
         int p = k;
@@ -321,3 +341,271 @@ double {name}_value(const double x[{n}]);
     L.append("    return 0;")
     L.append("}")
     return "\n".join(L) + "\n", header
+
+
+def _bounded_c(name, bound, R, m, q):
+    """C of the bounded saddle point: static helpers and the tail of ``NAME_saddle``.
+
+    Mirrors :meth:`InputBound.minimize` step by step (start ``v = −(M + 2R)⁻¹b``,
+    Newton on ``2Rv + b + M·squash(v) = 0`` with Armijo backtracking on F, the
+    fixed-point step where the direction is not one of descent, the same stopping
+    rules, then ``u = squash(−(2R)⁻¹(b + M·squash(v)))``).
+    """
+    twoR = [2.0 * float(R[i, i]) for i in range(m)]
+    lim = [float(v) for v in bound.limit]
+    Lmax = max(lim)
+    box = bound.shape == "box"
+    cl = c_literal
+    H = []
+    H.append(f"/* input bound: {bound.describe()} ({bound.shape}); penalty W(u) = "
+             "2 int_0^u (ubar atanh(v/ubar))' R dv */")
+    H.append(f"static void {name}_lsolve(double A[{m}][{m}], double b[{m}], double x[{m}])")
+    H.append("{")
+    H.append(f"""    for (int k = 0; k < {m}; ++k) {{
+        int p = k;
+        double best = fabs(A[k][k]);
+        for (int i = k + 1; i < {m}; ++i) {{
+            if (fabs(A[i][k]) > best) {{ best = fabs(A[i][k]); p = i; }}
+        }}
+        if (p != k) {{
+            for (int j = 0; j < {m}; ++j) {{
+                const double t = A[k][j]; A[k][j] = A[p][j]; A[p][j] = t;
+            }}
+            const double t = b[k]; b[k] = b[p]; b[p] = t;
+        }}
+        for (int i = k + 1; i < {m}; ++i) {{
+            const double l = A[i][k] / A[k][k];
+            for (int j = k; j < {m}; ++j) A[i][j] -= l * A[k][j];
+            b[i] -= l * b[k];
+        }}
+    }}
+    for (int i = {m - 1}; i >= 0; --i) {{
+        double s = b[i];
+        for (int j = i + 1; j < {m}; ++j) s -= A[i][j] * x[j];
+        x[i] = s / A[i][i];
+    }}""")
+    H.append("}")
+    H.append("")
+    # squash, its Jacobian and W(squash(v))
+    H.append(f"static void {name}_squash(const double v[{m}], double u[{m}])")
+    H.append("{")
+    if box:
+        for i in range(m):
+            H.append(f"    u[{i}] = {cl(lim[i])} * tanh(v[{i}] / {cl(lim[i])});")
+    else:
+        H.append("    double s2 = 0.0;")
+        H.append(f"    for (int i = 0; i < {m}; ++i) s2 += v[i] * v[i];")
+        H.append(f"    const double t = sqrt(s2) / {cl(lim[0])};")
+        H.append("    const double fac = t < 1e-8 ? 1.0 - t * t / 3.0 : tanh(t) / t;")
+        H.append("    double n2 = 0.0;")
+        H.append(f"    for (int i = 0; i < {m}; ++i) {{ u[i] = v[i] * fac; n2 += u[i] * u[i]; }}")
+        H.append(f"    const double over = sqrt(n2) / {cl(lim[0])};")
+        H.append("    if (over > 1.0) {")
+        H.append(f"        for (int i = 0; i < {m}; ++i) u[i] = u[i] / over * "
+                 f"{cl(1.0 - 2.0 ** -52)};")
+        H.append("    }")
+    H.append("}")
+    H.append("")
+    H.append(f"static void {name}_squash_jac(const double v[{m}], double S[{m}][{m}])")
+    H.append("{")
+    if box:
+        for i in range(m):
+            for j in range(m):
+                if i != j:
+                    H.append(f"    S[{i}][{j}] = 0.0;")
+            H.append(f"    {{ const double t = fabs(v[{i}] / {cl(lim[i])}); "
+                     f"const double ch = cosh(t < 350.0 ? t : 350.0); "
+                     f"S[{i}][{i}] = 1.0 / (ch * ch); }}")
+    else:
+        L0 = cl(lim[0])
+        H.append("    double s2 = 0.0;")
+        H.append(f"    for (int i = 0; i < {m}; ++i) s2 += v[i] * v[i];")
+        H.append(f"    const double t = sqrt(s2) / {L0};")
+        H.append("    const double t2 = t * t;")
+        H.append("    double fac, c;")
+        H.append("    const double ch = cosh(t < 350.0 ? t : 350.0);")
+        H.append("    const double sech2 = 1.0 / (ch * ch);")
+        H.append("    if (t < 1e-3) {")
+        H.append("        fac = 1.0 - t2 / 3.0 + 2.0 * t2 * t2 / 15.0;")
+        H.append("        c = -2.0 / 3.0 + 8.0 * t2 / 15.0 - 34.0 * t2 * t2 / 105.0;")
+        H.append("    } else {")
+        H.append("        fac = tanh(t) / t;")
+        H.append("        c = (sech2 - fac) / (t * t);")
+        H.append("    }")
+        H.append(f"    for (int i = 0; i < {m}; ++i)")
+        H.append(f"        for (int j = 0; j < {m}; ++j)")
+        H.append(f"            S[i][j] = (i == j ? fac : 0.0) + c * v[i] * v[j] / "
+                 f"({L0} * {L0});")
+    H.append("}")
+    H.append("")
+    H.append(f"static double {name}_lncosh_term(double t)  /* t tanh t - ln cosh t */")
+    H.append("{")
+    H.append("    const double lc = t > 20.0 ? t - log(2.0) : log1p(2.0 * sinh(0.5 * t) * "
+             "sinh(0.5 * t));")
+    H.append("    return t * tanh(t) - lc;")
+    H.append("}")
+    H.append("")
+    H.append(f"static double {name}_F(const double M[{m}][{m}], const double b[{m}], "
+             f"const double v[{m}])")
+    H.append("{")
+    H.append(f"    double u[{m}];")
+    H.append(f"    {name}_squash(v, u);")
+    H.append("    double f = 0.0;")
+    H.append(f"    for (int i = 0; i < {m}; ++i) {{")
+    H.append("        double Mu = 0.0;")
+    H.append(f"        for (int j = 0; j < {m}; ++j) Mu += M[i][j] * u[j];")
+    H.append("        f += 0.5 * u[i] * Mu + b[i] * u[i];")
+    H.append("    }")
+    if box:
+        for i in range(m):
+            H.append(f"    f += {cl(twoR[i] * lim[i] ** 2)} * "
+                     f"{name}_lncosh_term(fabs(v[{i}]) / {cl(lim[i])});")
+    else:
+        H.append("    double s2 = 0.0;")
+        H.append(f"    for (int i = 0; i < {m}; ++i) s2 += v[i] * v[i];")
+        H.append(f"    f += {cl(twoR[0] * lim[0] ** 2)} * {name}_lncosh_term(sqrt(s2) / "
+                 f"{cl(lim[0])});")
+    H.append("    return f;")
+    H.append("}")
+    H.append("")
+    H.append(f"static void {name}_G(const double M[{m}][{m}], const double b[{m}], "
+             f"const double v[{m}], double g[{m}])")
+    H.append("{")
+    H.append(f"    static const double twoR[{m}] = {{{', '.join(cl(v) for v in twoR)}}};")
+    H.append(f"    double u[{m}];")
+    H.append(f"    {name}_squash(v, u);")
+    H.append(f"    for (int i = 0; i < {m}; ++i) {{")
+    H.append("        double Mu = 0.0;")
+    H.append(f"        for (int j = 0; j < {m}; ++j) Mu += M[i][j] * u[j];")
+    H.append("        g[i] = twoR[i] * v[i] + b[i] + Mu;")
+    H.append("    }")
+    H.append("}")
+    H.append("")
+    H.append("/* argmin_u 0.5 u'Mu + b'u + W(u) over the bound, u = squash(v) */")
+    H.append(f"static void {name}_bounded_min(const double M[{m}][{m}], const double b[{m}], "
+             f"double u[{m}])")
+    H.append("{")
+    H.append(f"    static const double twoR[{m}] = {{{', '.join(cl(v) for v in twoR)}}};")
+    H.append(f"    double v[{m}], A[{m}][{m}], rhs[{m}], d[{m}], g[{m}], S[{m}][{m}], "
+             f"vn[{m}];")
+    H.append("    double scale = 0.0, Mmax = 0.0;")
+    H.append(f"    for (int i = 0; i < {m}; ++i) {{")
+    H.append("        if (fabs(b[i]) > scale) scale = fabs(b[i]);")
+    H.append(f"        for (int j = 0; j < {m}; ++j) {{")
+    H.append("            A[i][j] = M[i][j] + (i == j ? twoR[i] : 0.0);")
+    H.append("            if (fabs(M[i][j]) > Mmax) Mmax = fabs(M[i][j]);")
+    H.append("        }")
+    H.append("        rhs[i] = -b[i];")
+    H.append("    }")
+    H.append("    double twoRmax = twoR[0];")
+    H.append(f"    for (int i = 1; i < {m}; ++i) if (twoR[i] > twoRmax) twoRmax = twoR[i];")
+    H.append(f"    scale += Mmax * {cl(Lmax)} + twoRmax * {cl(Lmax)};")
+    H.append(f"    {name}_lsolve(A, rhs, v);  /* exact for M = 0 */")
+    H.append("    for (int it = 0; it < 100; ++it) {")
+    H.append(f"        {name}_G(M, b, v, g);")
+    H.append(f"        {name}_squash_jac(v, S);")
+    H.append(f"        for (int i = 0; i < {m}; ++i) {{")
+    H.append(f"            for (int j = 0; j < {m}; ++j) {{")
+    H.append("                double MS = 0.0;")
+    H.append(f"                for (int k = 0; k < {m}; ++k) MS += M[i][k] * S[k][j];")
+    H.append("                A[i][j] = (i == j ? twoR[i] : 0.0) + MS;")
+    H.append("            }")
+    H.append("            rhs[i] = -g[i];")
+    H.append("        }")
+    H.append(f"        {name}_lsolve(A, rhs, d);")
+    H.append("        double slope = 0.0;")
+    H.append("        int finite = 1;")
+    H.append(f"        for (int i = 0; i < {m}; ++i) {{")
+    H.append("            if (!isfinite(d[i])) finite = 0;")
+    H.append(f"            for (int j = 0; j < {m}; ++j) slope += g[i] * S[i][j] * d[j];")
+    H.append("        }")
+    H.append("        if (!finite || !(slope < 0.0)) {  /* fixed-point step */")
+    H.append(f"            for (int i = 0; i < {m}; ++i) d[i] = -g[i] / twoR[i];")
+    H.append("            slope = 0.0;")
+    H.append(f"            for (int i = 0; i < {m}; ++i)")
+    H.append(f"                for (int j = 0; j < {m}; ++j) slope += g[i] * S[i][j] * d[j];")
+    H.append("        }")
+    H.append("        double alpha = 1.0;")
+    H.append(f"        const double f0 = {name}_F(M, b, v);")
+    H.append("        const double tol_f = 1e-15 * (fabs(f0) + 1.0);")
+    H.append("        const double sl = slope < 0.0 ? slope : 0.0;")
+    H.append("        for (int k = 0; k < 60; ++k) {")
+    H.append(f"            for (int i = 0; i < {m}; ++i) vn[i] = v[i] + alpha * d[i];")
+    H.append(f"            if (!({name}_F(M, b, vn) > f0 + 1e-4 * alpha * sl + tol_f)) break;")
+    H.append("            alpha *= 0.5;")
+    H.append("        }")
+    H.append("        double gmax = 0.0, dv = 0.0, vmax = 0.0;")
+    H.append(f"        for (int i = 0; i < {m}; ++i) {{")
+    H.append("            vn[i] = v[i] + alpha * d[i];")
+    H.append("            if (fabs(g[i]) > gmax) gmax = fabs(g[i]);")
+    H.append("            if (fabs(vn[i] - v[i]) > dv) dv = fabs(vn[i] - v[i]);")
+    H.append("            if (fabs(vn[i]) > vmax) vmax = fabs(vn[i]);")
+    H.append("            v[i] = vn[i];")
+    H.append("        }")
+    H.append(f"        if (gmax <= 1e-14 * scale || dv <= 1e-15 * (vmax + {cl(Lmax)})) break;")
+    H.append("    }")
+    H.append("    /* u = squash(-(2R)^-1 (b + M squash(v))) */")
+    H.append(f"    {name}_squash(v, u);")
+    H.append(f"    for (int i = 0; i < {m}; ++i) {{")
+    H.append("        double Mu = 0.0;")
+    H.append(f"        for (int j = 0; j < {m}; ++j) Mu += M[i][j] * u[j];")
+    H.append("        vn[i] = -(b[i] + Mu) / twoR[i];")
+    H.append("    }")
+    H.append(f"    {name}_squash(vn, u);")
+    H.append("}")
+    H.append("")
+    K = m + q
+    B_ = []
+    B_.append(f"""    /* eliminate w: Yw X = [h'HJ g | h'r], Yw = M[m..][m..] (Gaussian elimination) */
+    double Y[{q}][{q}], X[{q}][{m + 1}];
+    for (int i = 0; i < {q}; ++i) {{
+        for (int j = 0; j < {q}; ++j) Y[i][j] = M[{m} + i][{m} + j];
+        for (int j = 0; j < {m}; ++j) X[i][j] = M[{m} + i][j];
+        X[i][{m}] = -M[{m} + i][{K}];
+    }}
+    for (int k = 0; k < {q}; ++k) {{
+        int p = k;
+        double best = fabs(Y[k][k]);
+        for (int i = k + 1; i < {q}; ++i) {{
+            if (fabs(Y[i][k]) > best) {{ best = fabs(Y[i][k]); p = i; }}
+        }}
+        if (!(best > 0.0)) return -1;
+        if (p != k) {{
+            for (int j = 0; j < {q}; ++j) {{ const double t = Y[k][j]; Y[k][j] = Y[p][j]; Y[p][j] = t; }}
+            for (int j = 0; j <= {m}; ++j) {{ const double t = X[k][j]; X[k][j] = X[p][j]; X[p][j] = t; }}
+        }}
+        for (int i = k + 1; i < {q}; ++i) {{
+            const double l = Y[i][k] / Y[k][k];
+            for (int j = k; j < {q}; ++j) Y[i][j] -= l * Y[k][j];
+            for (int j = 0; j <= {m}; ++j) X[i][j] -= l * X[k][j];
+        }}
+    }}
+    for (int i = {q - 1}; i >= 0; --i) {{
+        for (int c = 0; c <= {m}; ++c) {{
+            double s = X[i][c];
+            for (int j = i + 1; j < {q}; ++j) s -= Y[i][j] * X[j][c];
+            X[i][c] = s / Y[i][i];
+        }}
+    }}
+    /* reduced problem in u: Meff = g'HJ g - g'HJ h X_g, beff = g'r - g'HJ h X_r */
+    double Me[{m}][{m}], Ms[{m}][{m}], be[{m}];
+    for (int a = 0; a < {m}; ++a) {{
+        for (int b = 0; b < {m}; ++b) {{
+            double s = M[a][b];
+            for (int i = 0; i < {q}; ++i) s -= M[a][{m} + i] * X[i][b];
+            Me[a][b] = s;
+        }}
+        double s = -M[a][{K}];
+        for (int i = 0; i < {q}; ++i) s -= M[a][{m} + i] * X[i][{m}];
+        be[a] = s;
+    }}
+    for (int a = 0; a < {m}; ++a)
+        for (int b = 0; b < {m}; ++b) Ms[a][b] = 0.5 * (Me[a][b] + Me[b][a]);
+    {name}_bounded_min((const double (*)[{m}])Ms, be, u);
+    for (int i = 0; i < {q}; ++i) {{
+        double s = X[i][{m}];
+        for (int j = 0; j < {m}; ++j) s += X[i][j] * u[j];
+        w[i] = -s;
+    }}
+    return 0;""")
+    return H, B_

@@ -276,7 +276,7 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
 
     def trial(gamma):
         t1 = time.perf_counter()
-        c = GameCost(cost.Q, cost.R, cost.P, float(gamma))
+        c = GameCost(cost.Q, cost.R, cost.P, float(gamma), cost.bound)
         reasons = []
         for start in settings.starts:
             pol = policy_for(start, gamma)

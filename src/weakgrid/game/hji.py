@@ -12,6 +12,12 @@ updates the control by (24), the inner loop the disturbance by (23)::
         u⁽ⁱ⁺¹⁾ from (24) with the last J and w
     until max|Δu| ≤ δu
 
+With an input bound in the cost (:mod:`weakgrid.game.input_bound`, beyond the paper)
+the stage cost charges ``W(u)`` instead of ``u'Ru`` in the regression (27)–(28) and
+the control update minimizes ``½u'(g'∇²J g)u + u'g'[∇J + ∇²J(f + h·w − x)] + W(u)``
+over the bounded set at each mesh point in place of (24); the initial policy is
+mapped into the set by ``ū·tanh(·/ū)`` (identical to first order at the origin).
+
 Everything that does not change across iterations (f, g, h and the basis
 derivatives at the mesh) is evaluated once. Each fit solves the least-squares
 problem by a QR factorization of the regression matrix with normalized columns
@@ -107,6 +113,9 @@ class IterationRecord:
         Largest eigenvalue of ``Yw`` on the mesh (must be < 0).
     min_eig_Yu : float
         Smallest eigenvalue of ``Yu`` on the mesh (must be > 0).
+    bound_active : float or None
+        With an input bound: the fraction of the mesh where the unbounded update (24)
+        from the same J and w would leave the bound (None without a bound).
     """
 
     outer: int
@@ -118,12 +127,16 @@ class IterationRecord:
     min_J: float
     max_eig_Yw: float
     min_eig_Yu: float
+    bound_active: float | None = None
 
     def to_dict(self):
-        return {"outer": self.outer, "inner": self.inner, "max_du": self.max_du,
-                "max_dw": list(self.max_dw), "residual": self.residual,
-                "weights": self.weights.tolist(), "min_J": self.min_J,
-                "max_eig_Yw": self.max_eig_Yw, "min_eig_Yu": self.min_eig_Yu}
+        d = {"outer": self.outer, "inner": self.inner, "max_du": self.max_du,
+             "max_dw": list(self.max_dw), "residual": self.residual,
+             "weights": self.weights.tolist(), "min_J": self.min_J,
+             "max_eig_Yw": self.max_eig_Yw, "min_eig_Yu": self.min_eig_Yu}
+        if self.bound_active is not None:
+            d["bound_active"] = self.bound_active
+        return d
 
 
 def closed_loop_spectral_radius(system: ControlAffineSystem, policy, x0=None, eps=1e-6):
@@ -427,6 +440,9 @@ def solve_hji(
         raise ShapeError("initial_policy(x)", u.shape, f"({p}, {system.n_controls})")
     if not np.all(np.isfinite(u)):
         raise NonFiniteError("the initial policy gives NaN or inf on the mesh")
+    bound = cost.bound
+    if bound is not None:
+        u = bound.squash(u)  # admissible: inside the bound, unchanged to first order
     if settings.check_initial_policy:
         rho = closed_loop_spectral_radius(system, initial_policy)
         if rho >= 1.0:
@@ -444,7 +460,8 @@ def solve_hji(
     cs = pr.set_column_scale(u)
     for i in range(1, settings.max_outer + 1):
         w = np.zeros((q, p))
-        base_Y = pr.Qx + _quad_planes(cost.R, u)
+        base_Y = pr.Qx + (_quad_planes(cost.R, u) if bound is None
+                          else bound.penalty(u.T, cost.R))
         vu = pr.input_effect(u, None)
         dws = []
         for j in range(1, settings.max_inner + 1):
@@ -522,6 +539,18 @@ def solve_hji(
                 f"outer iteration {i}: the fitted cost is not convex enough; increase R or "
                 "use a richer basis.")
         u_new = -_solve_planes(Yu, rhs)
+        active = None
+        if bound is not None:
+            # the bounded update: argmin ½u'(Yu − 2R)u + u'rhs + W(u) at every point
+            active = float(np.mean(bound.ratio(u_new.T) > 1.0))
+            u_new, info = bound.minimize(np.moveaxis(Yu - pr.R2, -1, 0), rhs.T, cost.R,
+                                         return_info=True)
+            u_new = np.ascontiguousarray(u_new.T)
+            if info["n_unconverged"]:
+                warnings.warn(f"the bounded control update did not converge at "
+                              f"{info['n_unconverged']} mesh points in outer iteration {i} "
+                              f"(largest relative residual {info['max_residual']:.2e})",
+                              RuntimeWarning, stacklevel=2)
         du = float(np.abs(u_new - u).max())
         if not np.isfinite(du):
             raise NonFiniteError(f"the control became NaN/inf at outer iteration {i}")
@@ -529,7 +558,7 @@ def solve_hji(
             outer=i, inner=len(dws), max_du=du, max_dw=dws,
             residual=res / max(float(np.sqrt(np.dot(Y, Y))), 1e-300),
             weights=W, min_J=float((pr.phi_s @ Ws).min()),
-            max_eig_Yw=float(eYw.max()), min_eig_Yu=float(eYu.min()))
+            max_eig_Yw=float(eYw.max()), min_eig_Yu=float(eYu.min()), bound_active=active)
         history.append(rec)
         if progress is not None:
             progress(rec)
@@ -564,7 +593,9 @@ def solve_hji(
         "cost": cost.to_dict(),
         "mesh": mesh.to_dict(),
         "basis": basis.to_dict(),
-        "initial_policy": describe_policy(initial_policy),
+        "initial_policy": describe_policy(initial_policy)
+        if bound is None else {**describe_policy(initial_policy),
+                               "mapped_into_bound": "u_bar*tanh(u/u_bar)"},
         "settings": settings.to_dict(),
     }
     if problem:

@@ -56,7 +56,8 @@ def value_error(controller, dp, lower, upper) -> dict:
 
 def _cost(system, cost, pol, dist, starts, steps):
     r = rollout(system, pol, starts, steps, Q=cost.Q, R=cost.R, disturbance=dist, P=cost.P,
-                gamma=cost.gamma)
+                gamma=cost.gamma,
+                penalty=cost.control_penalty if cost.bound is not None else None)
     return r.cost, r.diverged, r.states
 
 

@@ -38,7 +38,7 @@ class Rollout:
 
 
 def rollout(system, policy, x0, n_steps: int, *, Q=None, R=None, disturbance=None,
-            P=None, gamma=None, bound: float = 1e6) -> Rollout:
+            P=None, gamma=None, bound: float = 1e6, penalty=None) -> Rollout:
     """Simulate ``x+ = f + g·π(x) + h·w(x)`` from a batch of initial states.
 
     Parameters
@@ -53,6 +53,9 @@ def rollout(system, policy, x0, n_steps: int, *, Q=None, R=None, disturbance=Non
     P, gamma : used to subtract ``γ²w'Pw`` from the cost when a disturbance is given.
     bound : float
         A run whose state norm exceeds this is stopped and marked diverged.
+    penalty : callable, (B, m) -> (B,), optional
+        The control's charge instead of ``u'Ru`` (e.g. ``GameCost.control_penalty``
+        of a cost with an input bound).
     """
     x = np.atleast_2d(np.asarray(x0, float)).copy()
     if n_steps < 1:
@@ -76,7 +79,8 @@ def rollout(system, policy, x0, n_steps: int, *, Q=None, R=None, disturbance=Non
             raise NonFiniteError(f"the policy returned NaN/inf at step {k}")
         w = np.zeros((xa.shape[0], q)) if disturbance is None else \
             np.asarray(disturbance(xa), float).reshape(-1, q)
-        c = np.einsum("bi,ij,bj->b", xa, Q, xa) + np.einsum("bi,ij,bj->b", u, R, u)
+        c = np.einsum("bi,ij,bj->b", xa, Q, xa) + (
+            np.einsum("bi,ij,bj->b", u, R, u) if penalty is None else penalty(u))
         if disturbance is not None and gamma is not None:
             Pm = np.eye(q) if P is None else np.atleast_2d(P)
             c = c - gamma**2 * np.einsum("bi,ij,bj->b", w, Pm, w)

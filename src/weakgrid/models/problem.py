@@ -12,6 +12,12 @@ see ``src/weakgrid/data/presets/case1-paper.toml`` for a complete example.
 * ``sg`` — a classical SG: ``H, E_prime, B, Vr_bar, T``, ``f_nominal`` and one of
   ``Pm`` / ``delta0`` (see :func:`sg_design_model`);
 * ``linear`` — ``A, B, E`` matrices (for checks against the LQ game).
+
+``[cost]`` may bound the control (beyond the paper): ``u_bound = 0.15`` with
+``u_bound_shape = "disk"`` (‖u‖ ≤ ū, the UPQC's |Vu| = √(Vup² + Vuq²) ≤ rating, the
+default) or ``"box"`` (|u_i| ≤ ū_i; one value or one per input). The penalty
+``W(u)`` of :mod:`weakgrid.game.input_bound` then replaces ``u'Ru``. Studies set the
+bound from the device rating with :meth:`TrainingProblem.with_input_bound`.
 """
 
 from __future__ import annotations
@@ -238,7 +244,7 @@ class TrainingProblem:
     def train(self, settings: SolverSettings | None = None, progress=None) -> GameController:
         """Run the two-loop policy iteration (docs/theory.md, (25)–(28))."""
         extra = {"name": self.name, "source": self.source}
-        if self.published:
+        if self.published and self.cost.bound is None:
             extra["published"] = self.published
         return solve_hji(self.system, self.basis, self.cost, self.mesh, self.initial_policy,
                          settings or self.settings, problem=extra, progress=progress)
@@ -246,8 +252,52 @@ class TrainingProblem:
     def with_gamma(self, gamma: float) -> "TrainingProblem":
         c = self.cost
         return TrainingProblem(self.name, self.system, self.basis,
-                               GameCost.for_system(self.system, c.Q, c.R, c.P, gamma), self.mesh,
+                               GameCost.for_system(self.system, c.Q, c.R, c.P, gamma,
+                                                   bound=c.bound), self.mesh,
                                self.initial_policy, self.settings, self.published, self.raw,
+                               self.source)
+
+    def with_rating(self, rating, shape: str | None = None) -> "TrainingProblem":
+        """Bounded by the problem's own ``u_bound`` if it sets one, else by ``rating``.
+
+        The hook for studies: ``problem.with_rating(upqc_rating)`` trains the bounded
+        controller of a case with the device's rating unless the design settings
+        choose another bound.
+        """
+        if self.cost.bound is not None:
+            return self
+        return self.with_input_bound(rating, shape)
+
+    @property
+    def input_bound(self):
+        """The :class:`~weakgrid.game.input_bound.InputBound` of the cost, or None."""
+        return self.cost.bound
+
+    def with_input_bound(self, limit, shape: str | None = None) -> "TrainingProblem":
+        """The same problem with the control bounded (e.g. by a device rating).
+
+        Parameters
+        ----------
+        limit : float, sequence of float, or None
+            ``ū`` in the units of u (per unit for the UPQC series voltage); None
+            removes the bound (the paper's cost).
+        shape : {"disk", "box"}, optional
+            Default: the problem file's ``u_bound_shape``, else "disk".
+
+        The published weights are dropped (they are for the unbounded cost).
+        See also :meth:`with_rating`.
+        """
+        if limit is None:
+            cost = self.cost.with_bound(None)
+        else:
+            shape = shape or self.raw.get("cost", {}).get("u_bound_shape", "disk")
+            c = self.cost
+            cost = GameCost.for_system(self.system, c.Q, c.R, c.P, c.gamma, bound=limit,
+                                       bound_shape=shape)
+        name = self.name if cost.bound is None else f"{self.name}-bounded"
+        return TrainingProblem(name, self.system, self.basis, cost, self.mesh,
+                               self.initial_policy, self.settings,
+                               self.published if cost.bound is None else {}, self.raw,
                                self.source)
 
 
@@ -263,12 +313,17 @@ def problem_from_dict(d: dict, source: str = "") -> TrainingProblem:
         _table(d, sec)
     system = _model(d["model"])
     c = d["cost"]
-    _check_keys(c, {"Q", "R", "P", "gamma"}, "cost")
+    _check_keys(c, {"Q", "R", "P", "gamma", "u_bound", "u_bound_shape"}, "cost")
     gamma = _num(c, "gamma", "cost")
     if gamma <= 0:
         raise ParameterError("cost.gamma", gamma, "the attenuation level must be > 0")
+    shape = c.get("u_bound_shape", "disk")
+    if "u_bound_shape" in c and "u_bound" not in c:
+        raise ParameterError("cost.u_bound", None, "u_bound_shape is given without a bound: "
+                             "add `u_bound = …` (e.g. the device rating) or drop the shape")
     cost = GameCost.for_system(system, _array(c, "Q", "cost"), _array(c, "R", "cost"),
-                               _array(c, "P", "cost"), gamma)
+                               _array(c, "P", "cost"), gamma,
+                               bound=c.get("u_bound"), bound_shape=shape)
     m = d["mesh"]
     _check_keys(m, {"lower", "upper", "step"}, "mesh")
     mesh = GridMesh(_array(m, "lower", "mesh"), _array(m, "upper", "mesh"),

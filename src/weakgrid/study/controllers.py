@@ -1,11 +1,6 @@
 """The controllers the paper compares, built for a case's design model.
 
-================  ===============================================================
-name              what
-================  ===============================================================
-``hji``           the game-theoretic controller (24)/(23) trained on the design model
-                  derived from the grid's operating point, with the paper's settings
-``nonlinear-29``  the paper's initial nonlinear controller (29) (case 1)
+================  ========================================================``nonlinear-29``  the paper's initial nonlinear controller (29) (case 1)
 ``lqr``           discrete LQR of the design model's linearization (case 2's
                   initial policy), Q = 0.01·I, R = I
 ``pq``            conventional PQ control of the GTI (PID, paper's gains), no UPQC (case 1)
@@ -26,7 +21,7 @@ from ..models import NonlinearInitialPolicy, load_preset, lqr_policy
 __all__ = ["CONTROLLERS", "PAPER_SETTINGS", "ControllerChoice", "case_variant", "make_controller",
            "train_hji_for"]
 
-CONTROLLERS = ("hji", "nonlinear-29", "lqr", "pq", "pss-only", "none")
+CONTROLLERS = ("hji", "nonlinear-29", "lqr", "pq", "pss-only", "none", "hji-bounded")
 # the paper's game settings (Q, R, P, γ, Ω, mesh, basis, initial policy) per case
 PAPER_SETTINGS = {"case1-weak-grid": "case1-paper", "case2-lv-microgrid": "case2-paper"}
 
@@ -57,8 +52,12 @@ def case_variant(name: str) -> str:
     return "pq" if name == "pq" else "upqc"
 
 
-def train_hji_for(case_name: str, design, progress=None):
-    """Train the HJI controller on ``design`` with the paper's settings of the case."""
+def train_hji_for(case_name: str, design, progress=None, u_bound=None):
+    """Train the HJI controller on ``design`` with the paper's settings of the case.
+
+    ``u_bound``: the UPQC rating ū (pu); the cost then bounds ‖u‖ ≤ ū, unless the
+    settings set their own bound (:meth:`~weakgrid.models.TrainingProblem.with_rating`).
+    """
     base = load_preset(PAPER_SETTINGS[case_name])
     base.system = design
     if base.raw.get("initial_policy", {}).get("kind") == "nonlinear-29":
@@ -71,19 +70,31 @@ def train_hji_for(case_name: str, design, progress=None):
                                          float(ip.get("R", 1.0)) * np.eye(2))
     base.name = f"{case_name}-derived"
     base.published = {}
+    if u_bound is not None and np.isfinite(u_bound):
+        base = base.with_rating(float(u_bound))
     return base, base.train(progress=progress)
 
 
-def make_controller(name: str, case_name: str, design, trained=None) -> ControllerChoice:
+def make_controller(name: str, case_name: str, design, trained=None,
+                    u_bound=None) -> ControllerChoice:
     """Build controller ``name`` for a case whose design model is ``design``.
 
     ``trained`` may carry an already trained HJI controller (a GameController) so
     that one training serves every scenario with the same design model.
+    ``u_bound`` is the UPQC rating, used by ``hji-bounded``.
     """
     if name not in CONTROLLERS:
         raise ParameterError("controller", name, f"choose one of {CONTROLLERS}")
+    if name == "hji-bounded":
+        if u_bound is None or not np.isfinite(u_bound):
+            raise ParameterError("controller", name, "needs the UPQC rating (Vmax) of the case")
+        ctl = trained if trained is not None and trained.cost.bound is not None else \
+            train_hji_for(case_name, design, u_bound=u_bound)[1]
+        return ControllerChoice(name, ctl.control, info={
+            "weights": ctl.weights.tolist(), "iterations": ctl.iterations,
+            "train_seconds": ctl.train_seconds, "u_bound": ctl.cost.bound.to_dict()})
     if name == "hji":
-        ctl = trained if trained is not None else train_hji_for(case_name, design)[1]
+        ctl = trained if trained is not None and trained.cost.bound is None else train_hji_for(case_name, design)[1]
         return ControllerChoice(name, ctl.control, info={
             "weights": ctl.weights.tolist(), "iterations": ctl.iterations,
             "train_seconds": ctl.train_seconds})

@@ -68,7 +68,10 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
     case = build_case(sc.case, sc.load, sc.upqc, case_variant(sc.controller))
     key = (sc.case, sc.load, sc.upqc)
     ctl = (trained or {}).get(key)
-    choice = make_controller(sc.controller, sc.case, case.design, ctl)
+    up_ = case.system.components.get("UPQC")
+    rating = float(up_.p["Vmax"][up_.names.index(case.upqc_name)]) if up_ is not None and \
+        case.upqc_name in up_.names else None
+    choice = make_controller(sc.controller, sc.case, case.design, ctl, u_bound=rating)
     if not choice.pss:
         _disable_pss(case.system)
     T = case.design.T
