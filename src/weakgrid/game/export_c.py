@@ -305,8 +305,8 @@ double {name}_value(const double x[{n}]);
         L.extend(body)
         L.append("}")
         header = header.replace(
-            "/* Control u* and worst-case disturbance w* at state x (docs/theory.md, joint block "
-            "system).",
+            "/* Control u* and worst-case disturbance w* at state x (the paper's (23)-(24) solved "
+            "jointly as one block system).",
             f"/* Control u* (inside the input bound {bound.describe()}) and worst-case "
             "disturbance w* at state x.")
         return "\n".join(L) + "\n", header
