@@ -38,7 +38,7 @@ from scipy.linalg.lapack import dgetrs
 from .errors import DataError
 
 #: largest DAE size (states + 2 × buses) solved densely by ``linear_solver="auto"``
-DENSE_MAX_VARS = 600
+DENSE_MAX_VARS = 100
 
 
 class DenseFactor:
