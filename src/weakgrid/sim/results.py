@@ -237,6 +237,7 @@ class _Recorder:
         self._tm = slice(c, c + nm)
         self._vs = slice(c + nm, c + 2 * nm)
         self._ncol = c + 2 * nm
+        self._states_only = self.sel is not None and (len(self.sel) == 0 or self.sel.max() < nx)
         self._row = np.empty(self._ncol)
         self._buf = np.empty((256, self._ncol if self.sel is None else len(self.sel)))
         self._tbuf = np.empty(256)
@@ -252,6 +253,11 @@ class _Recorder:
         sys = self.sys
         nx, nb = sys.nx, sys.nb
         row = self._buf[self._n] if self.sel is None else self._row
+        if self._states_only:     # selected states only: no derived quantities needed
+            self._buf[self._n] = z[self.sel]
+            self._tbuf[self._n] = t
+            self._n += 1
+            return
         row[:nx] = z[:nx]
         Vr, Vi = z[nx:nx + nb], z[nx + nb:]
         bus = row[self._bus]
