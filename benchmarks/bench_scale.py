@@ -16,7 +16,8 @@ Scenario: 10 s at a fixed step of 1/120 s, one three-phase fault (xf = 1e-4 pu) 
 1.05 s at the bus with the most branch ends (kundur_full: bus 8). Timed: the integration only
 (ANDES ``TDS.run``; weakgrid ``Simulator.run``), median of ``--repeat`` runs. Each tool and case
 runs in its own subprocess, whose peak resident memory (``ru_maxrss``, whole process including
-imports) is reported, with the resident memory after the imports in brackets. The speed
+imports) is reported, with the resident memory after the imports (numpy, SciPy, pandapower,
+ANDES where used) in brackets. The speed
 deviation is the largest difference of any machine speed between the two tools [pu] over the
 run (linear interpolation on a common grid).
 
@@ -61,9 +62,14 @@ def fault_bus(mpc):
 
 # ------------------------------------------------------------------ children
 def child_weakgrid(case, repeat, solver, lu, out):
+    import pandapower.networks  # noqa: F401  (imports before the baseline memory)
+
     from weakgrid.sim.events import Fault
     from weakgrid.sim.integrate import Simulator
+    from weakgrid.sim.templates import classical_system, matpower_case
 
+    if case in PEER:
+        import andes  # noqa: F401
     base = _rss_mb()
     walls = []
     for _ in range(repeat):
@@ -74,8 +80,6 @@ def child_weakgrid(case, repeat, solver, lu, out):
             s, events, names = build_weakgrid(path, fault=(bus, T_ON, T_OFF), disable_toggles=True)
             s.setup()
         else:
-            from weakgrid.sim.templates import classical_system, matpower_case
-
             mpc = matpower_case(case)
             s = classical_system(mpc, **TEMPLATE)
             events = [Fault(fault_bus(mpc), T_ON, T_OFF)]
@@ -94,6 +98,10 @@ def child_weakgrid(case, repeat, solver, lu, out):
 
 def child_andes(case, repeat, out):
     import andes
+    import pandapower.networks  # noqa: F401
+    from andes.io.matpower import mpc2system
+
+    from weakgrid.sim.templates import classical_parameters, matpower_case
 
     andes.config_logger(40)
     base = _rss_mb()
@@ -105,10 +113,6 @@ def child_andes(case, repeat, out):
             path, bus = PEER[case]
             ss = load_andes(path, fault=(bus, T_ON, T_OFF), disable_toggles=True)
         else:
-            from andes.io.matpower import mpc2system
-
-            from weakgrid.sim.templates import classical_parameters, matpower_case
-
             mpc = matpower_case(case)
             ss = andes.System(default_config=True, no_output=True)
             mpc2system(mpc, ss)

@@ -208,3 +208,19 @@ def test_sparse_pattern_is_complete_and_colouring_exact(which, gus):
     J = np.zeros((s.N, s.N))
     J[s._pr, s._pc] = s.device_jacobian_values(0.0, z)
     np.testing.assert_allclose(J, np.where(inside, ref, 0.0), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("lu", ["klu", "superlu"])
+def test_singular_matrix_gives_nan_not_a_traceback(gus, lu):
+    """A singular matrix (no device derivatives, network switched to all zeros) is reported as
+    NaN solutions, which the integrator handles as a failed iteration."""
+    nx = gus.nx
+    saved = gus.Yr_coo
+    try:
+        gus.Yr_coo = (saved[0], saved[1], np.zeros_like(saved[2]))
+        s = SparseSolver(gus, lu=lu)
+        s.set_device_jacobian(np.zeros(len(gus._pr)))
+        x = s.factor_algebraic().solve(np.ones(gus.N - nx))
+    finally:
+        gus.update_network()
+    assert np.all(np.isnan(x))

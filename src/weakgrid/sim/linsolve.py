@@ -53,6 +53,17 @@ class DenseFactor:
         return x
 
 
+class SingularFactor:
+    """Stands for a factorization that failed (singular matrix): every solve gives NaN, which
+    the integrator treats as a failed Newton iteration (fresh Jacobian, then a shorter step)."""
+
+    def __init__(self, n):
+        self.n = n
+
+    def solve(self, b):
+        return np.full(np.shape(b), np.nan)
+
+
 class LinearSolver:
     """Interface: holds the current device Jacobian and factorizes the matrices built from it.
 
@@ -155,7 +166,10 @@ class _KLU:
         A = self._spmatrix(self._matrix(data), self._I, self._J, (self.pat.n, self.pat.n))
         if self.symbolic is None:
             self.symbolic = klu.symbolic(A)
-        return _KLUFactor(A, self.symbolic, klu.numeric(A, self.symbolic), self._matrix)
+        try:
+            return _KLUFactor(A, self.symbolic, klu.numeric(A, self.symbolic), self._matrix)
+        except ArithmeticError:   # singular
+            return SingularFactor(self.pat.n)
 
 
 class _KLUFactor:
@@ -183,6 +197,12 @@ class _SuperLU:
 
         p = self.pat
         A = sp.csc_matrix((data, p.indices, p.indptr), shape=(p.n, p.n))
+        try:
+            return self._factor(A, splu)
+        except RuntimeError:      # "Factor is exactly singular"
+            return SingularFactor(p.n)
+
+    def _factor(self, A, splu):
         if self.perm is None:
             lu = splu(A, permc_spec="COLAMD")
             self.perm = lu.perm_c
