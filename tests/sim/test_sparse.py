@@ -137,7 +137,11 @@ def test_sparse_and_dense_same_trajectory_peer_case(case, fault):
 
 
 def test_template_classical_case39_is_an_equilibrium_and_sparse_equals_dense():
-    from weakgrid.sim.templates import classical_parameters, classical_system, matpower_case
+    from weakgrid.sim.templates import (
+        classical_parameters,
+        classical_system,
+        matpower_case,
+    )
 
     mpc = matpower_case("case39")
     s = classical_system(mpc, H=4.0, xd1=0.3)

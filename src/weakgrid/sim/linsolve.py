@@ -49,7 +49,7 @@ class DenseFactor:
 
     def solve(self, b):
         """Solve ``M x = b`` (LAPACK ``getrs`` without SciPy's per-call checks)."""
-        x, info = dgetrs(self.lu[0], self.lu[1], b)
+        x, _ = dgetrs(self.lu[0], self.lu[1], b)
         return x
 
 
@@ -259,7 +259,7 @@ class SparseSolver(LinearSolver):
 
     def _coo_values(self):
         s = self.sys
-        r, c, v = s.Yr_coo
+        r, _, v = s.Yr_coo
         if len(r) != self._nnet:
             raise RuntimeError("the network pattern changed; the sparse solver must be rebuilt")
         return np.concatenate([self.dev, v, np.zeros(self.N)])

@@ -24,7 +24,7 @@ from .system import System
 
 PMAX = 8
 
-__all__ = ["matpower_case", "classical_parameters", "classical_system"]
+__all__ = ["classical_parameters", "classical_system", "matpower_case"]
 
 
 def matpower_case(case) -> dict:
