@@ -30,17 +30,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import scipy.linalg as sla
-from scipy.linalg.lapack import dgetrs
 
 from .errors import DataError, SimulationError
+from .linsolve import make_solver
 from .results import Results
 
 
 def lu_solve(lu, b):
-    """``scipy.linalg.lu_solve`` without its per-call checks (LAPACK getrs on a factored matrix)."""
-    x, info = dgetrs(lu[0], lu[1], b)
-    return x
+    """Solve with a factorization from :mod:`weakgrid.sim.linsolve` (dense or sparse)."""
+    return lu.solve(b)
 
 
 class Simulator:
@@ -60,10 +58,19 @@ class Simulator:
         Loss-of-synchronism threshold on ``max(delta) - min(delta)`` over machines [deg].
     save_every : int
         Record every n-th step (breakpoints are always recorded).
+    linear_solver : {"auto", "dense", "sparse"}
+        Linear algebra backend (:mod:`weakgrid.sim.linsolve`): ``"auto"`` is dense
+        for small systems and sparse (KLU) for large ones.
+    sparse_lu : {"klu", "superlu"}
+        Sparse LU library of the sparse backend.
+    record : None, "all", "machines" or list of str
+        What :meth:`run` records (:meth:`Results.recorder`): ``None`` records
+        everything for small systems and the machine speeds and angles for large
+        ones; a list selects variables by name (or by a ``"*.omega"``-style pattern).
     """
 
     def __init__(self, system, dt=1 / 120, tol=1e-7, max_iter=8, max_angle_spread=180.0,
-                 save_every=1, min_step=None):
+                 save_every=1, min_step=None, linear_solver="auto", sparse_lu="klu", record=None):
         if not system.is_setup:
             system.setup()
         if not dt > 0:
@@ -82,6 +89,8 @@ class Simulator:
         self.frozen = np.zeros(len(system.lim_idx), dtype=np.int8)  # +1 upper, -1 lower
         self.stats = {"steps": 0, "newton": 0, "jac": 0, "lu": 0, "evals": 0}
         self._Jdev = None
+        self.linsolver = make_solver(system, linear_solver, sparse_lu)
+        self.record = record
         self._lu = None
         self._lu_key = None
         self._lu_h = None
@@ -93,7 +102,8 @@ class Simulator:
     # ----------------------------------------------------------- linear algebra
     def _refresh_jacobian(self, t, z):
         self._refresh_next = False
-        self._Jdev = self.sys.jacobian_devices(t, z)
+        self._Jdev = self.sys.device_jacobian_values(t, z)
+        self.linsolver.set_device_jacobian(self._Jdev)
         self.stats["jac"] += 1
         self.stats["evals"] += self.sys.ncolours + 1
         self._lu_key = None
@@ -101,9 +111,10 @@ class Simulator:
 
     def _step_diagnosis(self, t, z):
         """If dt is large against the fastest time constant, say so (the real cause)."""
+        if self.sys.N > 3000:  # a dense eigen-analysis would cost more than it tells
+            return ""
         try:
-            self._refresh_jacobian(t, z)
-            J = self._full_jac()
+            J = self.sys.jacobian(t, z)
             nx = self.nx
             A = J[:nx, :nx] - J[:nx, nx:] @ np.linalg.solve(J[nx:, nx:], J[nx:, :nx])
             lam, vec = np.linalg.eig(A)
@@ -118,26 +129,13 @@ class Simulator:
                 f"constant of the system, ≈ {tau:.3g} s (mode dominated by {name}): use dt ≤ "
                 f"{2 * tau:.2g} s")
 
-    def _full_jac(self):
-        J = self._Jdev.copy()
-        J[self.nx:, self.nx:] += self.sys.Yr
-        return J
-
     def _iteration_lu(self, h):
         key = (self.sys.net_version, self.frozen.tobytes())
         # a step that differs from the factored one only by round-off (steps onto
         # sampling breakpoints) reuses the chord matrix
         if self._lu_key != key or abs(h - self._lu_h) > 1e-9 * h:
-            J = self._full_jac()
-            nx = self.nx
-            M = J
-            M[:nx] *= -0.5 * h
-            M[:nx, :nx] += np.eye(nx)
-            if len(self.frozen):
-                fi = self.sys.lim_idx[self.frozen != 0]
-                M[fi] = 0.0
-                M[fi, fi] = 1.0
-            self._lu = sla.lu_factor(M, check_finite=False)
+            fi = self.sys.lim_idx[self.frozen != 0] if len(self.frozen) else None
+            self._lu = self.linsolver.factor_iteration(h, fi)
             self._lu_key = key
             self._lu_h = h
             self.stats["lu"] += 1
@@ -146,8 +144,7 @@ class Simulator:
     def _alg_lu_get(self):
         key = self.sys.net_version
         if self._alg_key != key:
-            J = self._full_jac()
-            self._alg_lu = sla.lu_factor(J[self.nx:, self.nx:], check_finite=False)
+            self._alg_lu = self.linsolver.factor_algebraic()
             self._alg_key = key
         return self._alg_lu
 
@@ -361,7 +358,7 @@ class Simulator:
         controllers = list(controllers)
         for c in controllers:
             c.bind(sys)
-        rec = Results.recorder(sys)
+        rec = Results.recorder(sys, self.record)
         self._corr = self._corr_h = None
         self._refresh_next = False
         self.z = self.solve_algebraic(self.t, self.z) if self._Jdev is not None else self.z

@@ -188,6 +188,40 @@ class Network:
             Y[np.diag_indices(self.nb)] += np.asarray(shunt, dtype=complex)
         return Y
 
+    def ybus_coo(self, branch_status=None, shunt=None):
+        """Bus admittance matrix in coordinate form with a *fixed* pattern [pu].
+
+        Every branch contributes its four entries (zeros when out of service) and
+        every bus its diagonal, so the pattern (``rows``, ``cols``; duplicates are
+        summed) does not change with branch status, loads or faults. This is what
+        the sparse simulator assembles from.
+
+        Returns
+        -------
+        rows, cols : ndarray of int
+            Entry positions (length ``4 nl + nb``; repeated positions add up).
+        vals : ndarray of complex
+            Entry values.
+        """
+        f, t, Yff, Yft, Ytf, Ytt = self.branch_admittances()
+        st = self.branch[:, BR_STATUS] > 0 if branch_status is None else np.asarray(branch_status, bool)
+        on = st.astype(float)
+        d = np.arange(self.nb)
+        ysh = (self.bus[:, GS] + 1j * self.bus[:, BS]) / self.Sb
+        if shunt is not None:
+            ysh = ysh + np.asarray(shunt, dtype=complex)
+        rows = np.concatenate([f, f, t, t, d])
+        cols = np.concatenate([f, t, f, t, d])
+        vals = np.concatenate([Yff * on, Yft * on, Ytf * on, Ytt * on, ysh])
+        return rows, cols, vals
+
+    def ybus_sparse(self, branch_status=None, shunt=None):
+        """Bus admittance matrix [pu] as a ``scipy.sparse`` CSR matrix (see :meth:`ybus`)."""
+        import scipy.sparse as sp
+
+        r, c, v = self.ybus_coo(branch_status, shunt)
+        return sp.csr_matrix((v, (r, c)), shape=(self.nb, self.nb))
+
     def load_admittance(self, V) -> np.ndarray:
         """Constant-impedance equivalent of the bus loads at voltages ``V`` [pu]."""
         S = (self.bus[:, PD] + 1j * self.bus[:, QD]) / self.Sb
@@ -252,7 +286,7 @@ class Network:
                             "set BUS_TYPE = 4 (isolated)")
 
     def _finish_pf(self, V, check_tol):
-        Y = self.ybus()
+        Y = self.ybus_sparse()
         Sinj = V * np.conj(Y @ V)
         Sload = (self.bus[:, PD] + 1j * self.bus[:, QD]) / self.Sb
         Sgen_bus = Sinj + Sload

@@ -15,9 +15,15 @@ with ``si=True`` converts to MW/Mvar, kV, rad/s and degrees.
 
 from __future__ import annotations
 
+import fnmatch
 import math
 
 import numpy as np
+
+from .errors import DataError
+
+#: systems with more DAE variables than this record only machine speeds and angles by default
+RECORD_ALL_MAX = 3000
 
 # unit kind -> (pu label, SI label)
 _LABEL = {"pu": ("pu", "pu"), "power": ("pu (Sb)", "MW"), "voltage": ("pu", "kV"),
@@ -124,12 +130,29 @@ class Results:
 
     # ------------------------------------------------------------- recording
     @staticmethod
-    def recorder(system):
-        return _Recorder(system)
+    def recorder(system, record=None):
+        """A recorder of ``system``'s trajectories.
+
+        Parameters
+        ----------
+        record : None, "all", "machines" or list of str
+            ``"all"``: every state, bus voltage and output; ``"machines"``: the
+            speed and rotor angle of every machine (``"<m>.omega"``,
+            ``"<m>.delta"``); a list: those names, or ``fnmatch`` patterns such
+            as ``"*.omega"`` or ``"bus12.*"``; ``None``: ``"all"`` up to
+            :data:`RECORD_ALL_MAX` DAE variables, ``"machines"`` above (memory
+            and time of recording stay proportional to what is kept).
+        """
+        return _Recorder(system, record)
 
 
 class _Recorder:
-    def __init__(self, sys):
+    def __init__(self, sys, record=None):
+        if record is None:
+            record = "all" if sys.N <= RECORD_ALL_MAX else "machines"
+        if isinstance(record, str) and record not in ("all", "machines"):
+            record = [record]
+        self.record = record
         self.sys = sys
         net = sys.network
         names, kinds = [], []
@@ -140,6 +163,7 @@ class _Recorder:
         self._layout_done = False
         self.names, self.kinds = names, kinds
         self.fn = net.f_hz
+        self.sel = None
 
     def _layout(self, ctx):
         sys = self.sys
@@ -178,7 +202,33 @@ class _Recorder:
             else:
                 fac.append(1.0)
         self.fac = fac
+        self._select()
         self._layout_done = True
+
+    def _select(self):
+        rec = self.record
+        if rec == "all":
+            return
+        if rec == "machines":
+            want = [f"{m}.{s}" for m in self.sys.machine_names for s in ("delta", "omega")]
+        else:
+            want = list(rec)
+        col = {n: i for i, n in enumerate(self.names)}
+        sel = []
+        for w in want:
+            if w in col:
+                sel.append(col[w])
+                continue
+            hits = [col[n] for n in fnmatch.filter(self.names, w)] if any(ch in w for ch in "*?[") else []
+            if not hits:
+                close = [n for n in self.names if w.split(".")[-1] in n][:6]
+                raise DataError("simulation", "record", w, f"no such variable or pattern; e.g. {close}")
+            sel += hits
+        sel = np.array(sorted(set(sel)), dtype=int)
+        self.sel = sel
+        self.names = [self.names[i] for i in sel]
+        self.kinds = [self.kinds[i] for i in sel]
+        self.fac = [self.fac[i] for i in sel]
 
     def _plan(self):
         """Column ranges of each part of a row (set once, after the layout)."""
@@ -193,7 +243,9 @@ class _Recorder:
         self._tm = slice(c, c + nm)
         self._vs = slice(c + nm, c + 2 * nm)
         self._ncol = c + 2 * nm
-        self._buf = np.empty((256, self._ncol))
+        self._states_only = self.sel is not None and (len(self.sel) == 0 or self.sel.max() < nx)
+        self._row = np.empty(self._ncol)
+        self._buf = np.empty((256, self._ncol if self.sel is None else len(self.sel)))
         self._tbuf = np.empty(256)
         self._n = 0
 
@@ -206,7 +258,12 @@ class _Recorder:
             self._tbuf = np.concatenate([self._tbuf, np.empty_like(self._tbuf)])
         sys = self.sys
         nx, nb = sys.nx, sys.nb
-        row = self._buf[self._n]
+        row = self._buf[self._n] if self.sel is None else self._row
+        if self._states_only:     # selected states only: no derived quantities needed
+            self._buf[self._n] = z[self.sel]
+            self._tbuf[self._n] = t
+            self._n += 1
+            return
         row[:nx] = z[:nx]
         Vr, Vi = z[nx:nx + nb], z[nx + nb:]
         bus = row[self._bus]
@@ -218,6 +275,8 @@ class _Recorder:
             row[sl] = out[key]
         row[self._tm] = ctx.sig["tm"]
         row[self._vs] = ctx.sig["vs"]
+        if self.sel is not None:
+            self._buf[self._n] = row[self.sel]
         self._tbuf[self._n] = t
         self._n += 1
 

@@ -29,6 +29,58 @@ SIGNALS = ("omega", "delta", "Pe", "Qe", "Vt", "theta", "XadIfd", "vf", "tm", "v
            "vf0", "tm0", "Pe0", "Qe0", "delta0", "Vt0", "theta0")
 
 
+#: systems with at most this many buses keep a dense copy of the network matrix for the residual
+DENSE_NETWORK_MAX = 150
+
+
+def colour_columns(P):
+    """Greedy (first-fit, in column order) colouring of the columns of a sparse pattern.
+
+    Two columns get different colours when they share a row. Equivalent to the
+    first-fit scan "column ``j`` takes the first colour whose rows do not meet
+    its own", in O(sum over columns of the entries of their neighbour rows).
+
+    Parameters
+    ----------
+    P : scipy.sparse matrix (N × N)
+
+    Returns
+    -------
+    colour : ndarray of int
+        Colour of each column; -1 for empty columns.
+    ncolours : int
+    """
+    import scipy.sparse as sp
+
+    P = sp.csc_matrix(P, dtype=bool)
+    R = P.tocsr()
+    N = P.shape[1]
+    colour = -np.ones(N, dtype=np.int64)
+    cind, cptr = P.indices, P.indptr
+    rind, rptr = R.indices, R.indptr
+    ncol = 0
+    for j in range(N):
+        a, b = cptr[j], cptr[j + 1]
+        if a == b:
+            continue
+        rows = cind[a:b]
+        if len(rows) == 1:
+            nb = rind[rptr[rows[0]]:rptr[rows[0] + 1]]
+        else:
+            nb = np.concatenate([rind[rptr[i]:rptr[i + 1]] for i in rows])
+        used = colour[nb]
+        used = used[used >= 0]
+        if len(used) == 0:
+            k = 0
+        else:
+            taken = np.zeros(ncol + 1, dtype=bool)
+            taken[used] = True
+            k = int(np.argmin(taken))
+        colour[j] = k
+        ncol = max(ncol, k + 1)
+    return colour, ncol
+
+
 def _registry():
     from .exciters import EXDC2, SEXS
     from .governors import HYGOV, TGOV1
@@ -230,20 +282,48 @@ class System:
 
     # ----------------------------------------------------------------- network
     def update_network(self):
-        """Rebuild the network admittance matrix after a topology/load/fault change."""
-        Y = self.network.ybus(self.branch_status, self.y_load + self.fault_shunt)
-        self.Y = Y
-        G, B = Y.real, Y.imag
-        self.Yr = np.block([[G, -B], [B, G]])
+        """Rebuild the network admittance matrix after a topology/load/fault change.
+
+        Sets :attr:`Yr_coo` (``rows, cols, vals`` of ``Y`` in real form
+        ``[[G, -B], [B, G]]`` with a fixed pattern, see :meth:`Network.ybus_coo`),
+        :attr:`Yr` (the same as a CSR matrix) and, for systems with at most
+        :data:`DENSE_NETWORK_MAX` buses, :attr:`Yr_dense` (used for the residual,
+        where a dense product is faster).
+        """
+        import scipy.sparse as sp
+
+        r, c, v = self.network.ybus_coo(self.branch_status, self.y_load + self.fault_shunt)
+        nb = self.nb
+        G, B = v.real, v.imag
+        rr = np.concatenate([r, r, r + nb, r + nb])
+        cc = np.concatenate([c, c + nb, c, c + nb])
+        vv = np.concatenate([G, -B, B, G])
+        self.Yr_coo = (rr, cc, vv)
+        self.Yr = sp.csr_matrix((vv, (rr, cc)), shape=(2 * nb, 2 * nb))
+        self.Yr_dense = self.Yr.toarray() if nb <= DENSE_NETWORK_MAX else None
+        self._Yr_mv = self.Yr_dense if self.Yr_dense is not None else self.Yr
         self.net_version = getattr(self, "net_version", 0) + 1
+
+    @property
+    def Y(self):
+        """Dense complex bus admittance matrix as currently applied [pu] (for inspection)."""
+        return self.network.ybus(self.branch_status, self.y_load + self.fault_shunt)
 
     def bus_vars(self, b) -> list[int]:
         """Global variable indices (Vr, Vi) of bus position ``b``."""
         return [self.nx + b, self.nx + self.nb + b]
 
     def _build_pattern(self):
+        """Device Jacobian pattern (sparse, computed once) and its column colouring.
+
+        Sets :attr:`pattern` (CSC boolean matrix), ``_pr, _pc`` (rows and columns
+        of its entries, column-major), :attr:`colour` (colour of each column,
+        -1 for columns without device entries) and :attr:`ncolours`.
+        Columns of one colour share no row, so they are perturbed together.
+        """
+        import scipy.sparse as sp
+
         N = self.N
-        P = np.zeros((N, N), dtype=bool)
         groups = []
         mgroups = {m: [] for m in range(len(self._machines))}
         for c in self.comps:
@@ -257,30 +337,22 @@ class System:
                 groups += c.pattern(self) or []
         for idx in mgroups.values():
             groups.append((idx, idx))
+        rs, cs = [np.zeros(0, int)], [np.zeros(0, int)]
         for rows, cols in groups:
+            rows, cols = np.asarray(rows, int), np.asarray(cols, int)
             if len(rows) and len(cols):
-                P[np.ix_(np.asarray(rows, int), np.asarray(cols, int))] = True
+                rs.append(np.repeat(rows, len(cols)))
+                cs.append(np.tile(cols, len(rows)))
+        rs, cs = np.concatenate(rs), np.concatenate(cs)
+        P = sp.csc_matrix((np.ones(len(rs), dtype=bool), (rs, cs)), shape=(N, N))
+        P.sum_duplicates()
+        P.sort_indices()
         self.pattern = P
-        # greedy column colouring: columns sharing no row get the same colour
-        colour = -np.ones(N, dtype=int)
-        used: list[np.ndarray] = []
-        for j in range(N):
-            rows = P[:, j]
-            if not rows.any():
-                continue
-            for k, u in enumerate(used):
-                if not (u & rows).any():
-                    colour[j] = k
-                    u |= rows
-                    break
-            else:
-                colour[j] = len(used)
-                used.append(rows.copy())
-        self.colour = colour
-        self.ncolours = len(used)
-        self._pr, self._pc = np.nonzero(P)
-        self._ccols = np.nonzero(colour >= 0)[0]
-        self._pcol = colour[self._pc]
+        self.colour, self.ncolours = colour_columns(P)
+        self._pc = np.repeat(np.arange(N), np.diff(P.indptr))
+        self._pr = P.indices.astype(np.int64)
+        self._ccols = np.nonzero(self.colour >= 0)[0]
+        self._pcol = self.colour[self._pc]
 
     # --------------------------------------------------------------- equations
     def evaluate(self, t: float, z: np.ndarray) -> Context:
@@ -306,14 +378,15 @@ class System:
     def residual(self, t, z):
         """Full residual ``F = [f; g]`` and the evaluation context."""
         F, ctx = self.device_residual(t, z)
-        F[self.nx:] += self.Yr @ z[self.nx:]
+        F[self.nx:] += self._Yr_mv @ z[self.nx:]
         return F, ctx
 
-    def jacobian_devices(self, t, z, F0=None):
-        """Device part of ``dF/dz`` by coloured forward differences (dense array).
+    def device_jacobian_values(self, t, z, F0=None):
+        """Values of the device part of ``dF/dz`` on :attr:`pattern` (entries ``_pr, _pc``).
 
-        All ``ncolours`` perturbed points (and the base point) are evaluated in
-        one batched evaluation.
+        Coloured forward differences: all ``ncolours`` perturbed points (and the
+        base point) are evaluated in one batched evaluation. Cost
+        O(``ncolours`` N).
         """
         h = 1e-7 * np.maximum(1.0, np.abs(z))
         Z = np.repeat(z[None, :], self.ncolours + 1, axis=0)
@@ -322,16 +395,31 @@ class System:
         D = self.device_residual(t, Z)[0]
         if F0 is None:
             F0 = D[0]
-        J = np.zeros((self.N, self.N))
         r, c = self._pr, self._pc
-        J[r, c] = (D[self._pcol + 1, r] - F0[r]) / h[c]
+        return (D[self._pcol + 1, r] - F0[r]) / h[c]
+
+    def jacobian_devices(self, t, z, F0=None):
+        """Device part of ``dF/dz`` as a dense array (see :meth:`device_jacobian_values`)."""
+        J = np.zeros((self.N, self.N))
+        J[self._pr, self._pc] = self.device_jacobian_values(t, z, F0)
         return J
 
     def jacobian(self, t, z):
-        """Full Jacobian ``dF/dz`` (devices by coloured differences + analytic network)."""
+        """Full Jacobian ``dF/dz`` as a dense array (devices by coloured differences + analytic network)."""
         J = self.jacobian_devices(t, z)
-        J[self.nx:, self.nx:] += self.Yr
+        r, c, v = self.Yr_coo
+        np.add.at(J, (r + self.nx, c + self.nx), v)
         return J
+
+    def jacobian_sparse(self, t, z):
+        """Full Jacobian ``dF/dz`` as a ``scipy.sparse`` CSC matrix."""
+        import scipy.sparse as sp
+
+        r, c, v = self.Yr_coo
+        nx = self.nx
+        return sp.csc_matrix((np.concatenate([self.device_jacobian_values(t, z), v]),
+                              (np.concatenate([self._pr, r + nx]), np.concatenate([self._pc, c + nx]))),
+                             shape=(self.N, self.N))
 
     # ---------------------------------------------------------------- naming
     def state_names(self) -> list[str]:
@@ -353,10 +441,14 @@ class System:
     def element_kv(self, name: str) -> float:
         """Base kV of the bus of the element in variable ``name`` (machines/devices); system default 1."""
         inst = name.rsplit(".", 1)[0]
-        for c in self.comps:
-            if inst in c.names and hasattr(c, "bus"):
-                return float(self.network.base_kv[c.bus[c.names.index(inst)]])
-        return 1.0
+        cache = getattr(self, "_kv_cache", None)
+        if cache is None or cache[0] is not self.comps:
+            kv = {}
+            for c in reversed(self.comps):   # the first component holding a name wins
+                if hasattr(c, "bus"):
+                    kv.update({nm: float(self.network.base_kv[c.bus[i]]) for i, nm in enumerate(c.names)})
+            cache = self._kv_cache = (self.comps, kv)
+        return cache[1].get(inst, 1.0)
 
     def state_units(self) -> list[str]:
         units = ["pu"] * self.nx

@@ -1,0 +1,222 @@
+"""Scaling benchmark: weakgrid.sim and ANDES on the same grids, from 10 to 2869 buses.
+
+Not a test: prints a table, asserts nothing.
+
+Cases (each tool gets the same data):
+
+* ``kundur_full`` — the ANDES stock case (GENROU + EXDC2 + TGOV1), imported into weakgrid
+  through ``weakgrid.sim.io.andes``; its line trip disabled.
+* ``case39``, ``case118``, ``case300``, ``case1354pegase``, ``case2869pegase`` — the MATPOWER
+  cases pandapower ships, with a classical machine (GENCLS) at every in-service generator from
+  ``weakgrid.sim.templates.classical_system`` (H = 4 s, x'd = 0.3 pu, D = 0 on each machine's
+  rating). ANDES gets the same MATPOWER dict through ``andes.io.matpower.mpc2system`` and the
+  same GENCLS parameters through ``System.add``.
+
+Scenario: 10 s at a fixed step of 1/120 s, one three-phase fault (xf = 1e-4 pu) from 1.0 to
+1.05 s at the bus with the most branch ends (kundur_full: bus 8). Timed: the integration only
+(ANDES ``TDS.run``; weakgrid ``Simulator.run``), median of ``--repeat`` runs. Each tool and case
+runs in its own subprocess, whose peak resident memory (``ru_maxrss``, whole process including
+imports) is reported, with the resident memory after the imports (numpy, SciPy, pandapower,
+ANDES where used) in brackets. The speed
+deviation is the largest difference of any machine speed between the two tools [pu] over the
+run (linear interpolation on a common grid).
+
+Tolerances: ANDES's default TDS tolerance (1e-4); weakgrid's default Newton tolerance (1e-7).
+
+Run:  PYTHONPATH=src python benchmarks/bench_scale.py [--repeat 3] [--cases kundur_full,case118]
+      [--solver auto|dense|sparse] [--lu klu|superlu] [--tools weakgrid,andes]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+CASES = ["kundur_full", "case39", "case118", "case300", "case1354pegase", "case2869pegase"]
+TF, H, T_ON, T_OFF = 10.0, 1 / 120, 1.0, 1.05
+TEMPLATE = dict(H=4.0, xd1=0.3, D=0.0)
+PEER = {"kundur_full": ("kundur/kundur_full.xlsx", 8)}
+
+
+def _rss_mb():
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def fault_bus(mpc):
+    """The bus with the most branch ends (lowest number on ties)."""
+    br = np.asarray(mpc["branch"])
+    ends = np.concatenate([br[:, 0], br[:, 1]]).astype(int)
+    ids, cnt = np.unique(ends, return_counts=True)
+    return int(ids[np.argmax(cnt)])
+
+
+# ------------------------------------------------------------------ children
+def child_weakgrid(case, repeat, solver, lu, out):
+    import pandapower.networks  # noqa: F401  (imports before the baseline memory)
+
+    from weakgrid.sim.events import Fault
+    from weakgrid.sim.integrate import Simulator
+    from weakgrid.sim.templates import classical_system, matpower_case
+
+    if case in PEER:
+        import andes  # noqa: F401
+    base = _rss_mb()
+    walls = []
+    for _ in range(repeat):
+        if case in PEER:
+            from weakgrid.sim.peer.andes_runs import build_weakgrid
+
+            path, bus = PEER[case]
+            s, events, names = build_weakgrid(path, fault=(bus, T_ON, T_OFF), disable_toggles=True)
+            s.setup()
+        else:
+            mpc = matpower_case(case)
+            s = classical_system(mpc, **TEMPLATE)
+            events = [Fault(fault_bus(mpc), T_ON, T_OFF)]
+            names = s.machine_names
+        sim = Simulator(s, dt=H, linear_solver=solver, sparse_lu=lu,
+                        record=[f"{n}.omega" for n in names])
+        t0 = time.perf_counter()
+        res = sim.run(TF, events=events, on_failure="return")
+        walls.append(time.perf_counter() - t0)
+    omega = np.column_stack([res[f"{n}.omega"] for n in names])
+    np.savez(out, t=res.t, omega=omega)
+    return dict(N=int(s.N), wall=walls, ok=bool(res.ok and res.t[-1] > TF - 1e-9),
+                failure=str(res.failure) if res.failure else None, solver=sim.linsolver.name,
+                stats=res.stats, rss=_rss_mb(), rss_base=base)
+
+
+def child_andes(case, repeat, out):
+    import andes
+    import pandapower.networks  # noqa: F401
+    from andes.io.matpower import mpc2system
+
+    from weakgrid.sim.templates import classical_parameters, matpower_case
+
+    andes.config_logger(40)
+    base = _rss_mb()
+    walls = []
+    for _ in range(repeat):
+        if case in PEER:
+            from weakgrid.sim.peer.andes_runs import load_andes
+
+            path, bus = PEER[case]
+            ss = load_andes(path, fault=(bus, T_ON, T_OFF), disable_toggles=True)
+        else:
+            mpc = matpower_case(case)
+            ss = andes.System(default_config=True, no_output=True)
+            mpc2system(mpc, ss)
+            kv = {int(b[0]): float(b[9]) for b in mpc["bus"]}
+            for p in classical_parameters(mpc, **TEMPLATE):
+                ss.add("GENCLS", {"bus": p["bus"], "gen": p["gen"] + 1, "Sn": p["Sn"], "Vn": kv[p["bus"]],
+                                  "M": p["M"], "D": p["D"], "ra": p["ra"], "xd1": p["xd1"], "fn": 60.0})
+            ss.add("Fault", {"bus": fault_bus(mpc), "tf": T_ON, "tc": T_OFF})
+        ss.setup()
+        ss.PFlow.config.tol = 1e-11
+        ss.PFlow.run()
+        ss.TDS.config.tf = TF
+        ss.TDS.config.tstep = H
+        ss.TDS.config.fixt = 1
+        ss.TDS.config.shrinkt = 0
+        ss.TDS.config.no_tqdm = 1
+        t0 = time.perf_counter()
+        ss.TDS.run()
+        walls.append(time.perf_counter() - t0)
+    gen = ss.GENROU if ss.GENROU.n else ss.GENCLS
+    ts = ss.dae.ts
+    np.savez(out, t=np.asarray(ts.t), omega=np.asarray(ts.x[:, gen.omega.a]))
+    return dict(N=int(ss.dae.n + ss.dae.m), wall=walls, ok=bool(ss.exit_code == 0 and ts.t[-1] > TF - 1e-6),
+                failure=None, rss=_rss_mb(), rss_base=base)
+
+
+def run_child(tool, case, repeat, solver, lu, tmp):
+    out = str(Path(tmp) / f"{tool}_{case}.npz")
+    cmd = [sys.executable, __file__, "--child", tool, "--cases", case, "--repeat", str(repeat),
+           "--solver", solver, "--lu", lu, "--out", out]
+    p = subprocess.run(cmd, capture_output=True, text=True, env=os.environ.copy())
+    lines = [ln for ln in p.stdout.splitlines() if ln.startswith("{")]
+    if p.returncode != 0 or not lines:
+        return {"error": (p.stderr.strip().splitlines() or ["?"])[-1]}, None
+    info = json.loads(lines[-1])
+    d = np.load(out)
+    return info, {"t": d["t"], "omega": d["omega"]}
+
+
+def speed_deviation(a, b):
+    from weakgrid.sim.peer.andes_runs import interp_to
+
+    tg = np.linspace(0.0, min(a["t"][-1], b["t"][-1]), 4001)
+    return float(np.max(np.abs(interp_to(tg, a["t"], a["omega"]) - interp_to(tg, b["t"], b["omega"]))))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--cases", default=",".join(CASES))
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--solver", default="auto", choices=["auto", "dense", "sparse"])
+    ap.add_argument("--lu", default="klu", choices=["klu", "superlu"])
+    ap.add_argument("--tools", default="weakgrid,andes")
+    ap.add_argument("--child")
+    ap.add_argument("--out")
+    a = ap.parse_args()
+    cases = a.cases.split(",")
+    if a.child:
+        import logging
+        import warnings
+
+        warnings.simplefilter("ignore")
+        logging.disable(logging.WARNING)
+        if a.child == "weakgrid":
+            info = child_weakgrid(cases[0], a.repeat, a.solver, a.lu, a.out)
+        else:
+            info = child_andes(cases[0], a.repeat, a.out)
+        print(json.dumps(info))
+        return
+    tools = a.tools.split(",")
+    print(f"10 s, step 1/120 s, fault 1.0-1.05 s; median of {a.repeat}; weakgrid solver={a.solver} lu={a.lu}")
+    hdr = ("| case | DAE size (weakgrid / ANDES) | weakgrid | ANDES | weakgrid / ANDES | speed-up |"
+           " max speed deviation [pu] | peak memory weakgrid / ANDES [MB] |")
+    print(hdr)
+    print("|" + "---|" * 8)
+    with tempfile.TemporaryDirectory() as tmp:
+        for case in cases:
+            r = {}
+            for tool in tools:
+                r[tool] = run_child(tool, case, a.repeat, a.solver, a.lu, tmp)
+            w, an = r.get("weakgrid", ({}, None)), r.get("andes", ({}, None))
+
+            def cell(info, key):
+                if not info:
+                    return "-"
+                if "error" in info:
+                    return f"error: {info['error'][:60]}"
+                if key == "wall":
+                    return f"{statistics.median(info['wall']):.2f} s" + ("" if info["ok"] else " (failed)")
+                if key == "mem":
+                    return f"{info['rss']:.0f} ({info['rss_base']:.0f})"
+                return str(info[key])
+
+            ratio = speed = dev = "-"
+            if w[0] and an[0] and "error" not in w[0] and "error" not in an[0]:
+                tw, ta = statistics.median(w[0]["wall"]), statistics.median(an[0]["wall"])
+                ratio, speed = f"{tw / ta:.3f}", f"{ta / tw:.1f}x"
+                if w[0]["ok"] and an[0]["ok"]:
+                    dev = f"{speed_deviation(w[1], an[1]):.1e}"
+            solver = f" [{w[0]['solver']}]" if w[0] and "solver" in w[0] else ""
+            print(f"| {case}{solver} | {cell(w[0], 'N')} / {cell(an[0], 'N')} | {cell(w[0], 'wall')} | "
+                  f"{cell(an[0], 'wall')} | {ratio} | {speed} | {dev} | {cell(w[0], 'mem')} / "
+                  f"{cell(an[0], 'mem')} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
