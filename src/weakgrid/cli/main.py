@@ -8,8 +8,10 @@ import sys
 from .. import __version__
 from ..game.errors import WeakgridError
 from . import export, gamma, reproduce, simulate, train, verify
+from . import design, modes, run  # studies
 
 SUBCOMMANDS = [train, gamma, verify, export, simulate, reproduce]
+SUBCOMMANDS += [design, run, modes]
 
 
 def build_parser() -> argparse.ArgumentParser:
