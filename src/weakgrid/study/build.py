@@ -358,7 +358,8 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
         def measure(sim, t, z, ctx):
             m = meas(sim, t, z, ctx)
             return np.array([m[0], m[1] * ws])              # speed error pu -> rad/s
-    speed_of = d["report"].get("speed_of") or (ctl_name if der.machine == "sg" else
+    speed_of = d["report"].get("speed_of")
+    speed_of = speed_of if speed_of is not None else (ctl_name if der.machine == "sg" else
                                                (dyn["generator"][0]["name"]
                                                 if dyn["generator"] else None))
     signals = {"shunt_bus_v": f"bus{r_id}.v"}

@@ -43,7 +43,8 @@ def figure_specs(study, quick=False) -> list[dict]:
     kind_gti = any(g["name"] == study.data["machine"]["name"] for g in
                    study.data["dynamics"]["gti"])
     for sc in study.scenarios(quick):
-        panels = ["sg_speed"] + (["dc_voltage"] if kind_gti else []) + ["vu", "p_series_mw"]
+        speed = [] if study.data["report"].get("speed_of") == "" else ["sg_speed"]
+        panels = speed + (["dc_voltage"] if kind_gti else []) + ["vu", "p_series_mw"]
         out.append({"id": f"{study.name}-{sc['id']}", "title": f"{study.name}: {sc['id']}",
                     "panels": panels,
                     "runs": [[f"{sc['id']}-{c}", c] for c in sc["controllers"]]})

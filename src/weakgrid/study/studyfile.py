@@ -18,7 +18,9 @@ Tables (defaults in brackets)::
                   [cost], [mesh], [basis], [initial_policy], [solver] (override the preset)
     [controllers] compare [["hji", "lqr", "pss-only"]], [controllers.NAME] options
     [[scenarios]] id, load, upqc, t_end, controllers, events, bypass, quick
-    [report]      speed_of, notes;   [[figures]], [[claims]]
+    [report]      speed_of [the controlled SG, else the first generator; "" for none], notes
+    [[figures]]   id, title, panels, runs = [[run id, label]]  [one figure per scenario]
+    [[claims]]    id, case, paper, rule, judge (weakgrid.study.claims.RULES), parameters
 """
 
 from __future__ import annotations
