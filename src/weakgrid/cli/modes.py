@@ -45,7 +45,8 @@ def run(args) -> int:
         mark = "=>" if r["mode"] == k_m else "  "
         print(f"  {mark}{r['mode']:>5} {r['real']:>10.4g} {r['imag']:>10.4g} {r['f_hz']:>8.4g} "
               f"{r['zeta']:>7.3f}  {r['dominant']}")
-    unstable = [lam for lam in m.eigenvalues if lam.real > 1e-6]
+    # |λ| < 1e-4: the rigid-body (angle reference) modes, numerically zero
+    unstable = [lam for lam in m.eigenvalues if lam.real > 1e-6 and abs(lam) > 1e-4]
     if unstable:
         print(f"  {len(unstable)} eigenvalue(s) with positive real part: "
               f"{', '.join(f'{x:.3g}' for x in unstable)}")
