@@ -79,10 +79,11 @@ def _design_notes(study, setup, check):
     pre = load_preset(study.data["design"]["settings"]).system
     rel = {k: (getattr(d, k) - getattr(pre, k)) / getattr(pre, k)
            for k in ("a", "Vr_bar", "phi_s0")}
-    notes = [f"{study.name}, {setup.load} load, {setup.upqc} UPQC: derived a {rel['a']:+.2%}, "
-             f"V̄r {rel['Vr_bar']:+.2%}, ϕs0 {rel['phi_s0']:+.2%} from the "
-             f"{study.data['design']['settings']} preset (whose Q, R, P, γ, Ω, mesh, basis and "
-             "initial policy the training uses)"]
+    notes = [f"{study.name}, {setup.load} load, {setup.upqc} UPQC: the training uses Q, R, P, γ, "
+             f"Ω, mesh, basis and initial policy of the {study.data['design']['settings']} "
+             "preset" + (f"; derived a {rel['a']:+.2%}, V̄r {rel['Vr_bar']:+.2%}, ϕs0 "
+                         f"{rel['phi_s0']:+.2%} from its design model"
+                         if study.data["study"]["reproduce"] else "")]
     if not check["ok"]:
         notes.append(f"MISMATCH: the design model's mode ({check['design_f_hz']:.3g} Hz) differs "
                      f"from the full grid's mode of the controlled machine "
