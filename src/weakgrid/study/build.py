@@ -13,6 +13,10 @@ Grid kinds (``[grid] kind``):
   controlled generators, e.g. a wind turbine that becomes a GTI; ``bus`` moves it),
   ``add_impedance``, ``add_gen`` (``p_mw`` a number or a table per level).
 * ``matpower`` — ``file`` (a ``.m``/``.mat`` case); ``loads.levels`` scale PD, QD.
+* ``andes`` — ``file`` (any case ANDES parses: PSS/E ``.raw``, ``.xlsx``, ``.json``; ``andes:``
+  prefix for ANDES's stock cases) and ``dyr`` (PSS/E dynamic data): machines and controls come
+  from the file (named ``GENROU_<idx>`` …), the UPQC is an existing ``Line`` (``upqc.branch`` =
+  its idx; ``upqc.side = "to"`` when its bus2 is the shunt bus).
 
 Buses are referred to by external number (inline/matpower), or by pandapower name or index.
 The UPQC is either an existing series branch (``upqc.branch``: a branch name, a row, or
@@ -206,7 +210,7 @@ def _pp_bus_ids(net) -> dict:
 
 # ----------------------------------------------------------------------------- setup
 def _network(study, load):
-    """``(Network, bus_id name→number, branch names, upqc row)`` of the study at ``load``."""
+    """``(Network, bus_id name→number, branch names, upqc row, System or None)`` at ``load``."""
     g = study.data["grid"]
     up = study.data["upqc"]
     if g["kind"] == "pandapower":
@@ -247,7 +251,9 @@ def _network(study, load):
         if len(rows) != 1:
             raise ParameterError("upqc.branch", up.get("branch", up.get("insert")),
                                  "no unique series branch from the shunt bus to that bus")
-        return network, bus_id, {}, rows[0]
+        return network, bus_id, {}, rows[0], None
+    if g["kind"] == "andes":
+        return _andes_network(study, g, up)
     if g["kind"] == "inline":
         case, names, bus_id = _inline_case(g, load)
         f_hz = float(g.get("f_hz", 60.0))
@@ -281,7 +287,41 @@ def _network(study, load):
         k_up = row_of(up["branch"], "upqc.branch")
     network = Network(case)
     network.f_hz = f_hz
-    return network, bus_id, names, k_up
+    return network, bus_id, names, k_up, None
+
+
+def _andes_file(study, name):
+    if name.startswith("andes:"):
+        import andes
+
+        return andes.get_case(name[len("andes:"):])
+    return str(study.resolve(name))
+
+
+def _andes_network(study, g, up):
+    """An ANDES/PSS/E case (``file``, optional ``dyr``) with its machines and controls."""
+    try:
+        import andes
+    except ImportError:
+        raise ParameterError("grid.kind", "andes", "install the optional ANDES parser: "
+                             "pip install 'weakgrid[andes]'") from None
+    from ..sim.io.andes import from_andes
+
+    addfile = _andes_file(study, g["dyr"]) if g.get("dyr") else None
+    logging.getLogger("andes").setLevel(logging.ERROR)
+    ss = andes.load(_andes_file(study, g["file"]), addfile=addfile, setup=False,
+                    no_output=True, default_config=True)
+    system, _ = from_andes(ss, include_events=False)
+    bus_id = {str(k): int(v) for k, v in system.andes_bus_id.items()}
+    names = {str(k): int(v) for k, v in system.andes_line_row.items()}
+    if up.get("insert"):
+        raise ParameterError("upqc.insert", up["insert"], "for an ANDES grid put the UPQC into "
+                             "an existing plain series branch: upqc.branch = LINE idx")
+    ref = str(up["branch"])
+    if ref not in names:
+        raise ParameterError("upqc.branch", up["branch"], f"no ANDES Line with that idx; "
+                             f"choose one of {list(names)}")
+    return system.network, bus_id, names, names[ref], system
 
 
 def build_setup(study, load: str | None = None, upqc: str | None = None,
@@ -294,9 +334,12 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
     upqc = upqc or d["upqc"]["structure"]
     if variant not in VARIANTS:
         raise ParameterError("variant", variant, f"choose one of {VARIANTS}")
-    network, bus_id, br_names, k_up = _network(study, load)
+    network, bus_id, br_names, k_up, system = _network(study, load)
+    if d["upqc"].get("side", "from") == "to":     # the branch's to-bus is the shunt bus r
+        row = network.branch[k_up]
+        row[F_BUS], row[T_BUS] = row[T_BUS], row[F_BUS]
     r_id = int(network.branch[k_up, F_BUS])
-    s = System(network)
+    s = system if system is not None else System(network)
     net = s.network
     gbus = net.gen[:, GEN_BUS].astype(int)
 

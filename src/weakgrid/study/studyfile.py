@@ -38,7 +38,7 @@ __all__ = ["Study", "load_study", "study_from_dict", "get_path", "set_path", "sh
 
 TOP = {"study", "grid", "dynamics", "machine", "upqc", "design", "controllers", "scenarios",
        "report", "figures", "claims"}
-GRID_KINDS = ("inline", "pandapower", "matpower")
+GRID_KINDS = ("inline", "pandapower", "matpower", "andes")
 STRUCTURES = ("conventional", "reduced")
 EVENT_KINDS = ("fault", "line_trip", "load_step")
 
@@ -283,11 +283,12 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
             _num(gt, k, w, positive=k != "tau")
     m = _need(d, "machine", "study file", dict)
     _keys(m, {"name"}, "machine")
-    if _need(m, "name", "machine", str) not in names:
+    if _need(m, "name", "machine", str) not in names and g["kind"] != "andes":
         raise ParameterError("machine.name", m["name"], f"no generator or GTI of that name in "
                              f"[dynamics]; choose one of {names}")
     up = _need(d, "upqc", "study file", dict)
-    _keys(up, {"name", "branch", "insert", "structure", "rating"}, "upqc")
+    _keys(up, {"name", "branch", "side", "insert", "structure", "rating"}, "upqc")
+    _choice(up, "side", "upqc", ("from", "to"), "from")
     up.setdefault("name", "UPQC")
     up["structure"] = _choice(up, "structure", "upqc", STRUCTURES, "conventional")
     up["rating"] = _num(up, "rating", "upqc", 0.2, positive=True)
