@@ -65,13 +65,14 @@ def test_dotted_paths_and_defaults():
     assert st.get("scenarios.c2-high-f200.events.0.xf") == 0.01
     assert st.get("scenarios.1.id") == "c2-high-f100"
     # defaults a user expects: bypass = the fault windows, controllers = the compared ones
-    assert st.get("scenarios.c2-high-f200.bypass") == [[3.0, 3.2]]
+    assert st.scenarios()[0]["bypass"] == [[3.0, 3.2]]
     assert st.get("scenarios.c2-high-f200.controllers") == ["hji", "lqr", "pss-only"]
     with pytest.raises(ParameterError, match="upqc.ratin"):
         st.get("upqc.ratin")
     # a fault may be given by its duration
     st2 = st.with_values(**{"scenarios.c2-high-f200.events.0.duration": 0.15})
     assert st2.get("scenarios.c2-high-f200.events.0.t_off") == pytest.approx(3.15)
+    assert st2.scenarios()[0]["bypass"] == [[3.0, pytest.approx(3.15)]]   # follows the fault
     assert st.get("scenarios.c2-high-f200.events.0.t_off") == 3.2     # the original unchanged
 
 

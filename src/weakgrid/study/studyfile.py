@@ -221,9 +221,13 @@ class Study:
         return list(self.data["controllers"]["compare"])
 
     def scenarios(self, quick: bool = False) -> list[dict]:
-        """Scenarios (dicts) of a full or a quick run; quick uses each scenario's ``quick``."""
+        """Scenarios (dicts, with their defaults) of a full or a quick run; quick uses each
+        scenario's ``quick`` settings and leaves out scenarios without them."""
         out = []
         for sc in self.data["scenarios"]:
+            if "bypass" not in sc:
+                sc = dict(sc, bypass=[[e["t_on"], e["t_off"]] for e in sc["events"]
+                                      if e["kind"] == "fault"])
             if quick:
                 q = sc.get("quick")
                 if not q:
@@ -351,9 +355,9 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         evs = sc.setdefault("events", [])
         for j, ev in enumerate(evs):
             _event(ev, f"{w}.events.{j}", sc["t_end"])
-        if "bypass" not in sc:
-            sc["bypass"] = [[e["t_on"], e["t_off"]] for e in evs if e["kind"] == "fault"]
-        for j, b in enumerate(sc["bypass"]):
+        # bypass: default = the fault windows, computed when used (so that it follows the
+        # faults when a field is changed later), see Study.scenarios
+        for j, b in enumerate(sc.get("bypass", [])):
             if not (isinstance(b, list) and len(b) == 2 and b[0] < b[1]):
                 raise ParameterError(f"{w}.bypass.{j}", b, "give [t_start, t_end] with "
                                      "t_start < t_end (s)")
