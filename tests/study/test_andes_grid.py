@@ -36,3 +36,17 @@ def test_kundur_generator_behind_a_upqc_in_its_step_up_transformer():
     assert der.twoport.B == pytest.approx(1 / (gm.p["xd1"][i] + Xu), rel=1e-12)
     chk = mode_check(s)
     assert chk["grid_lambda"] is not None and chk["participation"] > 0.3
+
+
+def test_kundur_upqc_inserted_into_a_line():
+    pytest.importorskip("andes")
+    d = kundur_study()
+    d["upqc"] = {"insert": {"branch": "Line_13", "side": "to", "x": 0.01}, "rating": 0.1}
+    s = build_setup(study_from_dict(d))
+    net = s.system.network
+    assert s.shunt_bus == s.bus("9") and net.nb == 11 and net.nl == 16   # 10 buses, 15 lines + 1
+    gm = s.system.components["GENROU"]
+    i = gm.names.index("GENROU_3")
+    # G3 now sees its transformer and the series transformer in series: a path over 2 branches
+    x_tr = float(net.branch[s.branch_names["Line_13"], 3])
+    assert s.derivation.twoport.B == pytest.approx(1 / (gm.p["xd1"][i] + x_tr + 0.01), rel=1e-9)

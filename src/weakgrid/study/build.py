@@ -16,7 +16,8 @@ Grid kinds (``[grid] kind``):
 * ``andes`` — ``file`` (any case ANDES parses: PSS/E ``.raw``, ``.xlsx``, ``.json``; ``andes:``
   prefix for ANDES's stock cases) and ``dyr`` (PSS/E dynamic data): machines and controls come
   from the file (named ``GENROU_<idx>`` …), the UPQC is an existing ``Line`` (``upqc.branch`` =
-  its idx; ``upqc.side = "to"`` when its bus2 is the shunt bus).
+  its idx; ``upqc.side = "to"`` when its bus2 is the shunt bus) or inserted into one
+  (``upqc.insert = {branch = idx, side, r, x}``, pu on the system base).
 
 Buses are referred to by external number (inline/matpower), or by pandapower name or index.
 The UPQC is either an existing series branch (``upqc.branch``: a branch name, a row, or
@@ -314,13 +315,18 @@ def _andes_network(study, g, up):
     system, _ = from_andes(ss, include_events=False)
     bus_id = {str(k): int(v) for k, v in system.andes_bus_id.items()}
     names = {str(k): int(v) for k, v in system.andes_line_row.items()}
-    if up.get("insert"):
-        raise ParameterError("upqc.insert", up["insert"], "for an ANDES grid put the UPQC into "
-                             "an existing plain series branch: upqc.branch = LINE idx")
-    ref = str(up["branch"])
+    ins = up.get("insert")
+    ref = str(ins.get("branch", ins.get("index")) if ins else up["branch"])
     if ref not in names:
-        raise ParameterError("upqc.branch", up["branch"], f"no ANDES Line with that idx; "
-                             f"choose one of {list(names)}")
+        raise ParameterError("upqc.insert.branch" if ins else "upqc.branch", ref,
+                             f"no ANDES Line with that idx; choose one of {list(names)}")
+    if ins:     # a new bus and series branch (pu on the system base), appended to the tables
+        net = system.network
+        case, k_up, _, _ = insert_upqc_matpower(net.case, names[ref], ins["side"],
+                                                ins.get("r", 0.0), ins["x"])
+        system.network = Network(case, f_hz=net.f_hz)
+        names[up["name"]] = k_up
+        return system.network, bus_id, names, k_up, system
     return system.network, bus_id, names, names[ref], system
 
 
