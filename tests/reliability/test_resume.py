@@ -5,8 +5,16 @@ from __future__ import annotations
 import numpy as np
 
 from weakgrid.study.cache import inputs_key, load_run, remove_stale, save_run
-from weakgrid.study.runner import RunRecord
-from weakgrid.study.scenarios import C1, Scenario
+from weakgrid.study.runner import Run, RunRecord
+
+
+def Scenario(sid, case, load, upqc, controller, t_on, t_off, t_end):
+    return Run(sid, case, "sc", load, upqc, controller, t_end,
+               ({"kind": "fault", "bus": 3, "t_on": t_on, "t_off": t_off, "rf": 0.0,
+                 "xf": 0.1},), ((t_on, t_off),))
+
+
+C1 = "case1-weak-grid"
 
 
 def _rec(sc):

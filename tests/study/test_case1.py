@@ -12,8 +12,7 @@ from weakgrid.models import UPQCDesignModel
 from weakgrid.sim.controllers import DigitalController, UPQCTarget
 from weakgrid.sim.events import Fault
 from weakgrid.sim.integrate import simulate
-from weakgrid.study.cases import build_case
-from weakgrid.study.cases.case1 import load_data
+from paper_setups import build_case, study_data
 
 NAME = "case1-weak-grid"
 PRESET = {"T": 8.100248e-4, "a": 896.8810, "Vr_bar": 0.8337510, "phi_s0": 0.3136904}
@@ -79,7 +78,7 @@ def test_pq_variant_has_no_upqc():
 
 
 def test_design_model_is_derived_from_the_operating_point(high):
-    d, s, data = high.design, high.system, load_data()
+    d, s, data = high.design, high.system, study_data(NAME)
     assert isinstance(d, UPQCDesignModel) and d.machine == "gti"
     net, gti = s.network, s.components["GTI"]
     r = net.index_of(high.shunt_bus)
@@ -90,8 +89,8 @@ def test_design_model_is_derived_from_the_operating_point(high):
         pytest.approx([0.0, 0.0], abs=1e-12)
     # a = τ(1+χ)·Vs·B/C with B the transfer susceptance GTI → Vr+Vu; nearly the lossless
     # series sum 1/(1/B_gti + X_feeder + X_upqc) (the feeder's R and charging are small)
-    g = data["gti"]
-    x = {br["role"]: br["x"] for br in data["branch"]}
+    g = data["dynamics"]["gti"][0]
+    x = {br["name"]: br["x"] for br in data["grid"]["branch"]}
     B_series = 1.0 / (1.0 / g["B"] + x["feeder"] + x["upqc"])
     B = high.info["design_details"]["B_eff"]
     assert B == pytest.approx(B_series, rel=0.02)
@@ -179,7 +178,7 @@ def test_simulated_swing_matches_design_model(load, channel):
     assert r.ok
     t, i = np.unique(r.t, return_index=True)
     ph = r[cb.signals["phi_hat"]][i]
-    w = r[cb.signals["vr"]][i] - d.Vr_bar
+    w = r[cb.signals["shunt_bus_v"]][i] - d.Vr_bar
     k = t > 0.1
     f_sim, n = _zero_crossing_frequency(t[k], ph[k])
     f_design = np.sqrt(d.a * d.Vr_bar * np.cos(d.phi_s0)) / (2 * np.pi)
@@ -212,7 +211,7 @@ def test_simulated_swing_matches_design_model(load, channel):
 def test_fault_with_idle_upqc_is_survived_at_high_load():
     """The paper's fault (0.2 s → 0.25 s) with the UPQC idle (u = 0)."""
     cb = build_case(NAME, "high")
-    f = load_data()["fault"]
+    f = study_data(NAME)["scenarios"][0]["events"][0]
     r = simulate(cb.system, 8.0, dt=2e-3,
                  events=[Fault(cb.fault_bus, f["t_on"], f["t_off"], rf=f["rf"], xf=f["xf"])])
     assert r.ok
@@ -220,7 +219,7 @@ def test_fault_with_idle_upqc_is_survived_at_high_load():
     ph, ups, w, vc = r[sig["phi_hat"]], r[sig["upsilon"]], r[sig["sg_speed"]], r[sig["dc_voltage"]]
     assert np.all(np.isfinite(r.data))
     # the fault is felt (the shunt-bus voltage collapses, the GTI swings) ...
-    assert r[sig["vr"]][(t > 0.21) & (t < 0.24)].max() < 0.5
+    assert r[sig["shunt_bus_v"]][(t > 0.21) & (t < 0.24)].max() < 0.5
     assert np.max(np.abs(ph)) > 0.2
     # ... and the swing stays inside the paper's training region Ω (|ϕ̂| ≤ 1, |υ| ≤ 10 + 10 %)
     assert np.max(np.abs(ph)) < 1.0 and np.max(np.abs(ups)) < 11.0

@@ -9,11 +9,16 @@ import pandas as pd
 import pytest
 
 from weakgrid.cli.main import main
-from weakgrid.study.figures import FIGURES
+from weakgrid.study.figures import PANELS, figure_specs
 from weakgrid.study.report import COLUMNS
-from weakgrid.study.scenarios import paper_scenarios
+from weakgrid.study.reproduce import paper_studies
 
 pytestmark = pytest.mark.slow
+
+
+FIGURES = [(f["id"], f["title"], [(k, PANELS[k]) for k in f["panels"]], f["runs"])
+           for st in paper_studies() for f in figure_specs(st, quick=True)]
+RUN_IDS = [f"{sc['id']}-{c}" for st in paper_studies() for sc, c in st.runs(quick=True)]
 
 
 @pytest.fixture(scope="module")
@@ -29,9 +34,10 @@ def test_every_file_is_written(output):
         assert (output / "figures" / f"{fig_id}.svg").stat().st_size > 1000
     for name in ("metrics.csv", "metrics.md", "report.html", "claims.json"):
         assert (output / name).stat().st_size > 100
-    for sc in paper_scenarios(quick=True):
-        assert (output / "runs" / f"{sc.id}.parquet").exists()
-        assert json.loads((output / "runs" / f"{sc.id}.json").read_text())["metrics"]["id"] == sc.id
+    assert len(FIGURES) == 18 and len(RUN_IDS) == 12
+    for rid in RUN_IDS:
+        assert (output / "runs" / f"{rid}.parquet").exists()
+        assert json.loads((output / "runs" / f"{rid}.json").read_text())["metrics"]["id"] == rid
 
 
 def test_figures_are_valid_and_labelled(output):
@@ -48,7 +54,7 @@ def test_figures_are_valid_and_labelled(output):
 
 def test_table_holds_every_metric_for_every_run(output):
     df = pd.read_csv(output / "metrics.csv")
-    ids = [s.id for s in paper_scenarios(quick=True)]
+    ids = RUN_IDS
     assert sorted(df["id"]) == sorted(ids)
     for key, _ in COLUMNS:
         assert key in df.columns
@@ -62,3 +68,8 @@ def test_report_has_a_verdict_per_claim(output):
     assert all(c["verdict"] in ("reproduced", "partly", "not", "not run") for c in claims)
     html = (output / "report.html").read_text()
     assert all(c["id"] in html for c in claims)
+    # the design models with their mode check, for both studies
+    designs = json.loads((output / "designs.json").read_text())["designs"]
+    assert {d["case"] for d in designs} == {"case1-weak-grid", "case2-lv-microgrid"}
+    for d in designs:
+        assert d["mode_check"]["ok"], d["modes"]     # within 5 % on the paper's grids

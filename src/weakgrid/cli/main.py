@@ -26,8 +26,10 @@ import traceback
 
 from .. import __version__
 from . import export, gamma, reproduce, simulate, train, verify
+from . import design, modes, run  # studies
 
 SUBCOMMANDS = [train, gamma, verify, export, simulate, reproduce]
+SUBCOMMANDS += [design, run, modes]
 
 EXIT_OK, EXIT_INPUT, EXIT_RUN, EXIT_BUG, EXIT_INTERRUPT = 0, 2, 3, 4, 130
 

@@ -1,67 +1,74 @@
-"""``weakgrid simulate``: one scenario of a case with one controller."""
+"""``weakgrid simulate``: one scenario of a study with one controller."""
 
 from __future__ import annotations
 
 import argparse
 
-from ._common import nonnegative_float, output_file, positive_float
+from ._common import output_file, positive_float
 
 NAME = "simulate"
 
 
 def add_parser(sub):
     """Add ``weakgrid simulate`` to the subcommand parsers ``sub``; return its parser."""
-    from ..study.cases import case_names
-    from ..study.controllers import CONTROLLERS
-
     p = sub.add_parser(
-        NAME, help="simulate one case with one controller",
-        description="Build a case at a load level, attach a controller to the UPQC (or the "
-                    "PQ baseline), apply the paper's three-phase fault and print the metrics.",
+        NAME, help="simulate one scenario of a study with one controller",
+        description="Build the study's grid at the scenario's operating point, attach the "
+                    "controller to the UPQC (or the PQ baseline), apply the scenario's events "
+                    "and print the metrics.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    p.add_argument("case", choices=case_names(), help="the detailed grid to simulate")
-    p.add_argument("--controller", "-c", choices=CONTROLLERS, default="hji",
-                   help="controller of the UPQC series voltage (or the PQ baseline)")
-    p.add_argument("--load", choices=("high", "low"), default="high", help="load level of the case")
-    p.add_argument("--upqc", choices=("conventional", "reduced"), default="conventional",
-                   help="UPQC structure: with its shunt branch, or series branch fed by the GTI dc link")
-    p.add_argument("--fault", nargs=2, type=nonnegative_float, metavar=("T_ON", "T_OFF"), default=None,
-                   help="fault application and clearance [s] (default: the paper's)")
-    p.add_argument("--t-end", type=positive_float, default=None, help="simulated time [s]")
+    p.add_argument("study", help="a study file (TOML) or a shipped study's name")
+    p.add_argument("--scenario", "-s", default=None,
+                   help="scenario id (default: the study's first)")
+    p.add_argument("--controller", "-c", default=None,
+                   help="controller name (default: the scenario's first)")
+    p.add_argument("--quick", action="store_true", help="the scenario's quick settings")
+    p.add_argument("--t-end", type=positive_float, default=None,
+                   help="simulated time [s] (default: the scenario's)")
+    p.add_argument("--list", action="store_true", help="list scenarios and controllers")
     p.add_argument("--output", "-o", type=output_file(".csv", ".parquet"), default=None,
                    help="write the run's signals (.csv or .parquet)")
     p.set_defaults(func=run)
     return p
 
 
-def check_time_window(t_on: float, t_off: float, t_end: float):
-    """The fault must start before it clears, and clear before the end of the run."""
-    from ..game.errors import ParameterError
-
-    if not t_on < t_off:
-        raise ParameterError("--fault", [t_on, t_off], "the fault must clear after it starts "
-                             "(T_ON < T_OFF)")
-    if not t_off < t_end:
-        raise ParameterError("--fault", [t_on, t_off], f"the fault clears at or after the end "
-                             f"of the run (--t-end {t_end:g} s): use T_OFF < --t-end or a "
-                             "longer --t-end")
-
-
 def run(args) -> int:
     """Run ``weakgrid simulate`` with the parsed ``args``; return the exit status."""
+    import dataclasses
+
     import pandas as pd
 
     from ..fileio import replace_atomic
-    from ..study.runner import run_scenario
-    from ..study.scenarios import Scenario
+    from ..game.errors import ParameterError
+    from ..study.runner import Run, run_scenario
+    from ..study.studyfile import load_study
 
-    c1 = args.case.startswith("case1")
-    t_on, t_off = args.fault or ((0.2, 0.25) if c1 else (3.0, 3.1))
-    t_end = args.t_end if args.t_end is not None else (6.0 if c1 else 10.0)
-    check_time_window(t_on, t_off, t_end)
-    sc = Scenario(f"{args.case}-{args.load}-{args.upqc}-{args.controller}", args.case,
-                  args.load, args.upqc, args.controller, t_on, t_off, t_end)
-    rec = run_scenario(sc)
+    st = load_study(args.study)
+    scs = st.scenarios(args.quick) or st.scenarios(False)
+    if args.list:
+        for sc in scs:
+            print(f"  {sc['id']:<24} load {sc['load']:<6} {sc['upqc']:<13} t_end {sc['t_end']:g} s"
+                  f"  controllers: {', '.join(sc['controllers'])}")
+        return 0
+    ids = [sc["id"] for sc in st.scenarios(False)]
+    sid = args.scenario or ids[0]
+    if sid not in ids:
+        raise ParameterError("--scenario", sid, f"choose one of {ids}")
+    sc = next((s for s in scs if s["id"] == sid), None) or \
+        next(s for s in st.scenarios(False) if s["id"] == sid)
+    ctrl = args.controller or sc["controllers"][0]
+    if ctrl not in st.controllers:
+        raise ParameterError("--controller", ctrl, f"this study compares {st.controllers} "
+                             "(controllers.compare)")
+    run_ = Run.of(st, sc, ctrl)
+    if args.t_end is not None:
+        last = max([float(e.get("t_off", e.get("t", 0.0))) for e in sc.get("events", [])
+                    if isinstance(e, dict)] or [0.0])
+        if not args.t_end > last:
+            raise ParameterError("--t-end", args.t_end, f"the scenario's last event is at "
+                                 f"{last:g} s: give a longer --t-end")
+        run_ = dataclasses.replace(run_, t_end=float(args.t_end))
+    rec = run_scenario(st, run_)
     for k, v in rec.metrics.items():
         print(f"  {k:26s} {v:.6g}" if isinstance(v, float) else f"  {k:26s} {v}")
     if args.output:

@@ -18,15 +18,17 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
-from ..fileio import json_safe, replace_atomic, write_json_atomic
+from ..fileio import replace_atomic, write_json_atomic
+from ..sweep.cache import canonical_json, code_fingerprint
 
 __all__ = ["inputs_key", "save_run", "load_run", "remove_stale"]
 
 
 def inputs_key(**inputs) -> str:
-    """A short hash of ``inputs`` (JSON-serializable) and the package version."""
-    text = json.dumps(json_safe({"inputs": inputs, "version": __version__}), sort_keys=True,
-                      default=str)
+    """A short hash of ``inputs`` (JSON-serializable) and of the code (every source and data
+    file of the package, :func:`weakgrid.sweep.code_fingerprint`): a changed input or a
+    changed code never reuses a stale result."""
+    text = canonical_json({"inputs": inputs, "code": code_fingerprint()})
     return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 

@@ -1,12 +1,25 @@
-"""The controllers the paper compares, built for a case's design model.
+"""The controllers a study compares: a registry ``kind → builder``.
 
-================  ========================================================``nonlinear-29``  the paper's initial nonlinear controller (29) (case 1)
-``lqr``           discrete LQR of the design model's linearization (case 2's
-                  initial policy), Q = 0.01·I, R = I
-``pq``            conventional PQ control of the GTI (PID, paper's gains), no UPQC (case 1)
-``pss-only``      UPQC idle (u = 0): the SG's PSS and governor alone
-``none``          UPQC idle and the PSS out of service: no supplementary control
-================  ===============================================================
+=================  ==========================================================================
+kind               what
+=================  ==========================================================================
+``hji``            the game-theoretic controller (24)/(23) trained on the design model derived
+                   from the grid's operating point, with the study's design settings
+``hji-bounded``    beyond the paper: the HJI controller trained with the UPQC rating as an
+                   input bound ‖u‖ ≤ ū in the cost (constrained-input penalty; option:
+                   ``u_bound`` to bound by another value than ``upqc.rating``)
+``nonlinear-29``   the paper's initial nonlinear controller (29) (options: gain, phase)
+``lqr``            discrete LQR of the design model's linearization (options: Q, R)
+``pq``             conventional PQ control of a GTI (PID, paper's gains), no UPQC
+``pss-only``       UPQC idle (u = 0): the SG's PSS and governor alone
+``none``           UPQC idle and the PSS out of service: no supplementary control
+``file``           a trained controller file (``weakgrid train``/``design``; option: path)
+=================  ==========================================================================
+
+A study names the controllers it compares in ``[controllers] compare``; options go in
+``[controllers.NAME]`` (with ``kind = …`` when NAME is not itself a kind). A new kind is one
+function ``builder(ctx) -> ControllerChoice`` added to :data:`CONTROLLER_KINDS` (and, if it
+needs a grid variant other than the UPQC in service, an entry in :data:`VARIANT_OF`).
 """
 
 from __future__ import annotations
@@ -16,19 +29,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..game.errors import ParameterError
-from ..models import NonlinearInitialPolicy, load_preset, lqr_policy
+from ..models import NonlinearInitialPolicy, load_preset, lqr_policy, problem_from_dict
 
-__all__ = ["CONTROLLERS", "PAPER_SETTINGS", "ControllerChoice", "case_variant", "make_controller",
-           "train_hji_for"]
-
-CONTROLLERS = ("hji", "nonlinear-29", "lqr", "pq", "pss-only", "none", "hji-bounded")
-# the paper's game settings (Q, R, P, γ, Ω, mesh, basis, initial policy) per case
-PAPER_SETTINGS = {"case1-weak-grid": "case1-paper", "case2-lv-microgrid": "case2-paper"}
+__all__ = ["CONTROLLER_KINDS", "VARIANT_OF", "ControllerChoice", "BuildContext",
+           "controller_kind", "controller_variant", "make_controller", "design_problem",
+           "train_hji"]
 
 
 @dataclass
 class ControllerChoice:
-    """A controller ready for a case.
+    """A controller ready for a grid.
 
     Attributes
     ----------
@@ -36,7 +46,7 @@ class ControllerChoice:
     policy : callable or None
         ``u = policy(x)`` for the design state x = [ϕ̂, υ] (None: UPQC idle).
     pss : bool
-        Whether the SG's PSS stays in service.
+        Whether the SGs' PSS stay in service.
     info : dict
         Training record (weights, iterations, time) or parameters, for the report.
     """
@@ -47,65 +57,127 @@ class ControllerChoice:
     info: dict = field(default_factory=dict)
 
 
-def case_variant(name: str) -> str:
-    """The case variant a controller needs: the PQ baseline has no UPQC."""
-    return "pq" if name == "pq" else "upqc"
+@dataclass
+class BuildContext:
+    """What a controller builder receives."""
+
+    study: object
+    name: str
+    options: dict
+    design: object
+    trained: object = None
 
 
-def train_hji_for(case_name: str, design, progress=None, u_bound=None):
-    """Train the HJI controller on ``design`` with the paper's settings of the case.
+def _options(study, name) -> dict:
+    o = study.data["controllers"].get(name, {})
+    return o if isinstance(o, dict) else {}
 
-    ``u_bound``: the UPQC rating ū (pu); the cost then bounds ‖u‖ ≤ ū, unless the
-    settings set their own bound (:meth:`~weakgrid.models.TrainingProblem.with_rating`).
-    """
-    base = load_preset(PAPER_SETTINGS[case_name])
+
+def controller_kind(study, name) -> str:
+    """The kind of controller ``name`` of ``study`` (its ``kind`` option, else the name)."""
+    return _options(study, name).get("kind", name)
+
+
+def design_problem(study, design):
+    """The training problem: the study's design settings with the derived model (10)."""
+    ds = study.data["design"]
+    over = {k: ds[k] for k in ("cost", "mesh", "basis", "initial_policy", "solver") if k in ds}
+    base = load_preset(ds["settings"])
+    if over:
+        raw = dict(base.raw)
+        raw.update(over)
+        base = problem_from_dict(raw, source=f"{study.source} (design)")
     base.system = design
-    if base.raw.get("initial_policy", {}).get("kind") == "nonlinear-29":
-        ip = base.raw["initial_policy"]
+    ip = base.raw.get("initial_policy", {})
+    if ip.get("kind") == "nonlinear-29":
         base.initial_policy = NonlinearInitialPolicy.on_design_model(design, ip["gain"],
                                                                      ip["phase"])
+    elif ip.get("kind") == "linear":
+        pass
     else:
-        ip = base.raw.get("initial_policy", {})
         base.initial_policy = lqr_policy(design, float(ip.get("Q", 0.01)) * np.eye(2),
                                          float(ip.get("R", 1.0)) * np.eye(2))
-    base.name = f"{case_name}-derived"
+    base.name = f"{study.name}-derived"
     base.published = {}
-    if u_bound is not None and np.isfinite(u_bound):
-        base = base.with_rating(float(u_bound))
+    return base
+
+
+def train_hji(study, design, progress=None):
+    """``(problem, GameController)``: the HJI controller trained on ``design``."""
+    base = design_problem(study, design)
     return base, base.train(progress=progress)
 
 
-def make_controller(name: str, case_name: str, design, trained=None,
-                    u_bound=None) -> ControllerChoice:
-    """Build controller ``name`` for a case whose design model is ``design``.
+def _hji(ctx):
+    ctl = ctx.trained if ctx.trained is not None else train_hji(ctx.study, ctx.design)[1]
+    return ControllerChoice(ctx.name, ctl.control, info={
+        "weights": ctl.weights.tolist(), "iterations": ctl.iterations,
+        "train_seconds": ctl.train_seconds})
 
-    ``trained`` may carry an already trained HJI controller (a GameController) so
-    that one training serves every scenario with the same design model.
-    ``u_bound`` is the UPQC rating, used by ``hji-bounded``.
+
+def _hji_bounded(ctx):
+    ubar = float(ctx.options.get("u_bound", ctx.study.data["upqc"]["rating"]))
+    problem = design_problem(ctx.study, ctx.design).with_rating(ubar)
+    ctl = problem.train()
+    return ControllerChoice(ctx.name, ctl.control, info={
+        "weights": ctl.weights.tolist(), "iterations": ctl.iterations,
+        "train_seconds": ctl.train_seconds, "u_bound": ctl.cost.bound.to_dict()})
+
+
+def _n29(ctx):
+    pol = NonlinearInitialPolicy.on_design_model(ctx.design, float(ctx.options.get("gain", 125.0)),
+                                                 float(ctx.options.get("phase", 0.069)))
+    return ControllerChoice(ctx.name, pol, info=pol.to_dict())
+
+
+def _lqr(ctx):
+    pol = lqr_policy(ctx.design, float(ctx.options.get("Q", 0.01)) * np.eye(2),
+                     float(ctx.options.get("R", 1.0)) * np.eye(2))
+    return ControllerChoice(ctx.name, pol, info=pol.to_dict())
+
+
+def _idle(ctx):
+    return ControllerChoice(ctx.name, None)
+
+
+def _none(ctx):
+    return ControllerChoice(ctx.name, None, pss=False)
+
+
+def _file(ctx):
+    from ..models import load_controller
+
+    path = ctx.options.get("path")
+    if not path:
+        raise ParameterError(f"controllers.{ctx.name}.path", None, "give the controller file")
+    ctl = load_controller(ctx.study.resolve(path))
+    return ControllerChoice(ctx.name, ctl.control, info={"file": str(path)})
+
+
+CONTROLLER_KINDS = {"hji": _hji, "hji-bounded": _hji_bounded, "nonlinear-29": _n29, "lqr": _lqr, "pq": _idle,
+                    "pss-only": _idle, "none": _none, "file": _file}
+# grid variant a kind needs (default "upqc"): the PQ baseline has no UPQC
+VARIANT_OF = {"pq": "pq"}
+
+
+def controller_variant(study, name) -> str:
+    """The grid variant controller ``name`` needs: ``"pq"`` (no UPQC) for the PQ baseline,
+    else ``"upqc"``."""
+    return VARIANT_OF.get(controller_kind(study, name), "upqc")
+
+
+def make_controller(study, name: str, design, trained=None) -> ControllerChoice:
+    """Build controller ``name`` of ``study`` for the design model ``design``.
+
+    ``trained`` may carry an already trained HJI controller (a GameController) so that one
+    training serves every scenario with the same design model.
     """
-    if name not in CONTROLLERS:
-        raise ParameterError("controller", name, f"choose one of {CONTROLLERS}")
-    if name == "hji-bounded":
-        if u_bound is None or not np.isfinite(u_bound):
-            raise ParameterError("controller", name, "needs the UPQC rating (Vmax) of the case")
-        ctl = trained if trained is not None and trained.cost.bound is not None else \
-            train_hji_for(case_name, design, u_bound=u_bound)[1]
-        return ControllerChoice(name, ctl.control, info={
-            "weights": ctl.weights.tolist(), "iterations": ctl.iterations,
-            "train_seconds": ctl.train_seconds, "u_bound": ctl.cost.bound.to_dict()})
-    if name == "hji":
-        ctl = trained if trained is not None and trained.cost.bound is None else train_hji_for(case_name, design)[1]
-        return ControllerChoice(name, ctl.control, info={
-            "weights": ctl.weights.tolist(), "iterations": ctl.iterations,
-            "train_seconds": ctl.train_seconds})
-    if name == "nonlinear-29":
-        pol = NonlinearInitialPolicy.on_design_model(design, 125.0, 0.069)
-        return ControllerChoice(name, pol, info=pol.to_dict())
-    if name == "lqr":
-        pol = lqr_policy(design, 0.01 * np.eye(2), np.eye(2))
-        return ControllerChoice(name, pol, info=pol.to_dict())
-    if name == "pq":
-        return ControllerChoice(name, None)
-    if name == "pss-only":
-        return ControllerChoice(name, None)
-    return ControllerChoice(name, None, pss=False)
+    if name not in study.controllers:
+        raise ParameterError("controller", name, f"not compared in this study; choose one of "
+                             f"{study.controllers} (controllers.compare)")
+    kind = controller_kind(study, name)
+    if kind not in CONTROLLER_KINDS:
+        raise ParameterError(f"controllers.{name}.kind", kind,
+                             f"choose one of {sorted(CONTROLLER_KINDS)}")
+    return CONTROLLER_KINDS[kind](BuildContext(study, name, _options(study, name), design,
+                                               trained))

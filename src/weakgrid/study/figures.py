@@ -1,8 +1,8 @@
-"""The paper's figures (Figs. 7–16 for case 1, 18–25 for case 2), from run records.
-
-Each figure is a row of :data:`FIGURES`: the panels (signal, axis label with its
-unit) and the runs drawn in every panel. Missing runs (``--quick``) are left out
-and named in the figure's note.
+"""Figures of a study's runs, as data: each ``[[figures]]`` entry of a study file gives the
+panels (series keys of :data:`PANELS`, each with its axis label and unit) and the runs drawn
+in every panel (``[run id, legend label]``). The paper's Figs. 7–16 and 18–25 are such entries
+in the shipped paper studies. Missing runs (``--quick``) are left out and named in the
+figure's note.
 """
 
 from __future__ import annotations
@@ -17,67 +17,40 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from ..fileio import savefig_atomic  # noqa: E402
 
-__all__ = ["FIGURES", "write_figures"]
+__all__ = ["PANELS", "figure_specs", "write_figures"]
 
-SPEED = ("sg_speed", "SG speed [pu]")
-VDC = ("dc_voltage", "dc-link voltage [pu]")
-VUP = ("vup", "series voltage Vup [pu]")
-VUQ = ("vuq", "series voltage Vuq [pu]")
-PMW = ("p_series_mw", "UPQC injected power [MW]")
-PKW = ("p_series_kw", "UPQC injected power [kW]")
-COST = ("running_cost", "running cost of (18) [–]")
-
-HJI, N29, PQ = "HJI (optimal, (24))", "nonlinear (29)", "PQ control, no UPQC"
-LQR = "LQR"
-
-
-def _c1(load, ctrl, upqc="conv"):
-    return f"c1-{load}-{upqc}-{ctrl}"
-
-
-def _c2(load, f, ctrl):
-    return f"c2-{load}-{f}-{ctrl}"
+# panel key -> axis label (with unit); keys are run series (see weakgrid.study.build signals)
+PANELS = {
+    "sg_speed": "SG speed [pu]",
+    "dc_voltage": "dc-link voltage [pu]",
+    "vup": "series voltage Vup [pu]",
+    "vuq": "series voltage Vuq [pu]",
+    "vu": "series voltage |Vu| [pu]",
+    "p_series_mw": "UPQC injected power [MW]",
+    "p_series_kw": "UPQC injected power [kW]",
+    "running_cost": "running cost of (18) [–]",
+    "shunt_bus_v": "shunt-bus voltage [pu]",
+    "phi_hat": "GTI phase error [rad]",
+    "sg_pe": "SG electrical power [pu]",
+}
 
 
-FIGURES = [
-    ("fig07", "Case 1, high load: SG speed and RG dc-link voltage", [SPEED, VDC],
-     [(_c1("high", "hji"), HJI), (_c1("high", "nonlinear-29"), N29), (_c1("high", "pq"), PQ)]),
-    ("fig08", "Case 1, high load: UPQC series voltage", [VUP, VUQ],
-     [(_c1("high", "hji"), HJI), (_c1("high", "nonlinear-29"), N29)]),
-    ("fig09", "Case 1, high load: UPQC injected power", [PMW],
-     [(_c1("high", "hji"), HJI), (_c1("high", "nonlinear-29"), N29)]),
-    ("fig10", "Case 1, high load: running cost", [COST],
-     [(_c1("high", "hji"), HJI), (_c1("high", "nonlinear-29"), N29)]),
-    ("fig11", "Case 1, low load: SG speed and RG dc-link voltage", [SPEED, VDC],
-     [(_c1("low", "hji"), HJI), (_c1("low", "nonlinear-29"), N29), (_c1("low", "pq"), PQ)]),
-    ("fig12", "Case 1, low load: UPQC series voltage", [VUP, VUQ],
-     [(_c1("low", "hji"), HJI), (_c1("low", "nonlinear-29"), N29)]),
-    ("fig13", "Case 1, low load: running cost", [COST],
-     [(_c1("low", "hji"), HJI), (_c1("low", "nonlinear-29"), N29)]),
-    ("fig14", "Case 1, reduced UPQC, HJI: SG speed and dc-link voltage", [SPEED, VDC],
-     [(_c1("high", "hji", "red"), "high load"), (_c1("low", "hji", "red"), "low load")]),
-    ("fig15", "Case 1, reduced UPQC, HJI: series voltage", [VUP, VUQ],
-     [(_c1("high", "hji", "red"), "high load"), (_c1("low", "hji", "red"), "low load")]),
-    ("fig16", "Case 1, reduced UPQC, HJI: injected power", [PMW],
-     [(_c1("high", "hji", "red"), "high load"), (_c1("low", "hji", "red"), "low load")]),
-    ("fig18", "Case 2, high load, fault 0.2 s: SG speed", [SPEED],
-     [(_c2("high", "f200", "hji"), HJI), (_c2("high", "f200", "lqr"), LQR)]),
-    ("fig19", "Case 2, high load, fault 0.2 s: UPQC series voltage", [VUP, VUQ],
-     [(_c2("high", "f200", "hji"), HJI), (_c2("high", "f200", "lqr"), LQR)]),
-    ("fig20", "Case 2, high load, fault 0.2 s: UPQC injected power", [PKW],
-     [(_c2("high", "f200", "hji"), HJI), (_c2("high", "f200", "lqr"), LQR)]),
-    ("fig21", "Case 2, high load, fault 0.1 s: SG speed", [SPEED],
-     [(_c2("high", "f100", "hji"), HJI), (_c2("high", "f100", "lqr"), LQR)]),
-    ("fig22", "Case 2, high load, fault 0.1 s: UPQC series voltage", [VUP, VUQ],
-     [(_c2("high", "f100", "hji"), HJI), (_c2("high", "f100", "lqr"), LQR)]),
-    ("fig23", "Case 2, high load, fault 0.1 s: UPQC injected power", [PKW],
-     [(_c2("high", "f100", "hji"), HJI), (_c2("high", "f100", "lqr"), LQR)]),
-    ("fig24", "Case 2, low load, fault 0.1 s: SG speed", [SPEED],
-     [(_c2("low", "f100", "hji"), HJI), (_c2("low", "f100", "lqr"), LQR),
-      (_c2("low", "f100", "pss-only"), "PSS alone")]),
-    ("fig25", "Case 2, low load, fault 0.1 s: UPQC series voltage", [VUP, VUQ],
-     [(_c2("low", "f100", "hji"), HJI), (_c2("low", "f100", "lqr"), LQR)]),
-]
+def figure_specs(study, quick=False) -> list[dict]:
+    """The study's ``[[figures]]`` (id, title, panels, runs = [[run id, label]]), or one figure
+    per scenario (every controller; speed, dc link, series voltage, power) if it gives none."""
+    figs = study.data.get("figures") or []
+    if figs:
+        return [dict(f) for f in figs]
+    out = []
+    kind_gti = any(g["name"] == study.data["machine"]["name"] for g in
+                   study.data["dynamics"]["gti"])
+    for sc in study.scenarios(quick):
+        speed = [] if study.data["report"].get("speed_of") == "" else ["sg_speed"]
+        panels = speed + (["dc_voltage"] if kind_gti else []) + ["vu", "p_series_mw"]
+        out.append({"id": f"{study.name}-{sc['id']}", "title": f"{study.name}: {sc['id']}",
+                    "panels": panels,
+                    "runs": [[f"{sc['id']}-{c}", c] for c in sc["controllers"]]})
+    return out
 
 
 def _series(rec, key):
@@ -89,12 +62,15 @@ def _series(rec, key):
     return (s["t"], s[key]) if key in s else None
 
 
-def write_figures(records: dict, folder, formats=("png", "svg")) -> list[Path]:
-    """Write every figure of :data:`FIGURES` for the runs in ``records`` (id → RunRecord)."""
+def write_figures(records: dict, folder, specs, formats=("png", "svg")) -> list[Path]:
+    """Write every figure of ``specs`` (:func:`figure_specs`) for ``records`` (id → RunRecord)."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     written = []
-    for fig_id, title, panels, runs in FIGURES:
+    for spec in specs:
+        fig_id, title = spec["id"], spec["title"]
+        panels = [(k, PANELS.get(k, k)) for k in spec["panels"]]
+        runs = [tuple(r) for r in spec["runs"]]
         fig, axes = plt.subplots(len(panels), 1, figsize=(7.0, 2.6 * len(panels) + 0.6),
                                  sharex=True, squeeze=False)
         missing = []
@@ -116,7 +92,7 @@ def write_figures(records: dict, folder, formats=("png", "svg")) -> list[Path]:
             if ax.lines:
                 ax.legend(fontsize=8, loc="best")
         axes[-1, 0].set_xlabel("time [s]")
-        fig.suptitle(f"{fig_id.replace('fig', 'Fig. ')} — {title}", fontsize=10)
+        fig.suptitle(f"{spec.get('label', fig_id)} — {title}", fontsize=10)
         if missing:
             fig.text(0.01, 0.005, "not run: " + ", ".join(missing), fontsize=7, color="0.4")
         fig.tight_layout(rect=(0, 0.02, 1, 1))

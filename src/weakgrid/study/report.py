@@ -69,26 +69,44 @@ img{max-width:100%;border:1px solid #ddd;margin:0.5em 0}"""
 def write_html(path, *, claims, metrics, figures, designs, meta, notes=None) -> Path:
     """One HTML page: claims with verdicts, design models, figures, metrics."""
     e = html.escape
-    parts = [f"<!doctype html><meta charset='utf-8'><title>weakgrid reproduce</title>"
-             f"<style>{_CSS}</style><h1>weakgrid — reproduction of Nazaripouya &amp; "
-             f"Mehraeen (2015)</h1>",
+    title = meta.get("title", "study")
+    parts = [f"<!doctype html><meta charset='utf-8'><title>weakgrid — {e(title)}</title>"
+             f"<style>{_CSS}</style><h1>weakgrid — {e(title)}</h1>",
              f"<p>weakgrid {e(meta.get('version', ''))}, {e(meta.get('mode', ''))} run, "
              f"{meta.get('n_runs', 0)} simulations in {meta.get('wall_s', 0):.0f} s. "
              "Every number below was measured in this run; the rules that turn them into "
              "verdicts are stated beside them.</p>",
-             "<h2>Claims of the paper</h2><table><tr><th>claim</th><th>case</th><th>paper"
-             "</th><th>measured</th><th>rule</th><th>verdict</th></tr>"]
+             ]
+    if claims:
+        parts.append("<h2>Claims</h2><table><tr><th>claim</th><th>case</th><th>paper"
+                     "</th><th>measured</th><th>rule</th><th>verdict</th></tr>")
     for c in claims:
         cls = c["verdict"].replace(" ", "")
         parts.append(f"<tr><td>{e(c['id'])}</td><td>{e(c['case'])}</td><td>{e(c['paper'])}"
                      f"</td><td>{e(c['measured'] or '—')}</td><td>{e(c['rule'])}</td>"
                      f"<td class='{cls}'>{e(c['verdict'])}</td></tr>")
-    parts.append("</table><h2>Design models derived from the grids</h2><table><tr><th>case"
-                 "</th><th>load</th><th>UPQC</th><th>T [s]</th><th>a</th><th>V̄r [pu]</th>"
-                 "<th>ϕs0 [rad]</th><th>preset (T, a, V̄r, ϕs0)</th><th>HJI training</th></tr>")
+    if claims:
+        parts.append("</table>")
+    cols = [("case", "study"), ("load", "load"), ("upqc", "UPQC"), ("T", "T [s]"), ("a", "a"),
+            ("Vr_bar", "V̄r [pu]"), ("phi_s0", "ϕs0 [rad]"),
+            ("preset", "settings preset (T, a, V̄r, ϕs0)"),
+            ("modes", "design-model mode vs full grid's mode"), ("training", "HJI training")]
+    parts.append("<h2>Design models derived from the grids</h2><table><tr>" +
+                 "".join(f"<th>{e(lbl)}</th>" for _, lbl in cols) + "</tr>")
     for d in designs:
-        parts.append("<tr>" + "".join(f"<td>{e(str(v))}</td>" for v in d) + "</tr>")
+        parts.append("<tr>" + "".join(f"<td>{e(str(d.get(k, '')))}</td>" for k, _ in cols)
+                     + "</tr>")
     parts.append("</table>")
+    for d in designs:
+        der = d.get("derivation")
+        if not der:
+            continue
+        parts.append(f"<details><summary>derivation: {e(d['case'])}, {e(d['load'])} load, "
+                     f"{e(d['upqc'])} UPQC</summary><table><tr><th>value</th><th></th>"
+                     "<th>unit</th><th>source</th></tr>" +
+                     "".join(f"<tr><td>{e(v['name'])}</td><td>{e(_fmt(v['value']))}</td>"
+                             f"<td>{e(v['unit'])}</td><td>{e(v['source'])}</td></tr>"
+                             for v in der["values"]) + "</table></details>")
     for case, items in (notes or {}).items():
         if items:
             parts.append(f"<h3>Notes from the data of {e(case)}</h3><ul>" +

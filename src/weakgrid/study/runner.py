@@ -1,25 +1,56 @@
-"""Run one scenario on the detailed simulator and measure it."""
+"""Run one (scenario, controller) of a study on the detailed simulator and measure it."""
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from ..game.errors import ParameterError
 from ..sim.controllers import DigitalController, UPQCTarget
-from ..sim.events import Fault
+from ..sim.events import Fault, LineTrip, LoadStep
 from ..sim.integrate import simulate
-from .cases import build_case
-from .controllers import case_variant, make_controller
+from ..sim.network import F_BUS, T_BUS
+from .build import build_setup
+from .controllers import controller_variant, make_controller
 from .metrics import backswing, control_cost, itae, running_cost, settling_time, stability_verdict
 
-__all__ = ["RunRecord", "run_scenario", "FAULT_IMPEDANCE"]
+__all__ = ["Run", "RunRecord", "run_scenario", "enable_windows", "make_events"]
 
-# default fault impedance (pu on the system base) where a case's data give none
-FAULT_IMPEDANCE = {"rf": 0.0, "xf": 1e-3}
-Q_DESIGN = 0.01 * np.eye(2)  # the paper's state weight of (18)
+Q_DESIGN = 0.01 * np.eye(2)  # the paper's state weight of (18), for the running cost metric
 R_DESIGN = np.eye(2)
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run: a scenario of a study with one controller (``id = scenario-controller``)."""
+
+    id: str
+    case: str
+    scenario: str
+    load: str
+    upqc: str
+    controller: str
+    t_end: float
+    events: tuple
+    bypass: tuple
+
+    @classmethod
+    def of(cls, study, sc: dict, controller: str) -> "Run":
+        return cls(f"{sc['id']}-{controller}", study.name, sc["id"], sc["load"], sc["upqc"],
+                   controller, float(sc["t_end"]), tuple(dict(e) for e in sc["events"]),
+                   tuple(tuple(b) for b in sc["bypass"]))
+
+    def to_dict(self):
+        d = asdict(self)
+        d["events"], d["bypass"] = [dict(e) for e in self.events], [list(b) for b in self.bypass]
+        return d
+
+    @property
+    def fault_text(self) -> str:
+        f = [e for e in self.events if e["kind"] == "fault"]
+        return ", ".join(f"{e['t_on']:g}-{e['t_off']:g} s" for e in f) or "none"
 
 
 class _MeasureOnly:
@@ -42,7 +73,7 @@ class _MeasureOnly:
 class RunRecord:
     """What a run produced: metrics (flat dict) and the series the figures need."""
 
-    scenario: object
+    scenario: Run
     metrics: dict
     series: dict
     info: dict = field(default_factory=dict)
@@ -54,27 +85,66 @@ def _disable_pss(system):
         pss.p["KS"] = np.zeros_like(pss.p["KS"])
 
 
-def run_scenario(sc, trained=None, dt=None) -> RunRecord:
-    """Simulate scenario ``sc`` and compute its metrics.
+def enable_windows(bypass, t_end):
+    """Windows the controller is active: the complement of the bypass windows in [0, t_end+1]."""
+    out, t = [], 0.0
+    for a, b in sorted(bypass):
+        if a > t:
+            out.append((t, a))
+        t = max(t, b)
+    out.append((t, t_end + 1.0))
+    return out
+
+
+def _branch_row(setup, ref, where):
+    net = setup.system.network
+    if isinstance(ref, str):
+        if ref not in setup.branch_names:
+            raise ParameterError(where, ref, f"no branch of that name; choose one of "
+                                 f"{list(setup.branch_names)} or give a 0-based row")
+        return setup.branch_names[ref]
+    if isinstance(ref, dict):
+        f, t = setup.bus(ref.get("from"), f"{where}.from"), setup.bus(ref.get("to"), f"{where}.to")
+        rows = [k for k, row in enumerate(net.branch) if {int(row[F_BUS]), int(row[T_BUS])}
+                == {f, t}]
+        if len(rows) != 1:
+            raise ParameterError(where, ref, f"found {len(rows)} branches between these buses")
+        return rows[0]
+    return int(ref)
+
+
+def make_events(setup, run: Run):
+    """Simulator events of a run's scenario."""
+    out = []
+    for j, e in enumerate(run.events):
+        w = f"scenarios.{run.scenario}.events.{j}"
+        if e["kind"] == "fault":
+            out.append(Fault(bus=setup.bus(e["bus"], f"{w}.bus"), t_on=e["t_on"],
+                             t_off=e["t_off"], rf=float(e["rf"]), xf=float(e["xf"])))
+        elif e["kind"] == "line_trip":
+            out.append(LineTrip(_branch_row(setup, e["branch"], f"{w}.branch"), e["t"],
+                                close=bool(e.get("close", False))))
+        else:
+            out.append(LoadStep(setup.bus(e["bus"], f"{w}.bus"), e["t"], e["dP"], e["dQ"]))
+    return out
+
+
+def run_scenario(study, run: Run, trained=None, dt=None) -> RunRecord:
+    """Simulate ``run`` of ``study`` and compute its metrics.
 
     Parameters
     ----------
-    sc : Scenario
     trained : dict, optional
-        ``(case, load, upqc) -> GameController`` cache of trained HJI controllers.
+        ``(load, upqc) -> GameController`` cache of trained HJI controllers.
     dt : float, optional
         Integration step (default: the controller's sampling period T).
     """
-    case = build_case(sc.case, sc.load, sc.upqc, case_variant(sc.controller))
-    key = (sc.case, sc.load, sc.upqc)
-    ctl = (trained or {}).get(key)
-    up_ = case.system.components.get("UPQC")
-    rating = float(up_.p["Vmax"][up_.names.index(case.upqc_name)]) if up_ is not None and \
-        case.upqc_name in up_.names else None
-    choice = make_controller(sc.controller, sc.case, case.design, ctl, u_bound=rating)
+    setup = build_setup(study, run.load, run.upqc, controller_variant(study, run.controller))
+    ctl = (trained or {}).get((run.load, run.upqc))
+    choice = make_controller(study, run.controller, setup.design, ctl)
     if not choice.pss:
-        _disable_pss(case.system)
-    T = case.design.T
+        _disable_pss(setup.system)
+    T = setup.design.T
     xs = []
     policy = choice.policy
 
@@ -84,14 +154,12 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
         xs.append(m.copy())
         return u
 
-    target = UPQCTarget(case.upqc_name) if case.upqc_name else _MeasureOnly()
-    dc = DigitalController(K, T=T, measure=case.measure, target=target,
-                           enable=[(0.0, sc.t_fault), (sc.t_clear, sc.t_end + 1.0)],
-                           name=sc.controller)
-    fz = {k: float(case.info.get("fault", {}).get(k, v)) for k, v in FAULT_IMPEDANCE.items()}
-    fault = Fault(bus=case.fault_bus, t_on=sc.t_fault, t_off=sc.t_clear, **fz)
+    target = UPQCTarget(setup.upqc_name) if setup.upqc_name else _MeasureOnly()
+    dc = DigitalController(K, T=T, measure=setup.measure, target=target,
+                           enable=enable_windows(run.bypass, run.t_end), name=run.controller)
+    events = make_events(setup, run)
     t0 = time.perf_counter()
-    res = simulate(case.system, sc.t_end, dt=dt or T, events=[fault], controllers=[dc],
+    res = simulate(setup.system, run.t_end, dt=dt or T, events=events, controllers=[dc],
                    on_failure="return")
     wall = time.perf_counter() - t0
     # controller samples: times and (bypass-aware) outputs actually applied
@@ -101,18 +169,19 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
     # measurements were logged only when active; align them by the active mask
     active = np.array([dc.active(t) for t in tk])
     xk[active] = np.asarray(xs).reshape(-1, 2)[: active.sum()]
-    sig = case.signals
     t = res.t
     series = {"t": t}
-    for key_, name in sig.items():
+    for key_, name in setup.signals.items():
         if name in res:
             series[key_] = res[name]
-    metrics = {"id": sc.id, "case": sc.case, "load": sc.load, "upqc": sc.upqc,
-               "controller": sc.controller, "fault": f"{sc.t_fault:g}-{sc.t_clear:g} s",
+    metrics = {"id": run.id, "case": run.case, "load": run.load, "upqc": run.upqc,
+               "controller": run.controller, "fault": run.fault_text,
                "failed": res.failure is not None,
                "failure": str(res.failure) if res.failure is not None else "",
                "wall_s": wall}
-    after = sc.t_clear
+    # metrics are taken after the last disturbance (fault clearing, bypass end, step, trip)
+    after = max([b[1] for b in run.bypass] + [e["t_off"] for e in run.events if "t_off" in e]
+                + [e["t"] for e in run.events if "t" in e], default=0.0)
     post = t >= after
     for key_, label in (("sg_speed", "speed"), ("dc_voltage", "vdc")):
         if key_ not in series:
@@ -133,9 +202,9 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
                             f"{label}_itae": float("nan"), f"{label}_verdict": "unstable"})
     xa = np.nan_to_num(xk)
     # what the UPQC applied: |Vu| scaled down to its rating, as the simulator does
-    up = case.system.components.get("UPQC")
-    vmax = float(up.p["Vmax"][up.names.index(case.upqc_name)]) if up is not None and \
-        case.upqc_name in up.names else float("inf")
+    up = setup.system.components.get("UPQC")
+    vmax = float(up.p["Vmax"][up.names.index(setup.upqc_name)]) if up is not None and \
+        setup.upqc_name in up.names else float("inf")
     mag = np.hypot(uk[:, 0], uk[:, 1]) if uk.size else np.zeros(0)
     ua = uk * np.minimum(1.0, vmax / np.where(mag > 0, mag, 1.0))[:, None] if uk.size else uk
     metrics["control_cost"] = control_cost(ua, R_DESIGN, T)
@@ -152,12 +221,13 @@ def run_scenario(sc, trained=None, dt=None) -> RunRecord:
         metrics["vu_rating_pu"] = vmax
         metrics["vu_rating_reached"] = bool(metrics["vu_peak_pu"] >= vmax * (1 - 1e-6))
     if "p_series" in series:
-        pmw = series["p_series"] * case.Sb_mva
+        pmw = series["p_series"] * setup.Sb_mva
         series["p_series_mw"] = pmw
         pk = float(np.nanmax(np.abs(pmw[post]))) if post.any() else float("nan")
         metrics["p_series_peak_mw"] = pk
-        metrics["p_series_peak_pct_line"] = 100 * pk / abs(case.line_power_mw) \
-            if case.line_power_mw else float("nan")
-    metrics["line_power_mw"] = case.line_power_mw
-    info = {"design": case.design.to_dict(), "case_info": case.info, "controller": choice.info}
-    return RunRecord(sc, metrics, series, info)
+        metrics["p_series_peak_pct_line"] = 100 * pk / abs(setup.line_power_mw) \
+            if setup.line_power_mw else float("nan")
+    metrics["line_power_mw"] = setup.line_power_mw
+    info = {"design": setup.design.to_dict(), "derivation": setup.derivation.to_dict(),
+            "controller": choice.info}
+    return RunRecord(run, metrics, series, info)

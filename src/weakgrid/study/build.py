@@ -1,0 +1,428 @@
+"""Build a study's grid for the simulator at a load level, UPQC structure and variant.
+
+Grid kinds (``[grid] kind``):
+
+* ``inline`` — buses, branches, generators and loads per level in the study file
+  (``[[grid.bus]] id, name, type, base_kv``; ``[[grid.branch]] name, from, to, r, x, b``
+  (pu on ``Sb_mva``); ``[[grid.gen]] name, bus, P_mw, Q_mvar, V_set, Mbase``;
+  ``[grid.loads.LEVEL] "BUS" = [P_MW, Q_Mvar]``, constant impedance).
+* ``pandapower`` — ``network`` names a function of ``pandapower.networks`` (``kwargs``), then
+  edits in this order: ``keep_buses`` (regex on bus names; the rest is dropped), ``islanded``
+  (external grids removed), ``loads.levels`` (p_mw multiplier per level) and ``loads.pf``
+  (power factor by load name), ``add_bus``, ``sgen_to_gen`` (static generators turned into voltage-
+  controlled generators, e.g. a wind turbine that becomes a GTI; ``bus`` moves it),
+  ``add_impedance``, ``add_gen`` (``p_mw`` a number or a table per level).
+* ``matpower`` — ``file`` (a ``.m``/``.mat`` case); ``loads.levels`` scale PD, QD.
+* ``andes`` — ``file`` (any case ANDES parses: PSS/E ``.raw``, ``.xlsx``, ``.json``; ``andes:``
+  prefix for ANDES's stock cases) and ``dyr`` (PSS/E dynamic data): machines and controls come
+  from the file (named ``GENROU_<idx>`` …), the UPQC is an existing ``Line`` (``upqc.branch`` =
+  its idx; ``upqc.side = "to"`` when its bus2 is the shunt bus) or inserted into one
+  (``upqc.insert = {branch = idx, side, r, x}``, pu on the system base).
+
+Buses are referred to by external number (inline/matpower), or by pandapower name or index.
+The UPQC is either an existing series branch (``upqc.branch``: a branch name, a row, or
+``{from, to}``; from = the shunt bus r) or inserted into a branch (``upqc.insert``, see
+:mod:`weakgrid.design.upqc_insert`).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..design import derive_design
+from ..design.upqc_insert import insert_upqc_matpower, insert_upqc_pandapower
+from ..game.errors import ParameterError
+from ..sim.controllers import gti_design_states, sg_design_states
+from ..sim.gti import GTI
+from ..sim.network import BR_R, BR_X, F_BUS, GEN_BUS, T_BUS, Network
+from ..sim.system import System
+from ..sim.upqc import UPQC
+
+__all__ = ["Setup", "build_setup", "VARIANTS"]
+
+# "upqc": the UPQC in service (driven by a digital controller, or idle);
+# "pq": no UPQC, the controlled GTI's phase by its PQ loops (the conventional baseline)
+VARIANTS = ("upqc", "pq")
+
+
+@dataclass
+class Setup:
+    """A study's grid, set up for simulation at one operating point.
+
+    ``machine`` is "gti" or "sg"; ``source`` the controlled machine; ``measure`` returns the
+    design states ``[ϕ̂ (rad), υ (rad/s)]``; ``design`` the derived model (10) and
+    ``derivation`` how it was derived; ``signals`` maps figure keys to result variables.
+    """
+
+    study: object
+    load: str
+    upqc: str
+    variant: str
+    system: System
+    machine: str
+    source: str
+    upqc_name: str | None
+    shunt_bus: int
+    upqc_branch: int
+    measure: object
+    design: object
+    derivation: object
+    line_power_mw: float
+    signals: dict = field(default_factory=dict)
+    Sb_mva: float = 100.0
+    bus_id: dict = field(default_factory=dict)
+    branch_names: dict = field(default_factory=dict)
+
+    def bus(self, ref, where="bus") -> int:
+        """External bus number of a bus reference (number, or name)."""
+        return _bus_ref(ref, self.bus_id, self.system.network, where)
+
+
+def _bus_ref(ref, bus_id, network, where):
+    if isinstance(ref, str):
+        if ref not in bus_id:
+            raise ParameterError(where, ref, f"no bus of that name; e.g. {list(bus_id)[:8]}")
+        return int(bus_id[ref])
+    if isinstance(ref, (int, np.integer)) and not isinstance(ref, bool):
+        if ref in bus_id:                      # pandapower index → simulator bus
+            return int(bus_id[ref])
+        if int(ref) in set(int(b) for b in network.bus_ids):
+            return int(ref)
+    raise ParameterError(where, ref, "give a bus number or name of this grid")
+
+
+# ----------------------------------------------------------------------------- grids
+def _inline_case(g, load, where="grid"):
+    loads = g.get("loads", {}).get(load, {}) if g.get("loads") else {}
+    bus = []
+    ids = []
+    for i, b in enumerate(g["bus"]):
+        bid = int(b["id"])
+        ids.append(bid)
+        pd, qd = loads.get(str(bid), loads.get(b.get("name", ""), [0.0, 0.0]))
+        bus.append([bid, b.get("type", 1), pd, qd, 0, 0, 1, 1.0, 0, b.get("base_kv", 1.0), 1,
+                    1.5, 0.5])
+    for k in loads:
+        if not any(str(b["id"]) == k or b.get("name") == k for b in g["bus"]):
+            raise ParameterError(f"{where}.loads.{load}.{k}", loads[k], "no bus with that id")
+    gen = [[gg["bus"], gg.get("P_mw", 0.0), gg.get("Q_mvar", 0.0), 9999, -9999,
+            gg.get("V_set", 1.0), gg.get("Mbase", 100.0), 1, 9999, -9999] + [0] * 11
+           for gg in g["gen"]]
+    branch = [[br["from"], br["to"], br["r"], br["x"], br.get("b", 0.0), 0, 0, 0,
+               br.get("tap", 0), br.get("shift", 0), 1, -360, 360] for br in g["branch"]]
+    case = {"baseMVA": float(g.get("Sb_mva", 100.0)), "bus": np.array(bus, float),
+            "gen": np.array(gen, float), "branch": np.array(branch, float)}
+    names = {br.get("name", br.get("role", str(k))): k for k, br in enumerate(g["branch"])}
+    bus_id = {b["name"]: int(b["id"]) for b in g["bus"] if "name" in b}
+    return case, names, bus_id
+
+
+def _per_level(v, load, where):
+    if isinstance(v, dict):
+        if load not in v:
+            raise ParameterError(where, v, f"give a value for load level '{load}'")
+        return float(v[load])
+    return float(v)
+
+
+def _pandapower_net(g, load):
+    import pandapower as pp
+    import pandapower.networks as pn
+
+    fn = getattr(pn, g["network"], None)
+    if fn is None or not callable(fn):
+        raise ParameterError("grid.network", g["network"], "not a function of "
+                             "pandapower.networks (e.g. case9, create_cigre_network_mv)")
+    logging.getLogger("pandapower").setLevel(logging.ERROR)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        net = fn(**g.get("kwargs", {}))
+        if "keep_buses" in g:
+            keep = net.bus.name.astype(str).str.match(g["keep_buses"])
+            pp.toolbox.drop_buses(net, net.bus.index[~keep], drop_elements=True)
+        if g.get("islanded", False):
+            net.ext_grid.drop(net.ext_grid.index, inplace=True)
+        bus_of = {str(n): int(i) for i, n in net.bus.name.items() if n is not None}
+
+        def bref(ref, where):
+            if isinstance(ref, str):
+                if ref not in bus_of:
+                    raise ParameterError(where, ref, f"no bus of that name; e.g. "
+                                         f"{list(bus_of)[:8]}")
+                return bus_of[ref]
+            if ref not in net.bus.index:
+                raise ParameterError(where, ref, "no bus with that pandapower index")
+            return int(ref)
+
+        ld = g.get("loads", {})
+        levels = ld.get("levels", {})
+        if levels:
+            if load not in levels:
+                raise ParameterError("grid.loads.levels", levels, f"no level '{load}'")
+            scale = float(levels[load])
+            pf = ld.get("pf", {})
+            for i, row in net.load.iterrows():
+                p = float(row.p_mw) * scale
+                net.load.at[i, "p_mw"] = p
+                if row["name"] in pf:
+                    net.load.at[i, "q_mvar"] = p * math.tan(math.acos(float(pf[row["name"]])))
+                else:
+                    net.load.at[i, "q_mvar"] = float(row.q_mvar) * scale
+                net.load.at[i, "scaling"] = 1.0
+        for b in g.get("add_bus", []):
+            bus_of[b["name"]] = int(pp.create_bus(net, float(b["vn_kv"]), name=b["name"]))
+        for j, sg in enumerate(g.get("sgen_to_gen", [])):
+            w = f"grid.sgen_to_gen.{j}"
+            hit = net.sgen.index[net.sgen.name == sg["name"]]
+            if len(hit) != 1:
+                raise ParameterError(f"{w}.name", sg["name"], "no unique static generator of "
+                                     f"that name; e.g. {list(net.sgen.name)[:8]}")
+            row = net.sgen.loc[hit[0]]
+            p = float(row.p_mw) * float(row.scaling) * float(sg.get("scale", 1.0))
+            pp.create_gen(net, bref(sg["bus"], f"{w}.bus") if "bus" in sg else int(row.bus),
+                          p_mw=p, vm_pu=float(sg.get("vm_pu", 1.0)),
+                          name=sg["name"], sn_mva=float(row.sn_mva) if row.sn_mva == row.sn_mva
+                          else None)
+            net.sgen.drop(hit, inplace=True)
+        for j, z in enumerate(g.get("add_impedance", [])):
+            w = f"grid.add_impedance.{j}"
+            pp.create_impedance(net, bref(z["from"], f"{w}.from"), bref(z["to"], f"{w}.to"),
+                                rft_pu=z["r_pu"], xft_pu=z["x_pu"], sn_mva=z["sn_mva"],
+                                name=z.get("name", f"impedance {j}"))
+        for j, ge in enumerate(g.get("add_gen", [])):
+            w = f"grid.add_gen.{j}"
+            kw = {"slack": True} if ge.get("slack") else {}
+            pp.create_gen(net, bref(ge["bus"], f"{w}.bus"),
+                          p_mw=_per_level(ge.get("p_mw", 0.0), load, f"{w}.p_mw"),
+                          vm_pu=ge.get("vm_pu", 1.0), name=ge["name"], **kw)
+    return net, bus_of, bref
+
+
+def _pp_bus_ids(net) -> dict:
+    """pandapower bus index → simulator (ppc) bus number, after the conversion."""
+    lk = net._pd2ppc_lookups["bus"]        # set by pandapower's to_ppc (used only here)
+    return {int(i): int(lk[i]) for i in net.bus.index}
+
+
+# ----------------------------------------------------------------------------- setup
+def _network(study, load):
+    """``(Network, bus_id name→number, branch names, upqc row, System or None)`` at ``load``."""
+    g = study.data["grid"]
+    up = study.data["upqc"]
+    if g["kind"] == "pandapower":
+        net, bus_of, bref = _pandapower_net(g, load)
+        ins = up.get("insert")
+        ends = None
+        if ins:
+            el = ins.get("element", "line")
+            tab = getattr(net, el)
+            idx = ins.get("index")
+            if "name" in ins:
+                hit = tab.index[tab.name == ins["name"]]
+                if len(hit) != 1:
+                    raise ParameterError("upqc.insert.name", ins["name"],
+                                         f"no unique {el} of that name")
+                idx = int(hit[0])
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                res = insert_upqc_pandapower(net, el, idx, ins["side"], ins.get("r", 0.0),
+                                             ins["x"], ins.get("sn_mva", net.sn_mva),
+                                             name=up["name"])
+            ends = (res["shunt_bus"], res["series_bus"])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            network = Network.from_pandapower(net)
+        ids = _pp_bus_ids(net)
+        bus_id = {n: ids[i] for n, i in bus_of.items()}
+        bus_id.update({i: ids[i] for i in net.bus.index})
+        if ends is None:
+            br = up["branch"]
+            if not isinstance(br, dict):
+                raise ParameterError("upqc.branch", br, "for a pandapower grid give "
+                                     "{from = SHUNT BUS, to = BUS} (names or indices)")
+            ends = (bref(br["from"], "upqc.branch.from"), bref(br["to"], "upqc.branch.to"))
+        r_id, b1_id = ids[ends[0]], ids[ends[1]]
+        rows = [k for k, row in enumerate(network.branch)
+                if int(row[F_BUS]) == r_id and int(row[T_BUS]) == b1_id]
+        if len(rows) != 1:
+            raise ParameterError("upqc.branch", up.get("branch", up.get("insert")),
+                                 "no unique series branch from the shunt bus to that bus")
+        return network, bus_id, {}, rows[0], None
+    if g["kind"] == "andes":
+        return _andes_network(study, g, up)
+    if g["kind"] == "inline":
+        case, names, bus_id = _inline_case(g, load)
+        f_hz = float(g.get("f_hz", 60.0))
+    else:
+        from ..sim.io.matpower import load_matpower
+
+        case = load_matpower(study.resolve(g["file"]))
+        lv = g.get("loads", {}).get("levels", {})
+        if lv:
+            case["bus"] = np.array(case["bus"], float)
+            case["bus"][:, 2:4] *= float(lv[load])
+        names, bus_id = {}, {}
+        f_hz = float(g.get("f_hz", 60.0))
+
+    def row_of(ref, where):
+        if isinstance(ref, str):
+            if ref not in names:
+                raise ParameterError(where, ref, f"no branch of that name; choose one of "
+                                     f"{list(names)}")
+            return names[ref]
+        if isinstance(ref, int) and 0 <= ref < len(case["branch"]):
+            return ref
+        raise ParameterError(where, ref, "give a branch name or a 0-based row")
+
+    if up.get("insert"):
+        ins = up["insert"]
+        k = row_of(ins.get("branch", ins.get("index")), "upqc.insert.branch")
+        case, k_up, _, _ = insert_upqc_matpower(case, k, ins["side"], ins.get("r", 0.0), ins["x"])
+        names[up["name"]] = k_up
+    else:
+        k_up = row_of(up["branch"], "upqc.branch")
+    network = Network(case)
+    network.f_hz = f_hz
+    return network, bus_id, names, k_up, None
+
+
+def _andes_file(study, name):
+    if name.startswith("andes:"):
+        import andes
+
+        return andes.get_case(name[len("andes:"):])
+    return str(study.resolve(name))
+
+
+def _andes_network(study, g, up):
+    """An ANDES/PSS/E case (``file``, optional ``dyr``) with its machines and controls."""
+    try:
+        import andes
+    except ImportError:
+        raise ParameterError("grid.kind", "andes", "install the optional ANDES parser: "
+                             "pip install 'weakgrid[andes]'") from None
+    from ..sim.io.andes import from_andes
+
+    addfile = _andes_file(study, g["dyr"]) if g.get("dyr") else None
+    logging.getLogger("andes").setLevel(logging.ERROR)
+    ss = andes.load(_andes_file(study, g["file"]), addfile=addfile, setup=False,
+                    no_output=True, default_config=True)
+    system, _ = from_andes(ss, include_events=False)
+    bus_id = {str(k): int(v) for k, v in system.andes_bus_id.items()}
+    names = {str(k): int(v) for k, v in system.andes_line_row.items()}
+    ins = up.get("insert")
+    ref = str(ins.get("branch", ins.get("index")) if ins else up["branch"])
+    if ref not in names:
+        raise ParameterError("upqc.insert.branch" if ins else "upqc.branch", ref,
+                             f"no ANDES Line with that idx; choose one of {list(names)}")
+    if ins:     # a new bus and series branch (pu on the system base), appended to the tables
+        net = system.network
+        case, k_up, _, _ = insert_upqc_matpower(net.case, names[ref], ins["side"],
+                                                ins.get("r", 0.0), ins["x"])
+        system.network = Network(case, f_hz=net.f_hz)
+        names[up["name"]] = k_up
+        return system.network, bus_id, names, k_up, system
+    return system.network, bus_id, names, names[ref], system
+
+
+def build_setup(study, load: str | None = None, upqc: str | None = None,
+                variant: str = "upqc") -> Setup:
+    """Build and set up the study's grid at ``load`` with the UPQC in structure ``upqc``."""
+    d = study.data
+    load = load or d["design"].get("load", study.loads[0])
+    if load not in study.loads:
+        raise ParameterError("load", load, f"choose one of {study.loads}")
+    upqc = upqc or d["upqc"]["structure"]
+    if variant not in VARIANTS:
+        raise ParameterError("variant", variant, f"choose one of {VARIANTS}")
+    network, bus_id, br_names, k_up, system = _network(study, load)
+    if d["upqc"].get("side", "from") == "to":     # the branch's to-bus is the shunt bus r
+        row = network.branch[k_up]
+        row[F_BUS], row[T_BUS] = row[T_BUS], row[F_BUS]
+    r_id = int(network.branch[k_up, F_BUS])
+    s = system if system is not None else System(network)
+    net = s.network
+    gbus = net.gen[:, GEN_BUS].astype(int)
+
+    def gen_row(ref, where):
+        bid = _bus_ref(ref, bus_id, net, where)
+        rows = np.nonzero(gbus == bid)[0]
+        if len(rows) != 1:
+            raise ParameterError(where, ref, f"expected exactly one generator at bus {bid}, "
+                                 f"found {len(rows)}")
+        return int(rows[0])
+
+    ctl_name = d["machine"]["name"]
+    dyn = d["dynamics"]
+    for i, gen in enumerate(dyn["generator"]):
+        parts = {}
+        for part in ("machine", "exciter", "governor", "pss"):
+            if part in gen:
+                p = dict(gen[part])
+                parts[part] = (p.pop("model"), p)
+        s.add_generator(gen["name"], gen_row(gen["bus"], f"dynamics.generator.{i}.bus"), **parts)
+    gti_names = [gt["name"] for gt in dyn["gti"]]
+    if variant == "pq" and ctl_name not in gti_names:
+        raise ParameterError("controller", "pq", "the PQ baseline replaces the UPQC by the "
+                             "PQ loops of a GTI; this study's controlled machine is not a GTI")
+    if dyn["gti"]:
+        comp = s.add_component(GTI())
+        for i, gt in enumerate(dyn["gti"]):
+            p = {k: v for k, v in gt.items() if k not in ("name", "bus", "mode", "ref_bus")}
+            mode = "pq" if (variant == "pq" and gt["name"] == ctl_name) else gt.get("mode",
+                                                                                   "energy")
+            ref = _bus_ref(gt["ref_bus"], bus_id, net, f"dynamics.gti.{i}.ref_bus") \
+                if "ref_bus" in gt else r_id
+            comp.add_gti(gt["name"], gen=gen_row(gt["bus"], f"dynamics.gti.{i}.bus"),
+                         ref_bus=ref, mode=mode, **p)
+    up = d["upqc"]
+    upqc_name = None
+    if variant == "upqc":
+        if upqc == "reduced" and ctl_name not in gti_names:
+            raise ParameterError("upqc.structure", "reduced", "the reduced UPQC takes its "
+                                 "series power from the controlled GTI's dc link; this study's "
+                                 "controlled machine is an SG: use 'conventional'")
+        u = s.add_component(UPQC())
+        u.add_upqc(up["name"], branch=k_up, structure=upqc,
+                   gti=ctl_name if upqc == "reduced" else None, Vmax=up["rating"])
+        upqc_name = up["name"]
+    s.setup()
+    der = derive_design(s, ctl_name, k_up, float(d["design"]["T"]), structure=upqc)
+    b1 = net.index_of(int(net.branch[k_up, T_BUS]))
+    r = net.index_of(r_id)
+    yu = 1.0 / complex(net.branch[k_up, BR_R], net.branch[k_up, BR_X])
+    I = yu * (net.pf.V[r] - net.pf.V[b1])
+    p_line = abs(float((net.pf.V[r] * np.conj(I)).real)) * net.Sb
+    if der.machine == "gti":
+        measure = gti_design_states(ctl_name)
+    else:
+        meas = sg_design_states(ctl_name, r_id)
+        ws = 2 * math.pi * float(net.f_hz)
+
+        def measure(sim, t, z, ctx):
+            m = meas(sim, t, z, ctx)
+            return np.array([m[0], m[1] * ws])              # speed error pu -> rad/s
+    speed_of = d["report"].get("speed_of")
+    speed_of = speed_of if speed_of is not None else (ctl_name if der.machine == "sg" else
+                                               (dyn["generator"][0]["name"]
+                                                if dyn["generator"] else None))
+    signals = {"shunt_bus_v": f"bus{r_id}.v"}
+    if speed_of:
+        signals.update(sg_speed=f"{speed_of}.omega", sg_pe=f"{speed_of}.Pe")
+    if der.machine == "gti":
+        signals.update(dc_voltage=f"{ctl_name}.Vc", phi_hat=f"{ctl_name}.phi_hat",
+                       upsilon=f"{ctl_name}.upsilon")
+    if upqc_name:
+        signals.update(vup=f"{upqc_name}.Vup", vuq=f"{upqc_name}.Vuq",
+                       p_series=f"{upqc_name}.P_series", q_series=f"{upqc_name}.Q_series",
+                       p_line=f"{upqc_name}.P_line", vu=f"{upqc_name}.Vu")
+    return Setup(study=study, load=load, upqc=upqc, variant=variant, system=s,
+                 machine=der.machine, source=ctl_name, upqc_name=upqc_name, shunt_bus=r_id,
+                 upqc_branch=k_up, measure=measure, design=der.model, derivation=der,
+                 line_power_mw=p_line, signals=signals, Sb_mva=float(net.Sb), bus_id=bus_id,
+                 branch_names=br_names)

@@ -1,0 +1,407 @@
+"""Study files: a grid, a controlled machine, a UPQC, design settings, controllers, scenarios.
+
+A study is a TOML file (or a dict: :func:`study_from_dict`), validated when read; every error
+names the field (as a dotted path), the value and the fix. Any field can be addressed by a
+dotted path (:func:`get_path`, :func:`set_path`): ``upqc.rating``, ``design.T``,
+``scenarios.c1-high-conv.events.0.xf`` (a list element by its ``id``, or by index). The shipped
+studies live in ``weakgrid/data/studies/`` and can be named instead of a path.
+
+Tables (defaults in brackets)::
+
+    [study]       name, title [""], reproduce [false] (part of `weakgrid reproduce`), notes [[]]
+    [grid]        kind = "inline" | "pandapower" | "matpower"; see weakgrid.study.grid
+    [[dynamics.generator]]  name, bus, machine = {model, …}, exciter/governor/pss [none]
+    [[dynamics.gti]]        name, bus, C, Vc0, chi, B, ks_max, tau, mode ["energy"]
+    [machine]     name (the controlled GTI or SG)
+    [upqc]        name ["UPQC"], branch | insert, structure ["conventional"], rating [0.2]
+    [design]      T, settings (a preset giving Q, R, P, γ, Ω, mesh, basis, initial policy)
+                  [cost], [mesh], [basis], [initial_policy], [solver] (override the preset)
+    [controllers] compare [["hji", "lqr", "pss-only"]], [controllers.NAME] options
+    [[scenarios]] id, load, upqc, t_end, controllers, events, bypass, quick
+    [report]      speed_of [the controlled SG, else the first generator; "" for none], notes
+    [[figures]]   id, title, panels, runs = [[run id, label]]  [one figure per scenario]
+    [[claims]]    id, case, paper, rule, judge (weakgrid.study.claims.RULES), parameters
+"""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+from ..game.errors import ParameterError
+
+__all__ = ["Study", "load_study", "study_from_dict", "get_path", "set_path", "shipped_studies",
+           "read_study_dict", "EVENT_KINDS"]
+
+TOP = {"study", "grid", "dynamics", "machine", "upqc", "design", "controllers", "scenarios",
+       "report", "figures", "claims"}
+GRID_KINDS = ("inline", "pandapower", "matpower", "andes")
+STRUCTURES = ("conventional", "reduced")
+EVENT_KINDS = ("fault", "line_trip", "load_step")
+
+
+# --------------------------------------------------------------------------- dotted paths
+def _step(obj, key, path):
+    if isinstance(obj, dict):
+        if key not in obj:
+            raise ParameterError(path, None, f"no field '{key}'; fields here: {sorted(obj)}")
+        return obj[key]
+    if isinstance(obj, list):
+        for el in obj:
+            if isinstance(el, dict) and str(el.get("id", el.get("name"))) == key:
+                return el
+        if key.lstrip("-").isdigit() and -len(obj) <= int(key) < len(obj):
+            return obj[int(key)]
+        ids = [el.get("id", el.get("name")) for el in obj if isinstance(el, dict)]
+        raise ParameterError(path, None, f"no element '{key}'; give an index 0..{len(obj) - 1} "
+                             f"or one of {ids}")
+    raise ParameterError(path, obj, "is a value, not a table")
+
+
+def get_path(d: dict, path: str):
+    """The value at dotted ``path`` in study dict ``d`` (e.g. ``"upqc.rating"``)."""
+    obj = d
+    for i, key in enumerate(path.split(".")):
+        obj = _step(obj, key, ".".join(path.split(".")[:i + 1]))
+    return obj
+
+
+def set_path(d: dict, path: str, value) -> dict:
+    """Set the value at dotted ``path`` (creating missing tables); returns ``d``."""
+    keys = path.split(".")
+    obj = d
+    for i, key in enumerate(keys[:-1]):
+        if isinstance(obj, dict) and key not in obj:
+            obj[key] = {}
+        obj = _step(obj, key, ".".join(keys[:i + 1]))
+    last = keys[-1]
+    if isinstance(obj, list):
+        target = _step(obj, last, path)
+        obj[obj.index(target)] = value
+    elif isinstance(obj, dict):
+        obj[last] = value
+    else:
+        raise ParameterError(".".join(keys[:-1]), obj, "is a value, not a table")
+    return d
+
+
+# --------------------------------------------------------------------------- reading
+def shipped_studies() -> list[str]:
+    """Names of the studies shipped in ``weakgrid/data/studies``."""
+    folder = resources.files("weakgrid") / "data" / "studies"
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def read_study_dict(src) -> tuple[dict, str]:
+    """``(dict, source)`` of a study file path or a shipped study name."""
+    p = Path(str(src))
+    if not p.exists() and str(src) in shipped_studies():
+        res = resources.files("weakgrid") / "data" / "studies" / f"{src}.toml"
+        with resources.as_file(res) as rp:
+            return _read(rp), f"shipped:{src}"
+    if not p.exists():
+        raise ParameterError("study", str(src), "no such file and no shipped study of that "
+                             f"name; shipped: {shipped_studies()}")
+    return _read(p), str(p)
+
+
+def _read(p) -> dict:
+    try:
+        with open(p, "rb") as fh:
+            return tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError("study", str(p), f"is not valid TOML ({exc})") from None
+
+
+def load_study(src) -> "Study":
+    """Read and validate a study (a path or a shipped study's name)."""
+    d, source = read_study_dict(src)
+    base = Path(source).parent if not source.startswith("shipped:") else None
+    return study_from_dict(d, source=source, base_dir=base)
+
+
+# --------------------------------------------------------------------------- validation
+def _need(d, key, where, types=None):
+    if not isinstance(d, dict) or key not in d:
+        raise ParameterError(f"{where}.{key}", None, "missing; give it in the study file")
+    v = d[key]
+    if types is not None and not isinstance(v, types):
+        raise ParameterError(f"{where}.{key}", v, f"must be of type {_tn(types)}")
+    return v
+
+
+def _tn(types):
+    types = types if isinstance(types, tuple) else (types,)
+    return " or ".join({"str": "string", "int": "integer", "float": "number", "dict": "table",
+                        "list": "list", "bool": "true/false"}.get(t.__name__, t.__name__)
+                       for t in types)
+
+
+def _num(d, key, where, default=None, positive=False, nonneg=False):
+    if key not in d:
+        if default is None:
+            raise ParameterError(f"{where}.{key}", None, "missing; give a number")
+        return default
+    v = d[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise ParameterError(f"{where}.{key}", v, "must be a number")
+    v = float(v)
+    if v != v or v in (float("inf"), float("-inf")):
+        raise ParameterError(f"{where}.{key}", v, "must be finite")
+    if positive and v <= 0:
+        raise ParameterError(f"{where}.{key}", v, "must be > 0")
+    if nonneg and v < 0:
+        raise ParameterError(f"{where}.{key}", v, "must be ≥ 0")
+    return v
+
+
+def _keys(d, allowed, where):
+    if not isinstance(d, dict):
+        raise ParameterError(where, d, "must be a table")
+    for k in d:
+        if k not in allowed:
+            raise ParameterError(f"{where}.{k}", d[k], f"unknown field; allowed: {sorted(allowed)}")
+
+
+def _choice(d, key, where, choices, default=None):
+    v = d.get(key, default)
+    if v not in choices:
+        raise ParameterError(f"{where}.{key}", v, f"choose one of {list(choices)}")
+    return v
+
+
+@dataclass
+class Study:
+    """A validated study.
+
+    Attributes
+    ----------
+    data : dict
+        The study with defaults filled in (what runs; ``get_path``/``set_path`` address it).
+    source : str
+        Where it was read from.
+    base_dir : Path or None
+        Folder relative file names are resolved against.
+    """
+
+    data: dict
+    source: str = ""
+    base_dir: Path | None = None
+
+    @property
+    def name(self) -> str:
+        return self.data["study"]["name"]
+
+    def get(self, path):
+        return get_path(self.data, path)
+
+    def with_values(self, **paths) -> "Study":
+        """A copy with dotted-path fields replaced, validated again (``{"upqc.rating": 0.3}``)."""
+        d = copy.deepcopy(self.data)
+        for p, v in paths.items():
+            set_path(d, p, v)
+        return study_from_dict(d, self.source, self.base_dir)
+
+    def resolve(self, name) -> Path:
+        p = Path(name)
+        return p if p.is_absolute() or self.base_dir is None else self.base_dir / p
+
+    @property
+    def loads(self) -> list[str]:
+        g = self.data["grid"]
+        if g["kind"] == "inline":
+            return list(g.get("loads", {})) or ["base"]
+        return list(g.get("loads", {}).get("levels", {})) or ["base"]
+
+    @property
+    def controllers(self) -> list[str]:
+        return list(self.data["controllers"]["compare"])
+
+    def scenarios(self, quick: bool = False) -> list[dict]:
+        """Scenarios (dicts, with their defaults) of a full or a quick run; quick uses each
+        scenario's ``quick`` settings and leaves out scenarios without them."""
+        out = []
+        for sc in self.data["scenarios"]:
+            if "bypass" not in sc:
+                sc = dict(sc, bypass=[[e["t_on"], e["t_off"]] for e in sc["events"]
+                                      if e["kind"] == "fault"])
+            if quick:
+                q = sc.get("quick")
+                if not q:
+                    continue
+                sc = dict(sc, t_end=q.get("t_end", sc["t_end"]),
+                          controllers=q.get("controllers", sc["controllers"]))
+            out.append(sc)
+        return out
+
+    def runs(self, quick: bool = False) -> list[tuple[dict, str]]:
+        """Every ``(scenario, controller)`` pair; run id = ``"<scenario id>-<controller>"``."""
+        return [(sc, c) for sc in self.scenarios(quick) for c in sc["controllers"]]
+
+
+def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
+    """Validate a study dict and fill in its defaults (the input is not modified)."""
+    d = copy.deepcopy(d)
+    _keys(d, TOP, "study file")
+    st = d.setdefault("study", {})
+    _keys(st, {"name", "title", "reproduce", "notes", "description"}, "study")
+    st.setdefault("name", Path(source).stem if source else "study")
+    st.setdefault("title", "")
+    st.setdefault("reproduce", False)
+    st.setdefault("notes", [])
+    g = _need(d, "grid", "study file", dict)
+    _choice(g, "kind", "grid", GRID_KINDS)
+    if g["kind"] == "inline":
+        for k in ("bus", "branch", "gen"):
+            _need(g, k, "grid", list)
+        _num(g, "Sb_mva", "grid", 100.0, positive=True)
+        g.setdefault("Sb_mva", 100.0)
+        g.setdefault("f_hz", 60.0)
+    elif g["kind"] == "pandapower":
+        _need(g, "network", "grid", str)
+    else:
+        _need(g, "file", "grid", str)
+    dyn = d.setdefault("dynamics", {})
+    _keys(dyn, {"generator", "gti"}, "dynamics")
+    names = []
+    for i, gen in enumerate(dyn.setdefault("generator", [])):
+        w = f"dynamics.generator.{i}"
+        _keys(gen, {"name", "bus", "machine", "exciter", "governor", "pss"}, w)
+        names.append(_need(gen, "name", w, str))
+        _need(gen, "bus", w, (int, str))
+        _need(_need(gen, "machine", w, dict), "model", f"{w}.machine", str)
+        for part in ("exciter", "governor", "pss"):
+            if part in gen:
+                _need(_need(gen, part, w, dict), "model", f"{w}.{part}", str)
+    for i, gt in enumerate(dyn.setdefault("gti", [])):
+        w = f"dynamics.gti.{i}"
+        _keys(gt, {"name", "bus", "mode", "ref_bus", "C", "Vc0", "chi", "B", "ks_max", "tau",
+                   "kp_p", "ki_p", "kd_p", "kp_q", "ki_q", "kd_q", "Td"}, w)
+        names.append(_need(gt, "name", w, str))
+        _need(gt, "bus", w, (int, str))
+        _choice(gt, "mode", w, ("energy", "pq"), "energy")
+        for k in ("C", "B", "tau", "Vc0"):
+            _num(gt, k, w, positive=k != "tau")
+    m = _need(d, "machine", "study file", dict)
+    _keys(m, {"name"}, "machine")
+    if _need(m, "name", "machine", str) not in names and g["kind"] != "andes":
+        raise ParameterError("machine.name", m["name"], f"no generator or GTI of that name in "
+                             f"[dynamics]; choose one of {names}")
+    up = _need(d, "upqc", "study file", dict)
+    _keys(up, {"name", "branch", "side", "insert", "structure", "rating"}, "upqc")
+    _choice(up, "side", "upqc", ("from", "to"), "from")
+    up.setdefault("name", "UPQC")
+    up["structure"] = _choice(up, "structure", "upqc", STRUCTURES, "conventional")
+    up["rating"] = _num(up, "rating", "upqc", 0.2, positive=True)
+    if ("branch" in up) == ("insert" in up):
+        raise ParameterError("upqc.branch", up.get("branch"), "give either upqc.branch (an "
+                             "existing series branch, from = shunt bus) or upqc.insert (a new "
+                             "series branch put into an existing branch)")
+    if "insert" in up:
+        ins = up["insert"]
+        _keys(ins, {"element", "index", "name", "branch", "side", "r", "x", "sn_mva"},
+              "upqc.insert")
+        _choice(ins, "side", "upqc.insert", ("from", "to"))
+        _num(ins, "x", "upqc.insert", positive=True)
+        ins.setdefault("r", 0.0)
+    ds = _need(d, "design", "study file", dict)
+    _keys(ds, {"T", "settings", "cost", "mesh", "basis", "initial_policy", "solver", "load"},
+          "design")
+    _num(ds, "T", "design", positive=True)
+    ds.setdefault("settings", "case1-paper")
+    from ..models import preset_names
+
+    if ds["settings"] not in preset_names():
+        raise ParameterError("design.settings", ds["settings"],
+                             f"choose a preset for Q, R, P, γ, Ω, mesh, basis, initial policy: "
+                             f"{preset_names()}")
+    ct = d.setdefault("controllers", {})
+    ct.setdefault("compare", ["hji", "lqr", "pss-only"])
+    from .controllers import CONTROLLER_KINDS
+
+    if not isinstance(ct["compare"], list) or not ct["compare"]:
+        raise ParameterError("controllers.compare", ct["compare"], "give a list of controllers")
+    for c in ct["compare"]:
+        kind = ct.get(c, {}).get("kind", c) if isinstance(ct.get(c), dict) else c
+        if kind not in CONTROLLER_KINDS:
+            raise ParameterError("controllers.compare", c, f"unknown controller; choose from "
+                                 f"{sorted(CONTROLLER_KINDS)} or define [controllers.{c}] "
+                                 "with kind = \"file\", path = …")
+    scs = _need(d, "scenarios", "study file", list)
+    seen = set()
+    loads = Study(d, source, base_dir).loads
+    for i, sc in enumerate(scs):
+        w = f"scenarios.{i}"
+        _keys(sc, {"id", "load", "upqc", "t_end", "controllers", "events", "bypass", "quick",
+                   "description"}, w)
+        sid = _need(sc, "id", w, str)
+        if sid in seen:
+            raise ParameterError(f"{w}.id", sid, "scenario ids must be unique")
+        seen.add(sid)
+        w = f"scenarios.{sid}"
+        sc.setdefault("load", loads[0])
+        if sc["load"] not in loads:
+            raise ParameterError(f"{w}.load", sc["load"], f"choose one of {loads}")
+        sc["upqc"] = _choice(sc, "upqc", w, STRUCTURES, up["structure"])
+        sc["t_end"] = _num(sc, "t_end", w, positive=True)
+        sc.setdefault("controllers", list(ct["compare"]))
+        for c in sc["controllers"]:
+            if c not in ct["compare"]:
+                raise ParameterError(f"{w}.controllers", c, f"not in controllers.compare "
+                                     f"{ct['compare']}; add it there")
+        evs = sc.setdefault("events", [])
+        for j, ev in enumerate(evs):
+            _event(ev, f"{w}.events.{j}", sc["t_end"])
+        # bypass: default = the fault windows, computed when used (so that it follows the
+        # faults when a field is changed later), see Study.scenarios
+        for j, b in enumerate(sc.get("bypass", [])):
+            if not (isinstance(b, list) and len(b) == 2 and b[0] < b[1]):
+                raise ParameterError(f"{w}.bypass.{j}", b, "give [t_start, t_end] with "
+                                     "t_start < t_end (s)")
+        q = sc.get("quick")
+        if q:
+            _keys(q, {"t_end", "controllers"}, f"{w}.quick")
+    rp = d.setdefault("report", {})
+    _keys(rp, {"speed_of", "notes"}, "report")
+    rp.setdefault("notes", [])
+    d.setdefault("figures", [])
+    d.setdefault("claims", [])
+    for i, c in enumerate(d["claims"]):
+        from .claims import RULES
+
+        _choice(c, "judge", f"claims.{i}", sorted(RULES))
+        for k in ("id", "paper", "rule"):
+            _need(c, k, f"claims.{i}", str)
+    return Study(d, source, base_dir)
+
+
+def _event(ev, w, t_end):
+    kind = _choice(ev, "kind", w, EVENT_KINDS)
+    if kind == "fault":
+        _keys(ev, {"kind", "bus", "t_on", "t_off", "duration", "rf", "xf"}, w)
+        _need(ev, "bus", w, (int, str))
+        t_on = _num(ev, "t_on", w, nonneg=True)
+        if "duration" in ev:      # t_off from the duration (the duration is not kept)
+            ev["t_off"] = t_on + _num(ev, "duration", w, positive=True)
+            del ev["duration"]
+        t_off = _num(ev, "t_off", w)
+        if not t_on < t_off <= t_end:
+            raise ParameterError(f"{w}.t_off", t_off, f"need t_on ({t_on}) < t_off ≤ t_end "
+                                 f"({t_end})")
+        ev["rf"] = _num(ev, "rf", w, 0.0, nonneg=True)
+        ev["xf"] = _num(ev, "xf", w, 1e-3, nonneg=True)
+        if ev["rf"] == 0 and ev["xf"] == 0:
+            raise ParameterError(f"{w}.xf", 0.0, "a fault needs a non-zero impedance (rf or xf)")
+    elif kind == "line_trip":
+        _keys(ev, {"kind", "branch", "t", "close"}, w)
+        _need(ev, "branch", w, (int, str, dict))
+        _num(ev, "t", w, nonneg=True)
+    else:
+        _keys(ev, {"kind", "bus", "t", "dP", "dQ"}, w)
+        _need(ev, "bus", w, (int, str))
+        _num(ev, "t", w, nonneg=True)
+        ev["dP"] = _num(ev, "dP", w, 0.0)
+        ev["dQ"] = _num(ev, "dQ", w, 0.0)
