@@ -31,4 +31,4 @@ if __name__ == "__main__":
     n = int(sys.argv[2]) if len(sys.argv) > 2 else 4
     t_end = float(sys.argv[3]) if len(sys.argv) > 3 else 0.4
     rp.paper_studies = lambda: [small_study(n, t_end)]
-    sys.exit(main(["reproduce", "--output", sys.argv[1]]))
+    sys.exit(main(["reproduce", "--output", sys.argv[1]] + sys.argv[4:]))

@@ -93,6 +93,6 @@ def test_cli_refuses_a_malformed_file_naming_the_field(tmp_path, capsys):
     src = resources.files("weakgrid") / "data" / "studies" / "case1-weak-grid.toml"
     body = src.read_text().replace('rating = 0.15', 'rating = "high"')
     text.write_text(body)
-    assert main(["design", str(text), "--no-train"]) == 1
+    assert main(["design", str(text), "--no-train"]) == 2
     err = capsys.readouterr().err
     assert "upqc.rating" in err and "high" in err

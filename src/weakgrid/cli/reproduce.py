@@ -32,7 +32,7 @@ def run(args) -> int:
     from ..study.reproduce import reproduce
 
     summary = reproduce(args.output, quick=args.quick)
-    width = max(len(c["id"]) for c in summary["claims"])
+    width = max((len(c["id"]) for c in summary["claims"]), default=0)
     print("\nclaims of the paper:")
     for c in summary["claims"]:
         print(f"  {c['id']:<{width}}  {c['verdict']:<10}  {c['paper']}")
