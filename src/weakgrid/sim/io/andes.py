@@ -102,7 +102,8 @@ def from_andes(ss, include_events: bool = True):
             if _raw(sh, "u")[k] > 0:
                 i = pos[sh.bus.v[k]]
                 Sn, Vn = _raw(sh, "Sn")[k], _raw(sh, "Vn")[k]
-                c = (Sn / Sb) * (Vn_bus[i] / Vn) ** -2 if Vn > 0 else Sn / Sb
+                # b [pu on (Sn, Vn)] -> system base at the bus voltage: x (Sn/Sb) (Vb/Vn)^2 (as ANDES)
+                c = (Sn / Sb) * (Vn_bus[i] / Vn) ** 2 if Vn > 0 else Sn / Sb
                 B[i, 4] += _raw(sh, "g")[k] * c * Sb
                 B[i, 5] += _raw(sh, "b")[k] * c * Sb
     G = []
