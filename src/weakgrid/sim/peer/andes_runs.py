@@ -11,7 +11,7 @@ import time
 import numpy as np
 
 
-def load_andes(case: str, fault=None, disable_toggles=False, add=()):
+def load_andes(case: str, fault=None, disable_toggles=False, add=(), edit=()):
     """Load an ANDES stock case with ``andes.load(..., setup=False)``; optionally add a fault.
 
     Parameters
@@ -24,6 +24,8 @@ def load_andes(case: str, fault=None, disable_toggles=False, add=()):
         Set ``u = 0`` on all ``Toggle`` devices (e.g. the shipped line trip).
     add : sequence of (model, dict)
         Extra ANDES devices to add (e.g. ``("Toggle", {"model": "Line", "dev": "Line_8", "t": 3})``).
+    edit : sequence of (model, parameter, value)
+        Set a parameter of every device of a model (e.g. ``("IEEEST", "T5", 0.0)``).
     """
     import andes
 
@@ -37,10 +39,13 @@ def load_andes(case: str, fault=None, disable_toggles=False, add=()):
         ss.add("Fault", {"bus": bus, "tf": tf, "tc": tc})
     for model, data in add:
         ss.add(model, dict(data))
+    for model, prm, value in edit:
+        par = getattr(ss.models[model], prm)
+        par.v[:] = [value] * len(par.v)
     return ss
 
 
-def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, linesearch=None, add=()):
+def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, linesearch=None, add=(), edit=()):
     """Simulate a stock case in ANDES with a fixed step ``h``.
 
     Returns
@@ -48,7 +53,7 @@ def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1
     dict with ``t``, ``omega`` (n_t, n_gen), ``delta`` (n_t, n_gen), ``wall`` [s] (TDS only),
     ``names`` (generator idx order).
     """
-    ss = load_andes(case, fault, disable_toggles, add)
+    ss = load_andes(case, fault, disable_toggles, add, edit)
     ss.setup()
     ss.PFlow.config.tol = 1e-11
     ss.PFlow.run()
@@ -70,12 +75,12 @@ def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1
             "ok": bool(ss.exit_code == 0)}
 
 
-def build_weakgrid(case, fault=None, disable_toggles=False, add=()):
+def build_weakgrid(case, fault=None, disable_toggles=False, add=(), edit=()):
     """The same case imported into weakgrid through ANDES's loader; returns ``(system, events, machine names)``."""
     from ..events import Fault
     from ..io.andes import from_andes
 
-    ss = load_andes(case, None, disable_toggles, add)
+    ss = load_andes(case, None, disable_toggles, add, edit)
     system, events = from_andes(ss)
     if fault is not None:
         bus, tf, tc = fault
@@ -83,11 +88,11 @@ def build_weakgrid(case, fault=None, disable_toggles=False, add=()):
     return system, events, list(system.machine_names)
 
 
-def run_weakgrid(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, add=(), **kw):
+def run_weakgrid(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, add=(), edit=(), **kw):
     """Simulate the case in weakgrid with step ``h``; same outputs as :func:`run_andes`."""
     from ..integrate import Simulator
 
-    system, events, names = build_weakgrid(case, fault, disable_toggles, add)
+    system, events, names = build_weakgrid(case, fault, disable_toggles, add, edit)
     system.setup()
     sim = Simulator(system, dt=h, tol=tol, **kw)
     t0 = time.perf_counter()
