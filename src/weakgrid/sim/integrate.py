@@ -43,6 +43,22 @@ def lu_solve(lu, b):
     return x
 
 
+def default_tol(dt: float) -> float:
+    """Default Newton tolerance [pu] for step ``dt`` [s]: ``1e-7 (dt / (1/120 s))**3`` in ``[1e-10, 1e-7]``.
+
+    Each accepted step carries an iteration error up to ``tol`` that, in lightly damped
+    swings, accumulates over the ``T/dt`` steps of a run, while the trapezoidal rule's own
+    global error falls as ``dt**2``; a tolerance that falls like the local error ``dt**3``
+    keeps the iteration error a fixed small fraction of the step error at every step size.
+    Measured on ANDES's SMIB case (10 s, lightly damped): with a fixed 1e-7, at 1/480 s the
+    result moved 2.5e-5 pu between tolerances 1e-7 and 1e-12, as much as halving the step
+    (2.4e-5 pu); with this default the tolerance effect is < 1/10 of the step effect from
+    1/120 s to 1/1920 s. ``1e-7`` at 1/120 s keeps the PSS/E-class steps as fast as before;
+    the ``1e-10`` floor stays far above round-off.
+    """
+    return float(min(1e-7, max(1e-10, 1e-7 * (dt * 120.0) ** 3)))
+
+
 class Simulator:
     """Time-domain simulation of a set-up :class:`~weakgrid.sim.system.System`.
 
@@ -52,8 +68,11 @@ class Simulator:
         A system after :meth:`~weakgrid.sim.system.System.setup`.
     dt : float
         Nominal step [s].
-    tol : float
-        Newton convergence tolerance on the largest update [pu].
+    tol : float, optional
+        Newton convergence tolerance on the largest update [pu]. Default: scaled with
+        the step like the method's local error, ``1e-7 (dt / (1/120 s))**3``, within
+        ``[1e-10, 1e-7]`` (see :func:`default_tol`), so that the step, not the
+        tolerance, sets the error of a run.
     max_iter : int
         Newton iterations before the Jacobian is refreshed / the step is halved.
     max_angle_spread : float
@@ -62,7 +81,7 @@ class Simulator:
         Record every n-th step (breakpoints are always recorded).
     """
 
-    def __init__(self, system, dt=1 / 120, tol=1e-7, max_iter=8, max_angle_spread=180.0,
+    def __init__(self, system, dt=1 / 120, tol=None, max_iter=8, max_angle_spread=180.0,
                  save_every=1, min_step=None):
         if not system.is_setup:
             system.setup()
@@ -70,7 +89,7 @@ class Simulator:
             raise DataError("simulation", "dt", dt, "give a positive time step in seconds")
         self.sys = system
         self.dt = float(dt)
-        self.tol = float(tol)
+        self.tol = default_tol(self.dt) if tol is None else float(tol)
         self.max_iter = int(max_iter)
         self.max_spread = math.radians(max_angle_spread)
         self.save_every = int(save_every)

@@ -89,7 +89,9 @@ def build_weakgrid(case, fault=None, disable_toggles=False, add=(), edit=()):
 
 
 def run_weakgrid(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, add=(), edit=(), **kw):
-    """Simulate the case in weakgrid with step ``h``; same outputs as :func:`run_andes`."""
+    """Simulate the case in weakgrid with step ``h``; same outputs as :func:`run_andes`.
+
+    ``tol=None`` uses the simulator's default (step-scaled) Newton tolerance."""
     from ..integrate import Simulator
 
     system, events, names = build_weakgrid(case, fault, disable_toggles, add, edit)
