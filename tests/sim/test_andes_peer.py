@@ -22,6 +22,10 @@ CASES = {
     "smib_fault": dict(case="smib/SMIB.xlsx", h=1 / 1920, kw=dict(), akw=dict(linesearch=0)),
     "kundur_trip": dict(case=KUNDUR, h=1 / 60, kw=dict(), akw=dict()),
     "kundur_fault": dict(case=KUNDUR, h=1 / 60, kw=dict(fault=(8, 1.0, 1.05), disable_toggles=True), akw=dict()),
+    # the shipped Toggle opens Line_8 at 2 s; a second Toggle recloses it at 3 s (issue 8, item 3)
+    "kundur_trip_reclose": dict(case=KUNDUR, h=1 / 60,
+                                kw=dict(add=[("Toggle", {"model": "Line", "dev": "Line_8", "t": 3.0})]),
+                                akw=dict()),
 }
 
 

@@ -79,10 +79,8 @@ def scatter_add(a, idx, v, unique):
     """``a[..., idx] += v`` along the last axis, also for repeated indices (``unique=False``)."""
     if unique:
         a[..., idx] += v
-    else:
-        v = np.broadcast_to(v, a.shape[:-1] + (len(idx),))
-        for k, j in enumerate(idx):
-            a[..., j] += v[..., k]
+    else:   # unbuffered: every repeated index receives its share (two devices on one bus)
+        np.add.at(a, (Ellipsis, idx), v)
 
 
 class Component:

@@ -58,3 +58,7 @@ class SimulationError(SimError):
         self.cause = cause
         self.detail = detail
         super().__init__(f"simulation stopped at t = {self.t:.6g} s: {cause}" + (f" ({detail})" if detail else ""))
+
+
+class DataWarning(UserWarning):
+    """Data that is accepted but unusual enough to be said (e.g. a negative series reactance)."""

@@ -101,8 +101,11 @@ class LineTrip(Event):
             raise DataError(f"LineTrip at t={self.t}", "branch", self.branch, f"give a branch row 0..{nl - 1}")
 
     def apply(self, sim):
-        sim.sys.branch_status[self.branch] = self.close
+        sim.sys.branch_status[self.branch] = bool(self.close)
         sim.sys.update_network()
+
+    def __repr__(self):
+        return f"LineTrip(branch={self.branch}, t={self.t}, close={self.close})"
 
 
 class LoadStep(Event):

@@ -7,10 +7,13 @@ from-bus) and phase shift ``SHIFT`` [deg]. Loads ``PD + jQD`` [MW, Mvar] become
 constant admittances at their power-flow voltage in the time domain (as the
 ANDES ``PQ`` model with ``p2z = q2z = 1``); shunts ``GS + jBS`` [MW, Mvar at 1 pu].
 
-The power flow is *not* hand-written: :meth:`Network.solve_power_flow` converts
-the case to pandapower (``pandapower.converter.from_ppc``) and runs
-``pandapower.runpp``. The solution is then checked against this module's own
-admittance matrix; a mismatch raises :class:`~weakgrid.sim.errors.PowerFlowError`.
+The power flow is *not* hand-written: :meth:`Network.solve_power_flow` runs
+MATPOWER's Newton–Raphson method (PYPOWER's ``newtonpf``) on this module's own
+admittance matrix, so that transformer taps, phase shifts and charging are the
+same in the power flow and in the time domain, for either tap orientation (a
+conversion to pandapower elements places the tap on the high-voltage side).
+The solution is re-checked against the admittance matrix; a mismatch raises
+:class:`~weakgrid.sim.errors.PowerFlowError`.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import DataError, PowerFlowError
+from .errors import DataError, DataWarning, PowerFlowError
 
 # MATPOWER column indices (0-based)
 BUS_I, BUS_TYPE, PD, QD, GS, BS, BUS_AREA, VM, VA, BASE_KV = range(10)
@@ -107,9 +110,12 @@ class Network:
                 raise DataError(el, "BR_R", float(row[BR_R]), "a series resistance cannot be negative: "
                                 "check the sign and the per-unit base")
             if row[BR_X] < 0 and k not in self.series_capacitors:
-                raise DataError(el, "BR_X", float(row[BR_X]), "a negative series reactance is a series "
-                                f"capacitor: declare it with series_capacitors = [{k}] in the "
-                                "case, or correct the sign")
+                # standard cases have them (series compensation, star equivalents of
+                # three-winding transformers, e.g. MATPOWER's case300): accepted, not silently
+                warnings.warn(f"{el}: BR_X = {float(row[BR_X]):g} pu < 0 is taken as a series "
+                              "capacitor; declare it with series_capacitors = "
+                              f"[{k}] in the case to silence this, or correct the sign",
+                              DataWarning, stacklevel=3)
         # the columns the power flow and the simulator read must be finite (others, e.g.
         # MBASE from pandapower's converter, may be NaN)
         for name, table, cols in (
@@ -229,40 +235,74 @@ class Network:
 
     # -------------------------------------------------------------- power flow
     def solve_power_flow(self, tol_mva: float = 1e-9, check_tol: float = 1e-6) -> PowerFlowResult:
-        """Solve the power flow with pandapower and check it against this network's Ybus.
+        """Solve the power flow on this network's own Ybus (MATPOWER's Newton method, by PYPOWER).
+
+        The Newton–Raphson power flow of MATPOWER (``pypower.newtonpf``) is run on
+        :meth:`ybus` itself, so every branch (transformer taps on either side,
+        phase shifters, charging) is modelled exactly as in the time domain and as
+        in MATPOWER/ANDES. PV buses without an in-service generator are PQ buses;
+        generator reactive limits are not enforced (as ANDES's default). The
+        Newton iteration starts from the case's ``VM``/``VA`` with generator set
+        points; if it does not converge it is restarted from a flat start.
 
         Parameters
         ----------
         tol_mva : float
-            pandapower convergence tolerance [MVA].
+            Convergence tolerance on the largest bus power mismatch [MVA].
         check_tol : float
             Largest acceptable power mismatch [pu] when re-checked with :meth:`ybus`.
 
         Raises
         ------
         PowerFlowError
-            If pandapower does not converge or the solution does not satisfy the network equations.
+            If Newton does not converge (naming the bus with the largest mismatch) or
+            the solution does not satisfy the network equations.
         """
-        import pandapower as pp
-        from pandapower.converter.pypower import from_ppc
+        from pypower.newtonpf import newtonpf
+        from pypower.ppoption import ppoption
 
         self.check_connected()
 
-        ppc = {"version": "2", "baseMVA": self.Sb, "bus": self.bus.copy(),
-               "gen": self.gen.copy(), "branch": self.branch.copy()}
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            import logging
-            logging.getLogger("pandapower").setLevel(logging.ERROR)
-            try:
-                net = from_ppc(ppc, f_hz=self.f_hz, validate_conversion=False)
-                pp.runpp(net, numba=False, tolerance_mva=tol_mva, max_iteration=30,
-                         trafo_model="pi", calculate_voltage_angles=True, init="dc")
-            except Exception as exc:  # pandapower raises LoadflowNotConverged and others
-                raise PowerFlowError(f"pandapower power flow failed: {exc}. Fix: check loads, "
-                                     "generation and the slack bus; reduce loading") from exc
-        rb = net.res_bus.loc[self.bus_ids]
-        V = rb.vm_pu.to_numpy() * np.exp(1j * np.deg2rad(rb.va_degree.to_numpy()))
+        bus, gen = self.bus, self.gen
+        nb = self.nb
+        Y = self.ybus_sparse()
+        on = gen[:, GEN_STATUS] > 0 if gen.size else np.zeros(0, bool)
+        gbus = np.array([self._pos[int(b)] for b in gen[:, GEN_BUS]], dtype=int) if gen.size else np.zeros(0, int)
+        btype = bus[:, BUS_TYPE].astype(int).copy()
+        has_gen = np.zeros(nb, bool)
+        has_gen[gbus[on]] = True
+        btype[(btype == 2) & ~has_gen] = 1
+        ref = np.nonzero(btype == 3)[0]
+        pv = np.nonzero(btype == 2)[0]
+        pq = np.nonzero(btype == 1)[0]
+        Sg = np.zeros(nb, dtype=complex)
+        np.add.at(Sg, gbus[on], gen[on, PG] + 1j * gen[on, QG])
+        Sbus = (Sg - (bus[:, PD] + 1j * bus[:, QD])) / self.Sb
+        vm = np.where(bus[:, VM] > 0, bus[:, VM], 1.0)
+        vg = vm.copy()
+        for g in np.nonzero(on)[0][::-1]:      # the first in-service generator of a bus sets its voltage
+            if btype[gbus[g]] in (2, 3):
+                vg[gbus[g]] = gen[g, VG]
+        starts = [vg * np.exp(1j * np.deg2rad(bus[:, VA])),
+                  vg * np.exp(1j * np.deg2rad(bus[ref[0], VA]))]
+        opt = ppoption(VERBOSE=0, OUT_ALL=0, PF_TOL=tol_mva / self.Sb, PF_MAX_IT=30)
+        V = None
+        for V0 in starts:
+            with warnings.catch_warnings(), np.errstate(all="ignore"):
+                warnings.simplefilter("ignore")
+                Vs, ok, _ = newtonpf(Y, Sbus, V0, ref, pv, pq, opt)
+            if ok and np.all(np.isfinite(Vs)):
+                V = Vs
+                break
+        if V is None:
+            mis = Vs * np.conj(Y @ Vs) - Sbus
+            mis[ref] = 0
+            mis[pv] = mis[pv].real
+            k = int(np.nanargmax(np.where(np.isfinite(mis), np.abs(mis), np.inf)))
+            raise PowerFlowError(
+                f"Newton power flow did not converge (case and flat starts, 30 iterations each); "
+                f"largest mismatch {abs(mis[k]):.3g} pu at bus {self.bus_ids[k]}. Fix: check the "
+                "loads, generation, voltage set points and branch data near that bus; reduce loading")
         return self._finish_pf(V, check_tol)
 
     def check_connected(self, branch_status=None):

@@ -218,11 +218,27 @@ class System:
         s["omega"][m] = 1.0
 
     # ------------------------------------------------------------------- setup
-    def setup(self, power_flow: bool = True):
+    def setup(self, power_flow: bool = True, limits: str = "raise", init_tol: float = 1e-6):
         """Solve the power flow, build parameter arrays, lay out and initialize the states.
 
-        After ``setup`` the initial point is in :attr:`z0`.
+        After ``setup`` the initial point is in :attr:`z0`; it is verified (see
+        :meth:`check_initial_point`): limited states must start within their limits,
+        and the initial point must solve the DAE.
+
+        Parameters
+        ----------
+        power_flow : bool
+            Solve the power flow again (else reuse ``network.pf`` if present).
+        limits : {"raise", "warn"}
+            An initial value beyond a limit (a TGOV1 valve above VMAX, an exciter output
+            above VRMAX, ...) raises :class:`DataError` naming the device, the field, the
+            value and the limit; ``"warn"`` issues a warning instead (as ANDES does) and
+            the state is held at its limit from the first step (the grid then drifts).
+        init_tol : float
+            Largest acceptable residual of the DAE at the initial point [pu].
         """
+        if limits not in ("raise", "warn"):
+            raise DataError("System.setup", "limits", limits, 'use "raise" or "warn"')
         net = self.network
         if power_flow or net.pf is None:
             net.solve_power_flow()
@@ -277,8 +293,79 @@ class System:
         self.lim_hi = np.concatenate(hi) if hi else np.zeros(0)
         self.update_network()
         self._build_pattern()
+        self.check_initial_point(limits=limits, tol=init_tol)
         self.is_setup = True
         return self
+
+    def check_initial_point(self, limits: str = "raise", tol: float = 1e-6):
+        """Verify that the initial point ``z0`` is a steady state of the DAE within its limits.
+
+        Limits first: each non-windup limited state must start inside ``[lower, upper]``
+        (to 1e-9), else the integrator would clamp it at t = 0+ and the grid would drift
+        with no event. Then the residual ``F(0, z0) = [f; g]``: every state derivative
+        and every bus current mismatch must be below ``tol``.
+
+        ``tol = 1e-6`` pu: the power flow is solved to 1e-9 MVA and the models initialize
+        in closed form, so a consistent initial point has residuals of ~1e-10; any real
+        inconsistency (a machine's current missing at a shared bus, a wrong base) is
+        orders of magnitude larger; and it is 10x the integrator's Newton tolerance.
+
+        Raises
+        ------
+        DataError
+            Naming the device and field, the value and the limit (limits), or the
+            state / bus with the largest residual and its size.
+        """
+        import warnings
+
+        x0 = self.z0[:self.nx]
+        for c in self.comps:
+            fields = getattr(c, "limit_fields", {})
+            for idx, lo, hi in c.limits():
+                idx = np.asarray(idx, int)
+                lo = np.broadcast_to(np.asarray(lo, float), idx.shape)
+                hi = np.broadcast_to(np.asarray(hi, float), idx.shape)
+                for k, j in enumerate(idx):
+                    v = x0[j]
+                    if lo[k] - 1e-9 <= v <= hi[k] + 1e-9:
+                        continue
+                    st = self.var_name(int(j)).rsplit(".", 1)
+                    flo, fhi = fields.get(st[-1], ("lower limit", "upper limit"))
+                    bad = None
+                    if v > hi[k] + 1e-9:
+                        bad = (fhi, hi[k], "above")
+                    elif v < lo[k] - 1e-9:
+                        bad = (flo, lo[k], "below")
+                    if bad is None:
+                        continue
+                    msg = (f"initial value of {st[-1]} = {v:.6g} pu is {bad[2]} {bad[0]} = {bad[1]:.6g} pu "
+                           "(system base): the operating point needs a state beyond its limit")
+                    if limits == "warn":
+                        warnings.warn(f"{c.type_name} '{st[0]}': {msg}; it is held at the limit "
+                                      "from t = 0+ and the grid drifts before any event", stacklevel=3)
+                    else:
+                        raise DataError(f"{c.type_name} '{st[0]}'", bad[0], float(bad[1]),
+                                        f"{msg}. Raise the limit, change the dispatch/voltage set point, "
+                                        'or pass System.setup(limits="warn") to clamp it (as ANDES does)')
+        F, _ = self.residual(0.0, self.z0)
+        nx = self.nx
+        if not np.all(np.isfinite(F)):
+            k = int(np.nonzero(~np.isfinite(F))[0][0])
+            raise DataError("initial point", self.var_name(k), float(F[k]),
+                            "the initialization produced a non-finite residual; check this element's data")
+        worst_x = float(np.max(np.abs(F[:nx]))) if nx else 0.0
+        mis = np.abs(F[nx:nx + self.nb] + 1j * F[nx + self.nb:])
+        worst_g = float(mis.max()) if self.nb else 0.0
+        if worst_x > tol:
+            k = int(np.argmax(np.abs(F[:nx])))
+            raise DataError(f"initial point: state {self.var_name(k)}", "derivative", float(F[k]),
+                            f"the initialization does not solve the DAE (|dx/dt| = {abs(F[k]):.3g} > "
+                            f"{tol:g}); check this device's data and its link to the power flow")
+        if worst_g > tol:
+            b = int(np.argmax(mis))
+            raise DataError(f"initial point: bus {self.network.bus_ids[b]}", "current mismatch", worst_g,
+                            f"the devices' currents do not balance the network at this bus "
+                            f"({worst_g:.3g} pu > {tol:g}); check the machines/devices connected to it")
 
     # ----------------------------------------------------------------- network
     def update_network(self):

@@ -60,6 +60,9 @@ class EXDC2(MachineControl):
         self.SA, self.SB = quad_saturation_coeffs(p["E1"], p["SE1"], p["E2"], p["SE2"])
         self._nosat = bool(np.all(self.SB == 0))
 
+    #: parameter names of the limits of each limited state (for error messages)
+    limit_fields = {"VR": ("VRMIN", "VRMAX")}
+
     def limits(self):
         return [(self.idx("VR"), self.p["VRMIN"], self.p["VRMAX"])]
 

@@ -40,6 +40,9 @@ class SEXS(MachineControl):
         self.LL = LeadLag(p["TATB"] * p["TB"], p["TB"])
         self.LAW = Lag(p["K"], p["TE"])
 
+    #: parameter names of the limits of each limited state (for error messages)
+    limit_fields = {"LAW": ("EMIN", "EMAX")}
+
     def limits(self):
         on = self.p["TE"] > 0
         return [(self.idx("LAW")[on], self.p["EMIN"][on], self.p["EMAX"][on])]

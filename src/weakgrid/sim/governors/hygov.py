@@ -51,6 +51,9 @@ class HYGOV(MachineControl):
         self.LF = Lag(1.0, self.p["Tf"])
         self.LG = Lag(1.0, self.p["Tg"])
 
+    #: parameter names of the limits of each limited state (for error messages)
+    limit_fields = {"xi": ("GMIN", "GMAX")}
+
     def limits(self):
         return [(self.idx("xi"), self.p["GMIN"], self.p["GMAX"])]
 

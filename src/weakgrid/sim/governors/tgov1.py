@@ -48,6 +48,9 @@ class TGOV1(MachineControl):
         self.LL = LeadLag(p["T2"], p["T3"])
         self.paux = np.zeros(self.n)
 
+    #: parameter names of the limits of each limited state (for error messages)
+    limit_fields = {"LAG": ("VMIN", "VMAX")}
+
     def limits(self):
         return [(self.idx("LAG"), self.p["VMIN"], self.p["VMAX"])]
 

@@ -2,7 +2,8 @@
 
 Supported ANDES models: ``Bus``, ``Line``, ``PQ``, ``Shunt``, ``PV``, ``Slack``,
 ``GENCLS``, ``GENROU``, ``EXDC2``, ``SEXS``, ``TGOV1``, ``IEEEST`` (modes 1, 3,
-4, 5) and the events ``Toggle`` (of a ``Line``) and ``Fault``. Any other model
+4, 5) and the events ``Toggle`` (of a ``Line``: each toggle flips the line's status, so
+a second toggle recloses it) and ``Fault``. Any other model
 with devices raises :class:`~weakgrid.sim.errors.DataError`.
 
 Raw ANDES input data are used (device bases); the per-unit conversions are
@@ -102,7 +103,8 @@ def from_andes(ss, include_events: bool = True):
             if _raw(sh, "u")[k] > 0:
                 i = pos[sh.bus.v[k]]
                 Sn, Vn = _raw(sh, "Sn")[k], _raw(sh, "Vn")[k]
-                c = (Sn / Sb) * (Vn_bus[i] / Vn) ** -2 if Vn > 0 else Sn / Sb
+                # b [pu on (Sn, Vn)] -> system base at the bus voltage: x (Sn/Sb) (Vb/Vn)^2 (as ANDES)
+                c = (Sn / Sb) * (Vn_bus[i] / Vn) ** 2 if Vn > 0 else Sn / Sb
                 B[i, 4] += _raw(sh, "g")[k] * c * Sb
                 B[i, 5] += _raw(sh, "b")[k] * c * Sb
     G = []
@@ -195,12 +197,18 @@ def from_andes(ss, include_events: bool = True):
         lpos = {ix: k for k, ix in enumerate(line.idx.v)}
         if "Toggle" in ss.models:
             tg = ss.Toggle
-            for k in range(tg.n):
+            # a Toggle flips the line's status (open -> close -> open ...): replay them in time
+            # order from each line's initial status, so that a trip followed by a toggle recloses
+            status = {k: bool(_raw(line, "u")[k] > 0) for k in range(line.n)}
+            order = sorted(range(tg.n), key=lambda k: float(_raw(tg, "t")[k]))
+            for k in order:
                 if _raw(tg, "u")[k] <= 0:
                     continue
                 if tg.model.v[k] != "Line":
                     raise DataError(f"ANDES Toggle {tg.idx.v[k]}", "model", tg.model.v[k], "only Line toggles supported")
-                events.append(LineTrip(lpos[tg.dev.v[k]], float(_raw(tg, "t")[k])))
+                row = lpos[tg.dev.v[k]]
+                status[row] = not status[row]
+                events.append(LineTrip(row, float(_raw(tg, "t")[k]), close=status[row]))
         if "Fault" in ss.models:
             fl = ss.Fault
             for k in range(fl.n):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..component import Component, fast_index
+from ..component import Component, fast_index, scatter_add
 from ..errors import DataError
 from ..network import GEN_BUS, GEN_STATUS
 from ..params import Param
@@ -65,7 +65,9 @@ class SyncMachine(Component):
         self.wb = 2 * np.pi * self.p["fn"]
         self.m = np.array([system.machine_number(nm) for nm in self.names], dtype=int)
         self._mi = fast_index(self.m)
-        self._bi = fast_index(self.bus) if len(set(self.bus.tolist())) == self.n else self.bus
+        # two machines on one bus: their currents must accumulate (scatter_add with unique=False)
+        self._uniq = len(set(self.bus.tolist())) == self.n
+        self._bi = fast_index(self.bus) if self._uniq else self.bus
 
     def pattern(self, system):
         return None  # grouped with its controls by the system
@@ -80,6 +82,10 @@ class SyncMachine(Component):
     def network_current(Id, Iq, delta):
         """Current phasor injected into the bus: ``(Id + j Iq) * exp(j(delta - pi/2))``."""
         return (Id + 1j * Iq) * (np.sin(delta) - 1j * np.cos(delta))
+
+    def inject(self, ctx, I):
+        """Add the machines' network currents ``I`` to ``ctx.I`` (accumulating on shared buses)."""
+        scatter_add(ctx.I, self._bi, I, self._uniq)
 
     def publish(self, ctx, omega, delta, Pe, Qe, V, XadIfd):
         m = self._mi

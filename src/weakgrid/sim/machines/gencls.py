@@ -69,7 +69,7 @@ class GENCLS(SyncMachine):
         ra, xq = self.p["ra"], self.p["xd1"]
         vf = ctx.sig["vf"][..., self.m]
         Id, Iq = solve_stator(vf, 0.0, vd, vq, ra, xq, xq)
-        ctx.I[..., self.bus] += self.network_current(Id, Iq, delta)
+        self.inject(ctx, self.network_current(Id, Iq, delta))
         Pe = vd * Id + vq * Iq
         Qe = vq * Id - vd * Iq
         self._te = (vq + ra * Iq) * Iq + (vd + ra * Id) * Id

@@ -163,7 +163,7 @@ class GENROU(SyncMachine):
             psid = ra * Iq + vq
             psiq = -(ra * Id + vd)
         # injected current (Id + j Iq) exp(j(delta - pi/2))
-        ctx.I[..., self._bi] += (Id * sd + Iq * cd) + 1j * (Iq * sd - Id * cd)
+        self.inject(ctx, (Id * sd + Iq * cd) + 1j * (Iq * sd - Id * cd))
         XadIfd = e1q + self._kd1 * Id + self._kd2 * (e1q - e2d)
         XaqI1q = e1d + self._kq2 * (e1d - e2q) - self._kq1 * Iq
         if self._nosat:

@@ -11,7 +11,7 @@ import time
 import numpy as np
 
 
-def load_andes(case: str, fault=None, disable_toggles=False):
+def load_andes(case: str, fault=None, disable_toggles=False, add=(), edit=(), addfile=None):
     """Load an ANDES stock case with ``andes.load(..., setup=False)``; optionally add a fault.
 
     Parameters
@@ -22,21 +22,32 @@ def load_andes(case: str, fault=None, disable_toggles=False):
         Add an ANDES ``Fault`` at that bus from ``tf`` to ``tc`` [s].
     disable_toggles : bool
         Set ``u = 0`` on all ``Toggle`` devices (e.g. the shipped line trip).
+    add : sequence of (model, dict)
+        Extra ANDES devices to add (e.g. ``("Toggle", {"model": "Line", "dev": "Line_8", "t": 3})``).
+    addfile : str, optional
+        A dynamic data file (e.g. a PSS/E ``.dyr``) to load with a ``.raw`` case.
+    edit : sequence of (model, parameter, value)
+        Set a parameter of every device of a model (e.g. ``("IEEEST", "T5", 0.0)``).
     """
     import andes
 
     andes.config_logger(40)
-    ss = andes.load(andes.get_case(case), setup=False, no_output=True, default_config=True)
+    ss = andes.load(andes.get_case(case), addfile=addfile, setup=False, no_output=True, default_config=True)
     if disable_toggles and "Toggle" in ss.models:
         for k in range(ss.Toggle.n):
             ss.Toggle.u.v[k] = 0
     if fault is not None:
         bus, tf, tc = fault
         ss.add("Fault", {"bus": bus, "tf": tf, "tc": tc})
+    for model, data in add:
+        ss.add(model, dict(data))
+    for model, prm, value in edit:
+        par = getattr(ss.models[model], prm)
+        par.v[:] = [value] * len(par.v)
     return ss
 
 
-def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, linesearch=None):
+def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, linesearch=None, add=(), edit=(), addfile=None):
     """Simulate a stock case in ANDES with a fixed step ``h``.
 
     Returns
@@ -44,7 +55,7 @@ def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1
     dict with ``t``, ``omega`` (n_t, n_gen), ``delta`` (n_t, n_gen), ``wall`` [s] (TDS only),
     ``names`` (generator idx order).
     """
-    ss = load_andes(case, fault, disable_toggles)
+    ss = load_andes(case, fault, disable_toggles, add, edit, addfile)
     ss.setup()
     ss.PFlow.config.tol = 1e-11
     ss.PFlow.run()
@@ -66,12 +77,12 @@ def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1
             "ok": bool(ss.exit_code == 0)}
 
 
-def build_weakgrid(case, fault=None, disable_toggles=False):
+def build_weakgrid(case, fault=None, disable_toggles=False, add=(), edit=(), addfile=None):
     """The same case imported into weakgrid through ANDES's loader; returns ``(system, events, machine names)``."""
     from ..events import Fault
     from ..io.andes import from_andes
 
-    ss = load_andes(case, None, disable_toggles)
+    ss = load_andes(case, None, disable_toggles, add, edit, addfile)
     system, events = from_andes(ss)
     if fault is not None:
         bus, tf, tc = fault
@@ -79,11 +90,13 @@ def build_weakgrid(case, fault=None, disable_toggles=False):
     return system, events, list(system.machine_names)
 
 
-def run_weakgrid(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, **kw):
-    """Simulate the case in weakgrid with step ``h``; same outputs as :func:`run_andes`."""
+def run_weakgrid(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, add=(), edit=(), addfile=None, **kw):
+    """Simulate the case in weakgrid with step ``h``; same outputs as :func:`run_andes`.
+
+    ``tol=None`` uses the simulator's default (step-scaled) Newton tolerance."""
     from ..integrate import Simulator
 
-    system, events, names = build_weakgrid(case, fault, disable_toggles)
+    system, events, names = build_weakgrid(case, fault, disable_toggles, add, edit, addfile)
     system.setup()
     sim = Simulator(system, dt=h, tol=tol, **kw)
     t0 = time.perf_counter()

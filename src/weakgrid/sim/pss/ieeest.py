@@ -9,6 +9,11 @@ Input ``sig`` by ``MODE``: 1 speed deviation ``omega - 1`` [pu]; 3 electrical
 power on the machine base [pu]; 4 accelerating power ``tm - tm0`` [pu, system
 base]; 5 terminal voltage [pu]. The output is added to the exciter's summing
 junction. The output is cut (set to 0) when the terminal voltage leaves ``[VCL, VCU]``.
+
+Zero-parameter conventions (as PSS/E and ANDES): ``VCU = 0`` / ``VCL = 0`` means no
+upper / lower cut-off; ``T5 = 0`` turns the washout ``sT5/(1+sT6)`` into the lag
+``1/(1+sT6)``; a filter with all its coefficients zero, or a lead-lag with both time
+constants zero, passes its input.
 """
 
 from __future__ import annotations
@@ -58,11 +63,15 @@ class IEEEST(MachineControl):
         self.LL1 = LeadLag(p["T1"], p["T2"])
         self.LL2 = LeadLag(p["T3"], p["T4"])
         self.WO = Washout(p["T5"], p["T6"])
+        self._wo_lag = p["T5"] <= 0          # T5 = 0: the washout degenerates into a lag 1/(1+sT6)
+        # VCU = 0 / VCL = 0: no cut-off on that side
+        self.VCU = np.where(p["VCU"] == 0, 999.0, p["VCU"])
+        self.VCL = np.where(p["VCL"] == 0, -999.0, p["VCL"])
         # constant structure flags (fast paths of compute)
         self._mode1 = bool(np.all(p["MODE"] == 1))
         self._filt1 = bool(np.any((p["A1"] > 0) | (p["A2"] > 0)))
         self._filt2 = bool(np.any((p["A3"] > 0) | (p["A4"] > 0)))
-        self._no_cut = bool(np.all(p["VCL"] <= -999.0) and np.all(p["VCU"] >= 999.0))
+        self._no_cut = bool(np.all(self.VCL <= -999.0) and np.all(self.VCU >= 999.0))
 
     def _signal(self, ctx):
         p = self.p
@@ -127,10 +136,12 @@ class IEEEST(MachineControl):
         f[..., sl[5]] = self.LL2.deriv(x5, y3)
         vks = p["KS"] * y4
         vss = self.WO.output(x6, vks)
+        if self._wo_lag.any():
+            vss = np.where(self._wo_lag, x6, vss)
         f[..., sl[6]] = self.WO.deriv(x6, vks)
         vs = np.minimum(np.maximum(vss, p["LSMIN"]), p["LSMAX"])
         if not self._no_cut:
             vt = ctx.sig["Vt"][..., self.mach]
-            vs = np.where((vt > p["VCL"]) & (vt < p["VCU"]), vs, 0.0)
+            vs = np.where((vt > self.VCL) & (vt < self.VCU), vs, 0.0)
         ctx.sig["vs"][..., self.mach] = vs
         ctx.out["IEEEST.sig"], ctx.out["IEEEST.vss"] = u, vss
