@@ -8,27 +8,20 @@ per iterate and a line search. Oracle: the run completes, the UPQC reaches its r
 and the post-jump network solution satisfies the network equations.
 """
 
-import copy
-
 import numpy as np
 import pytest
 
-import weakgrid.study.runner as runner
-from weakgrid.study.cases import case1
-from weakgrid.study.scenarios import C1, Scenario
+from weakgrid.study.runner import Run, run_scenario
+from weakgrid.study.studyfile import load_study
 
 pytestmark = pytest.mark.slow
 
 
-def _run(vmax, controller, monkeypatch):
-    data = copy.deepcopy(case1.load_data())
-    data["upqc"]["Vmax"] = vmax
-    monkeypatch.setattr(runner, "build_case",
-                        lambda name, load, upqc, variant: case1.build(load=load, upqc=upqc,
-                                                                      variant=variant, data=data))
-    sc = Scenario(f"c1-high-conv-{controller}-vmax{vmax}", C1, "high", "conventional",
-                  controller, 0.2, 0.25, 1.0)
-    return runner.run_scenario(sc)
+def _run(vmax, controller, monkeypatch=None):
+    st = load_study("case1-weak-grid").with_values(**{"upqc.rating": vmax})
+    sc = next(s for s in st.scenarios() if s["id"] == "c1-high-conv")
+    run = Run.of(st, dict(sc, t_end=1.0), controller)
+    return run_scenario(st, run)
 
 
 @pytest.mark.parametrize("vmax", [0.4, 0.5, 0.6])
