@@ -62,9 +62,11 @@ def test_two_machine_mode_equals_the_analytic_one():
     # the lighter machine swings more: G1 (M = 6) participates twice as much as G2 (M = 12)
     p = dict(m.dominant_states(k, n=4))
     assert p["G1.omega"] == pytest.approx(2 * p["G2.omega"], rel=1e-4)
-    # the rest is the rigid-body (zero) mode pair
+    # the rest is the rigid-body (zero) mode pair: a double zero eigenvalue (a Jordan block),
+    # which moves like the square root of the finite-difference error of the Jacobian
+    # (~1e-8 relative gives ~1e-4 rad/s), so "zero" is judged against that, not against 1e-10
     others = np.delete(m.eigenvalues, [k, int(np.argmin(np.abs(m.eigenvalues - np.conj(m.eigenvalues[k]))))])
-    assert np.max(np.abs(others)) < 1e-5 * w
+    assert np.max(np.abs(others)) < 1e-3 * w
 
 
 def test_linearize_eliminates_the_network():
