@@ -35,8 +35,30 @@ source_suffix = {".rst": "restructuredtext", ".md": "myst-nb"}
 exclude_patterns = ["_build", "**.ipynb_checkpoints", "Thumbs.db", ".DS_Store"]
 templates_path = ["_templates"]
 root_doc = "index"
+# CLI help and docstrings are plain text: `--list` stays two hyphens (no en dash) and `x` is code
+smartquotes_action = "qe"
+default_role = "literal"
 
 # ---- API reference: one page per public module, from the docstrings (numpydoc)
+import types  # noqa: E402
+
+import sphinx.ext.autosummary as _autosummary  # noqa: E402
+
+_import_by_name = _autosummary._import_by_name
+
+
+def _prefer_module(name, grouped_exception=True):
+    """Resolve ``pkg.mod`` to the module even when ``pkg`` re-exports a function called ``mod``
+    (``weakgrid.design.modes``, ``weakgrid.game.rollout``); autosummary would document the
+    function under the module's name and lose the module's page."""
+    found = _import_by_name(name, grouped_exception)
+    mod = sys.modules.get(name)
+    if isinstance(mod, types.ModuleType) and found[0] is not mod:
+        return mod, None, name
+    return found
+
+
+_autosummary._import_by_name = _prefer_module
 autosummary_generate = True
 autosummary_ignore_module_all = True    # modules are found by walking the package
 autodoc_default_options = {"members": True, "show-inheritance": True, "member-order": "bysource"}

@@ -31,7 +31,7 @@ def add_parser(sub):
                    help="δu = δw (default: the problem's [solver] values)")
     p.add_argument("--u-bound", type=positive_float, nargs="+", default=None, metavar="UBAR",
                    help="bound the control (beyond the paper): ‖u‖ ≤ UBAR (disk) or "
-                        "|u_i| ≤ UBAR_i (box), replacing the problem's [cost] u_bound")
+                        "abs(u_i) ≤ UBAR_i (box), replacing the problem's [cost] u_bound")
     p.add_argument("--u-bound-shape", choices=("disk", "box"), default=None,
                    help="shape of --u-bound (default: the problem's, else disk)")
     p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")

@@ -50,7 +50,7 @@ class TwoPort:
 
     @property
     def B(self) -> float:
-        """Transfer susceptance |Y12| (pu)."""
+        """Transfer susceptance ``|Y12|`` (pu)."""
         return float(abs(self.Y12))
 
     @property

@@ -14,8 +14,8 @@ see ``src/weakgrid/data/presets/case1-paper.toml`` for a complete example.
 * ``linear`` — ``A, B, E`` matrices (for checks against the LQ game).
 
 ``[cost]`` may bound the control (beyond the paper): ``u_bound = 0.15`` with
-``u_bound_shape = "disk"`` (‖u‖ ≤ ū, the UPQC's |Vu| = √(Vup² + Vuq²) ≤ rating, the
-default) or ``"box"`` (|u_i| ≤ ū_i; one value or one per input). The penalty
+``u_bound_shape = "disk"`` (‖u‖ ≤ ū, the UPQC's ``|Vu| = √(Vup² + Vuq²) ≤ rating``, the
+default) or ``"box"`` (``|u_i| ≤ ū_i``; one value or one per input). The penalty
 ``W(u)`` of :mod:`weakgrid.game.input_bound` then replaces ``u'Ru``. Studies set the
 bound from the device rating with :meth:`TrainingProblem.with_input_bound`.
 """
