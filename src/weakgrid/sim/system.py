@@ -34,10 +34,11 @@ def _registry():
     from .governors import HYGOV, TGOV1
     from .machines import GENCLS, GENROU
     from .pss import IEEEST
+    from .loads import ZIP
     from .renewables import REGCA1
 
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST)
-            + (REGCA1,)}
+            + (REGCA1, ZIP)}
 
 
 class System:

@@ -245,6 +245,9 @@ def from_andes(ss, include_events: bool = True):
                 if _raw(m, fld)[k] != 1:
                     raise DataError(f"ANDES {mname} {m.idx.v[k]}", fld, _raw(m, fld)[k],
                                     "only one machine per static generator (gamma = 1) is supported")
+            if G[gen_row[m.gen.v[k]]][7] <= 0:
+                notes.append(f"{mname} {m.idx.v[k]}: its static generator {m.gen.v[k]} is out of service, skipped")
+                continue
             name = f"{mname}_{m.idx.v[k]}"
             system.add_machine(mname, name, gen_row[m.gen.v[k]], **_params(cls, m, k))
             syn_name[m.idx.v[k]] = name
@@ -281,7 +284,7 @@ def from_andes(ss, include_events: bool = True):
             if _raw(m, "u")[k] <= 0:
                 notes.append(f"{dev}: out of service (u = 0), skipped")
                 continue
-            link = cls.andes_link(m, k, gen_row=gen_row, pos=pos, dev_name=dev_name, Sb=Sb)
+            link = cls.andes_link(m, k, gen_row=gen_row, pos=pos, dev_name=dev_name, Sb=Sb, ss=ss)
             if link is None:
                 notes.append(f"{dev}: the device it controls is out of service, skipped")
                 continue
