@@ -113,13 +113,15 @@ def _check_islands(case, bus_names):
     t = L[on, 1].astype(int) - 1
     A = coo_matrix((np.ones(len(f)), (f, t)), shape=(nb, nb))
     ncomp, lab = connected_components(A, directed=False)
+    bad = []
     for c in range(ncomp):
         members = np.nonzero(lab == c)[0]
         if not np.any(B[members, 1] == 3):
-            names = [bus_names[i] for i in members]
-            raise DataError("ANDES case", "island", names,
-                            f"the buses {names} form an island without a slack (reference) bus; "
-                            "add a Slack device in it, connect it, or remove its buses")
+            bad.append([bus_names[i] for i in members])
+    if bad:
+        raise DataError("ANDES case", "island", bad,
+                        f"the bus groups {'; '.join(map(str, bad))} form islands without a slack (reference) "
+                        "bus; add a Slack device in each, connect them, or remove their buses")
     return ncomp
 
 
