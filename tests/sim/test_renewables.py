@@ -59,3 +59,38 @@ def test_initial_current_beyond_lvpl_is_refused():
 def test_volim_below_initial_voltage_is_refused():
     with pytest.raises(DataError, match="Volim"):
         build(Brkpt=0.8, Volim=0.9)
+
+
+def build_pvd1(shares=(0.5, 0.5), **kw):
+    from weakgrid.sim.renewables import PVD1
+
+    s = System(two_machine_case(x_line=0.2, p=0.6))
+    s.add_machine("GENROU", "SG", 1, **SG)
+    c = s.add_component(PVD1())
+    for k, g in enumerate(shares):
+        c.add_pvd1(f"D{k}", gen=0, Sn=100, gammap=g, gammaq=g, **kw)
+    return s.setup()
+
+
+def test_pvd1_shares_equilibrium_and_fault_ride_through():
+    # wide frequency bands: one undamped machine without governor keeps a speed offset
+    s = build_pvd1(ft0=55.0, ft1=56.0, ft2=64.0, ft3=65.0)
+    F, ctx = s.residual(0.0, s.z0)
+    assert np.max(np.abs(F)) < 1e-8
+    assert ctx.out["PVD1.Pe"].sum() == pytest.approx(0.6, abs=1e-9)
+    res = simulate(s, 3.0, dt=1 / 240, events=[Fault(bus=1, t_on=1.0, t_off=1.1, xf=0.05)])
+    assert res.ok
+    t = res.t
+    R = np.asarray(res["D0.R"])
+    assert R[(t > 1.02) & (t < 1.09)].max() < 1.0           # voltage trip band entered: current cut
+    assert np.asarray(res["D0.Pe"])[-1] == pytest.approx(0.3, abs=2e-2)
+
+
+def test_pvd1_shares_must_sum_to_one():
+    with pytest.raises(DataError, match="gammap"):
+        build_pvd1(shares=(0.5, 0.4))
+
+
+def test_pvd1_initial_point_in_trip_band_refused():
+    with pytest.raises(DataError, match="not a steady state"):
+        build_pvd1(vt0=1.05, vt1=1.1, vt2=1.2, vt3=1.3)

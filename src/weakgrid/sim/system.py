@@ -35,10 +35,10 @@ def _registry():
     from .machines import GENCLS, GENROU
     from .pss import IEEEST
     from .loads import ZIP
-    from .renewables import REGCA1
+    from .renewables import PVD1, REGCA1
 
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST)
-            + (REGCA1, ZIP)}
+            + (REGCA1, PVD1, ZIP)}
 
 
 class System:
@@ -190,7 +190,7 @@ class System:
         for c in self.comps:
             if c.kind == "machine" or (c.kind == "device" and hasattr(c, "gen")):
                 for i, g in enumerate(c.gen):
-                    if g in gen_used:
+                    if g in gen_used and not getattr(c, "gen_shared", False):
                         raise DataError(c.element(i), "gen", int(g), f"gen row already used by {gen_used[g]}")
                     gen_used[g] = c.element(i)
         from .network import GEN_STATUS

@@ -291,7 +291,10 @@ def from_andes(ss, include_events: bool = True):
                 notes.append(f"{dev}: the device it controls is out of service, skipped")
                 continue
             name = f"{mname}_{m.idx.v[k]}"
-            comp.add(name, link, _params(cls, m, k))
+            values = _params(cls, m, k)
+            if hasattr(cls, "andes_params"):
+                values = cls.andes_params(m, k, ss, values)
+            comp.add(name, link, values)
             dev_name[(mname, m.idx.v[k])] = name
     events = []
     if include_events:
