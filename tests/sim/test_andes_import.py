@@ -48,15 +48,20 @@ def test_measurement_models_ignored_with_a_note():
     assert any(n.startswith("COI") for n in system.import_notes)
 
 
-def test_machine_of_out_of_service_generator_skipped_and_two_slacks():
-    system, events = from_andes(load_case("kundur/kundur_islands.xlsx", keep_events=True))
-    assert "GENROU_3" not in system.machine_names and len(system.machine_names) == 3
-    assert not any("GENROU_3" == c.split(".")[0] for c in system.machine_names)
-    assert any("GENROU 3" in n for n in system.import_notes)
-    assert len(events) == 1
-    # the case's second slack (bus 3) has no machine left: refused with the generator named
-    with pytest.raises(DataError, match="dynamic machine model"):
-        system.setup()
+def test_machine_of_out_of_service_generator_skipped():
+    def off(ss):                         # PV 2 out of service: its GENROU (and controls) go too
+        ss.PV.u.v[list(ss.PV.idx.v).index(2)] = 0
+    system, events = from_andes(load_case(KUNDUR, modify=off))
+    assert "GENROU_2" not in system.machine_names and len(system.machine_names) == 3
+    assert any("GENROU 2" in n for n in system.import_notes)
+    assert len(system.components["TGOV1"].names) == 3
+
+
+def test_static_generator_without_dynamic_model_refused_by_name():
+    # kundur_islands: a second Slack (idx 5, bus 3) whose machine sits on an out-of-service PV
+    with pytest.raises(DataError, match="Slack 5") as e:
+        from_andes(load_case("kundur/kundur_islands.xlsx", keep_events=True))
+    assert "no in-service dynamic model" in str(e.value)
 
 
 def test_island_without_slack_refused_naming_its_buses():

@@ -296,6 +296,14 @@ def from_andes(ss, include_events: bool = True):
                 values = cls.andes_params(m, k, ss, values)
             comp.add(name, link, values)
             dev_name[(mname, m.idx.v[k])] = name
+    # every in-service static generator needs a dynamic model (machine or converter)
+    used = {lk["gen"] for c in system.components.values() for lk in c.links if "gen" in lk}
+    bare = [f"{mname} {ix} (bus {m.bus.v[k]})" for mname in ("Slack", "PV") for m in [ss.models[mname]]
+            for k, ix in enumerate(m.idx.v) if _raw(m, "u")[k] > 0 and gen_row[ix] not in used]
+    if bare:
+        raise DataError("ANDES case", "StaticGen", bare,
+                        f"the static generators {bare} have no in-service dynamic model (machine or "
+                        "converter); add one or set their u = 0")
     events = []
     if include_events:
         lpos = {ix: k for k, ix in enumerate(line.idx.v)}
