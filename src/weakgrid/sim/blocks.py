@@ -277,3 +277,51 @@ def quad_saturation_coeffs(E1, SE1, E2, SE2):
 def quad_saturation(x, A, B):
     r"""Quadratic saturation product :math:`x\,S(x) = B(x-A)^2` for ``x >= A`` else 0."""
     return np.where(x >= A, B * (x - A) ** 2, 0.0)
+
+
+class LagRate:
+    r"""First-order lag :math:`K/(1+sT)` with a rate limit, ANDES 2.0 convention.
+
+    :math:`T\dot x = \mathrm{clip}(Ku - x,\ r_{lo},\ r_{hi})`: the limits bound
+    :math:`T\dot x` (ANDES ``RateLimiter`` clips the equation value of a state
+    whose time constant is ``T``), i.e. :math:`\dot x` is bounded by ``r/T``.
+    A limit with ``enable = False`` is inactive.
+
+    Parameters
+    ----------
+    K, T : array_like
+        Gain and time constant [s] (> 0).
+    r_lo, r_hi : array_like
+        Rate limits [pu] on ``T dx/dt``.
+    """
+
+    nx = 1
+
+    def __init__(self, K, T, r_lo=-np.inf, r_hi=np.inf):
+        self.K = np.asarray(K, dtype=float)
+        self.T = _safe(T)
+        self.r_lo = np.asarray(r_lo, dtype=float)
+        self.r_hi = np.asarray(r_hi, dtype=float)
+
+    def init(self, u0):
+        return self.K * np.asarray(u0, dtype=float)
+
+    def deriv(self, x, u):
+        return np.clip(self.K * u - x, self.r_lo, self.r_hi) / self.T
+
+
+def piecewise_linear(u, points, values):
+    """Continuous piecewise-linear characteristic through ``(points[k], values[k])``, flat outside.
+
+    ``points`` and ``values`` are sequences of arrays (one entry per device); points must
+    be non-decreasing.
+    """
+    u = np.asarray(u, dtype=float)
+    y = np.broadcast_to(np.asarray(values[0], float), u.shape).copy()
+    for k in range(1, len(points)):
+        x0, x1 = points[k - 1], points[k]
+        y0, y1 = values[k - 1], values[k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            seg = y0 + (u - x0) * (y1 - y0) / (x1 - x0)
+        y = np.where(u > x0, np.where(u <= x1, seg, y1), y)
+    return y

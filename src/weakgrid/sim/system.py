@@ -86,8 +86,11 @@ def _registry():
     from .governors import HYGOV, TGOV1
     from .machines import GENCLS, GENROU
     from .pss import IEEEST
+    from .loads import ZIP
+    from .renewables import PVD1, REGCA1
 
-    return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST)}
+    return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST)
+            + (REGCA1, PVD1, ZIP)}
 
 
 class System:
@@ -255,7 +258,7 @@ class System:
         for c in self.comps:
             if c.kind == "machine" or (c.kind == "device" and hasattr(c, "gen")):
                 for i, g in enumerate(c.gen):
-                    if g in gen_used:
+                    if g in gen_used and not getattr(c, "gen_shared", False):
                         raise DataError(c.element(i), "gen", int(g), f"gen row already used by {gen_used[g]}")
                     gen_used[g] = c.element(i)
         from .network import GEN_STATUS
