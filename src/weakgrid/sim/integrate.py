@@ -245,6 +245,8 @@ class Simulator:
         """Advance one step of size ``h`` (may be shortened on failure). Returns the step taken."""
         t, z_n, f_n = self.t, self.z, self._f
         li = self.sys.lim_idx
+        if self.sys._var_lim:   # limits that move with the solution, taken at t_n
+            self.sys.update_limits(self._ctx)
         guess = None            # linearly implicit predictor (see _newton)
         refreshed = False
         corr = self._corr if (self._corr is not None and abs(self._corr_h - h) <= 1e-9 * h) else None

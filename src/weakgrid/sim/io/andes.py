@@ -2,7 +2,9 @@
 
 Supported ANDES models: ``Bus``, ``Line``, ``PQ``, ``Shunt``, ``PV``, ``Slack``,
 ``GENCLS``, ``GENROU``, ``EXDC2``, ``SEXS``, ``TGOV1``, ``IEEEST`` (modes 1, 3,
-4, 5) and the events ``Toggle`` (of a ``Line``) and ``Fault``. Any other model
+4, 5), the exciters ``ESST3A``, ``EXST1``, ``IEEEX1``, ``IEEET1``, ``EXAC1``,
+``ESDC2A``, the governors ``IEEEG1`` (with ``syn2``), ``IEESGO``, ``TG2``,
+``TGOV1N``, the PSS ``ST2CUT`` (modes 0, 1, 3, 4, 5) and the events ``Toggle`` (of a ``Line``) and ``Fault``. Any other model
 with devices raises :class:`~weakgrid.sim.errors.DataError`.
 
 Raw ANDES input data are used (device bases); the per-unit conversions are
@@ -24,6 +26,10 @@ from ..system import System
 
 _SUPPORTED = {"Bus", "Line", "PQ", "Shunt", "PV", "Slack", "GENCLS", "GENROU", "EXDC2", "SEXS",
               "TGOV1", "IEEEST", "Toggle", "Fault", "Area", "Summary", "BusFreq", "COI"}
+_SUPPORTED |= {"ESST3A", "EXST1", "IEEEX1", "IEEET1", "EXAC1", "ESDC2A", "IEEEG1", "IEESGO", "TG2", "TGOV1N",
+               "ST2CUT"}
+_EXCITERS = {"EXDC2", "SEXS", "ESST3A", "EXST1", "IEEEX1", "IEEET1", "EXAC1", "ESDC2A"}
+_PSS = {"IEEEST", "ST2CUT"}
 
 _MACHINE_FIELDS = {
     "GENCLS": ("Sn", "Vn", "fn", "D", "M", "ra", "xd1"),
@@ -35,6 +41,22 @@ _CONTROL_FIELDS = {
     "SEXS": ("TATB", "TB", "K", "TE", "EMIN", "EMAX"),
     "TGOV1": ("Tn", "wref0", "R", "VMAX", "VMIN", "T1", "T2", "T3", "Dt"),
     "IEEEST": ("MODE", "A1", "A2", "A3", "A4", "A5", "A6", "T1", "T2", "T3", "T4", "T5", "T6", "KS",
+               "LSMAX", "LSMIN", "VCU", "VCL"),
+    "ESST3A": ("TR", "VIMAX", "VIMIN", "KM", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KG", "KP", "KI",
+               "VBMAX", "KC", "XL", "VGMAX", "THETAP", "TM", "VMMAX", "VMMIN"),
+    "EXST1": ("TR", "VIMAX", "VIMIN", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KC", "KF", "TF"),
+    "IEEEX1": ("TR", "TA", "TC", "TB", "TE", "TF1", "KF1", "KA", "KE", "VRMAX", "VRMIN", "E1", "SE1", "E2", "SE2"),
+    "IEEET1": ("TR", "KA", "TA", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF", "Switch", "E1", "SE1", "E2", "SE2"),
+    "EXAC1": ("TR", "TB", "TC", "KA", "TA", "VRMAX", "VRMIN", "TE", "KF", "TF", "KC", "KD", "KE",
+              "E1", "SE1", "E2", "SE2"),
+    "ESDC2A": ("TR", "KA", "TA", "TB", "TC", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF1", "Switch",
+               "E1", "SE1", "E2", "SE2"),
+    "IEEEG1": ("Tn", "wref0", "K", "T1", "T2", "T3", "UO", "UC", "PMAX", "PMIN", "T4", "K1", "K2", "T5", "K3",
+               "K4", "T6", "K5", "K6", "T7", "K7", "K8"),
+    "IEESGO": ("Tn", "wref0", "T1", "T2", "T3", "T4", "T5", "T6", "K1", "K2", "K3", "PMAX", "PMIN"),
+    "TG2": ("Tn", "wref0", "R", "pmax", "pmin", "dbl", "dbu", "dbc", "T1", "T2"),
+    "TGOV1N": ("Tn", "wref0", "R", "VMAX", "VMIN", "T1", "T2", "T3", "Dt"),
+    "ST2CUT": ("MODE", "MODE2", "K1", "K2", "T1", "T2", "T3", "T4", "T5", "T6", "T7", "T8", "T9", "T10",
                "LSMAX", "LSMIN", "VCU", "VCL"),
 }
 
@@ -171,7 +193,8 @@ def from_andes(ss, include_events: bool = True):
             system.add_machine(mname, name, gen_row[m.gen.v[k]], **params)
             syn_name[m.idx.v[k]] = name
     avr_syn = {}
-    for mname, fields in _CONTROL_FIELDS.items():
+    # exciters first (PSSs are linked to them), then governors, then PSSs
+    for mname, fields in sorted(_CONTROL_FIELDS.items(), key=lambda kv: (kv[0] in _PSS) - (kv[0] in _EXCITERS)):
         m = ss.models.get(mname)
         if m is None:
             continue
@@ -179,15 +202,23 @@ def from_andes(ss, include_events: bool = True):
             if _raw(m, "u")[k] <= 0:
                 continue
             params = {f: float(_raw(m, f)[k]) for f in fields}
+            if mname == "ST2CUT":
+                params["MODE2"] = 0.0 if not np.isfinite(params["MODE2"]) else params["MODE2"]
+                for fld in ("busr", "busr2"):
+                    if getattr(m, fld).v[k] not in (None, ""):
+                        raise DataError(f"ANDES ST2CUT {m.idx.v[k]}", fld, getattr(m, fld).v[k],
+                                        "remote-bus inputs are not supported; leave it empty")
             name = f"{mname}_{m.idx.v[k]}"
-            if mname == "IEEEST":
+            if mname in _PSS:
                 syn = avr_syn[m.avr.v[k]]
                 system.add_pss(mname, name, syn, **params)
             else:
                 syn = syn_name[m.syn.v[k]]
-                if mname in ("EXDC2", "SEXS"):
+                if mname in _EXCITERS:
                     avr_syn[m.idx.v[k]] = syn
                     system.add_exciter(mname, name, syn, **params)
+                elif mname == "IEEEG1" and m.syn2.v[k] not in (None, ""):
+                    system.add_governor(mname, name, syn, machine2=syn_name[m.syn2.v[k]], **params)
                 else:
                     system.add_governor(mname, name, syn, **params)
     events = []
