@@ -219,8 +219,12 @@ class Simulator:
         residual = self.sys.residual
         tol = self.tol
         c = x_n + 0.5 * h * f_n
+        var_lim = fi is not None and bool(self.sys._var_lim)
         for it in range(self.max_iter):
             F, ctx = residual(t1, z)
+            if var_lim:   # held at a limit that moves with the solution (VRMAX*Vt): implicit in the limit
+                self.sys.update_limits(ctx)
+                limval = np.where(self.frozen > 0, self.sys.lim_hi, self.sys.lim_lo)[fz]
             f = F[:nx].copy()
             R = F
             R[:nx] = z[:nx] - c - 0.5 * h * f
@@ -266,6 +270,8 @@ class Simulator:
                 guess = corr = None
                 continue
             f1, ctx = last      # evaluated at the accepted point
+            if self.sys._var_lim:   # limits at the new point
+                self.sys.update_limits(ctx)
             if len(li):
                 xl = z[li]
                 new_hi = (self.frozen == 0) & (xl > self.sys.lim_hi + 1e-9)
