@@ -47,7 +47,7 @@ def _case_a(limits):
         2: ("EXST1", dict(TR=0.02, VIMAX=0.2 if not limits else 0.05, VIMIN=0 if not limits else -0.05,
                           TC=1, TB=1, KA=50 * k, TA=0.05, VRMAX=12, VRMIN=-3, KC=0.2, KF=0.1, TF=1)),
         3: ("IEEEX1", dict(TR=0.02, TA=0.02, TC=1, TB=1, TE=0.83, TF1=1.246, KF1=0.0754, KA=20 * k,
-                           KE=1, VRMAX=7.5, VRMIN=-7.5,
+                           KE=1, VRMAX=50, VRMIN=-50,
                            E1=2.8, SE1=0.04, E2=3.73, SE2=0.33)),
         4: ("IEEET1", dict(TR=0.02, KA=20 * k, TA=0.04, VRMAX=5 if not limits else 3.0,
                            VRMIN=-4 if not limits else 0.5, KE=1, TE=0.8, KF=0.05, TF=1.0,
@@ -58,36 +58,41 @@ def _case_a(limits):
                            PMAX=10, PMIN=0, T4=0.4, K1=0.5, T5=10, K3=0.5)),
         2: ("IEESGO", dict(K1=20 * k, T1=0.1, T2=1, T3=2, T4=0.3, T5=8, T6=0.5, K2=0.7, K3=0.4,
                            PMAX=1.2, PMIN=0 if not limits else 0.76)),
-        3: ("TG2", dict(R=0.05 / k, T1=0.2, T2=10, pmax=1.2, pmin=0 if not limits else 0.705)),
+        3: ("TG2", dict(R=0.05 / k, T1=0.2, T2=10, pmax=1.2, pmin=0 if not limits else 0.705,
+                        dbl=-1e-9, dbu=1e-9)),
         4: ("TGOV1N", dict(R=0.05 / k, VMAX=33, VMIN=0.4 if not limits else 0.75, T1=0.49, T2=2.1, T3=7)),
     }
     return dict(exciters=exc, governors=gov)
 
 
 def _case_b(limits):
-    """G1 EXAC1 + ST2CUT, G2 ESDC2A, G3 EXDC2 + ST2CUT with IEEEG1 driving G3 (HP) and G4 (LP)."""
+    """G1 EXAC1 + ST2CUT, G2 ESDC2A, G3 IEEET1 + ST2CUT, G4 ESST3A; IEEEG1 drives G3 (HP) and G4 (LP)."""
     k = 3.0 if limits else 1.0
     sat = dict(E1=2.8, SE1=0.04, E2=3.73, SE2=0.33)
     exc = {
         1: ("EXAC1", dict(TR=0, TB=1, TC=1, KA=80 * k, TA=0.04, VRMAX=8 if not limits else 3.0, VRMIN=0,
                           TE=0.8, KF=0.1, TF=1, KC=0.1, KD=0.2, KE=1, **sat)),
-        2: ("ESDC2A", dict(TR=0, KA=80 * k, TA=0.04, TB=1, TC=1, VRMAX=20, VRMIN=-20, KE=1, TE=0.8, KF=0.1,
+        2: ("ESDC2A", dict(TR=0, KA=80 * k, TA=0.04, TB=1, TC=1, VRMAX=200, VRMIN=-200, KE=1, TE=0.8, KF=0.1,
                            TF1=1, Switch=0, **sat)),
+        3: ("IEEET1", dict(TR=0.02, KA=20, TA=0.04, VRMAX=9, VRMIN=-9, KE=1, TE=0.8, KF=0.05, TF=1.0, **sat)),
+        4: ("ESST3A", dict(TR=0.01, VIMAX=0.8, VIMIN=-0.1, KM=500, TC=3, TB=15, KA=20, TA=0.1, VRMAX=8, VRMIN=0,
+                           KG=1, KP=4, KI=0.1, VBMAX=18, KC=0.1, XL=0.01, VGMAX=4, THETAP=0, TM=0.1, VMMAX=1,
+                           VMMIN=0.1)),
     }
     gov = {
         3: ("IEEEG1", dict(syn2=4, K=20 * k, T1=1, T2=2, T3=0.1, UO=0.1, UC=-0.1, PMAX=10,
-                           PMIN=0 if not limits else 0.36, T4=0.4, K1=0.25, K2=0.25, T5=10, K3=0.25, K4=0.25)),
+                           PMIN=0 if not limits else 0.78, T4=0.4, K1=0.25, K2=0.25, T5=10, K3=0.25, K4=0.25)),
         4: None,
     }
     st2 = dict(MODE=1, MODE2=3, K1=10 * k, K2=0.5, T1=0.02, T2=0.02, T3=1, T4=1, T5=0.2, T6=0.05, T7=1,
                T8=1, T9=1, T10=1, LSMAX=0.1 if not limits else 0.03, LSMIN=-0.1 if not limits else -0.03,
                VCU=0, VCL=0)
-    pss = [("ST2CUT", "EXAC1_1", st2), ("ST2CUT", 3, dict(st2, MODE2=0, T3=0))]
+    pss = [("ST2CUT", "EXAC1_1", st2), ("ST2CUT", "IEEET1_3", dict(st2, MODE2=0, T3=0))]
     return dict(exciters=exc, governors=gov, pss=pss)
 
 
 # (limited signal in weakgrid results, bound) checked in the limit cases
-LIMITS_A = [("ESST3A_ESST3A_1.VM", "hi", 0.6), ("EXST1_EXST1_2.vi", "lo", -0.05),
+LIMITS_A = [("ESST3A_ESST3A_1.VM", "hi", 0.6), ("EXST1_EXST1_2.vi", "hi", 0.05),
             ("IEEET1_IEEET1_4.VR", "hi", 3.0),
             ("IEEEG1_IEEEG1_1.vs", "lo", -0.02), ("IEESGO_IEESGO_2.pout", "lo", None),
             ("TG2_TG2_3.pout", "lo", None), ("TGOV1N_TGOV1N_4.LAG", "lo", None)]
@@ -102,11 +107,18 @@ CASES = {
 }
 
 
+def _andes_tg2_deadband(ss):
+    """ANDES 2.0's TG2 with its dead band disabled (the default) has no speed response (its dead-band
+    flag defaults to "inside"); enable it, with a 1e-9 pu band, so that TG2 acts as its diagram."""
+    if "TG2" in ss.models and ss.TG2.n:
+        ss.TG2.w_db.enable = 1
+
+
 @pytest.fixture(scope="module", params=list(CASES))
 def runs(request, tmp_path_factory):
     builder, limits, fault = CASES[request.param]
     path = kundur_variant(tmp_path_factory.mktemp("cases") / f"{request.param}.xlsx", **builder(limits))
-    a = run_andes(path, 10.0, H, fault=fault, disable_toggles=True)
+    a = run_andes(path, 10.0, H, fault=fault, disable_toggles=True, configure=_andes_tg2_deadband)
     system, events, names = build_weakgrid(path, fault=fault, disable_toggles=True)
     system.setup()
     res = Simulator(system, dt=H, tol=1e-8).run(10.0, events=events)

@@ -15,7 +15,8 @@ absent, as in ANDES); ``Switch`` is accepted and unused (as in PSS/E).
 Difference from ANDES 2.0 (documented, not copied): ANDES feeds the unfiltered
 bus voltage to the summing junction (its ``TR`` lag is computed but unused);
 here the sensed voltage passes through ``TR`` as in the standard. They agree
-for ``TR = 0``.
+for ``TR = 0``. ANDES also keeps the ceiling at its initial value ``VRMAX*Vt0``
+instead of following ``Vt``.
 """
 
 from __future__ import annotations

@@ -7,6 +7,10 @@ quadratic saturation, rate feedback sKF1/(1+sTF1)), except that
 * the regulator limits scale with the terminal voltage: ``VRMIN*Vt <= VR <= VRMAX*Vt``
   (non-windup, the limits move with ``Vt``), and
 * the field voltage is the exciter voltage itself, ``Efd = vp`` (no speed factor).
+
+Difference from ANDES 2.0 (documented, not copied): there the ceiling keeps its
+initial value ``VRMAX*Vt0`` (it does not follow ``Vt`` during a fault); here it
+follows ``Vt`` as in the standard. They agree while the limits are not reached.
 """
 
 from __future__ import annotations

@@ -8,7 +8,9 @@ Block diagram (pu on the system base after conversion; times in s)::
 
 ``R`` is on the turbine base (``ipower``), ``pmax``/``pmin`` on the turbine
 base (``power``). The speed dead band (``dbl``, ``dbu``, ``dbc``) is accepted and
-not applied, as with ANDES's default configuration (``deadband = 0``).
+not applied. (ANDES 2.0 with its default ``deadband = 0`` gives TG2 no speed
+response at all, its dead-band flag defaulting to "inside the band"; the peer
+test enables ANDES's dead band with a 1e-9 pu band.)
 """
 
 from __future__ import annotations

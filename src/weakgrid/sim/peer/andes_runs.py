@@ -36,7 +36,8 @@ def load_andes(case: str, fault=None, disable_toggles=False):
     return ss
 
 
-def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, linesearch=None):
+def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, linesearch=None,
+              configure=None):
     """Simulate a stock case in ANDES with a fixed step ``h``.
 
     Returns
@@ -45,6 +46,8 @@ def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1
     ``names`` (generator idx order).
     """
     ss = load_andes(case, fault, disable_toggles)
+    if configure is not None:   # e.g. model config flags: configure(ss) before setup
+        configure(ss)
     ss.setup()
     ss.PFlow.config.tol = 1e-11
     ss.PFlow.run()
