@@ -44,7 +44,7 @@ class IEESGO(MachineControl):
         Param("PMIN", 0.0, "pu (turbine base)", "minimum power", "", "power"),
     )
     states = ("F1", "F2", "F3", "F4", "F5")
-    outputs = ("pout",)
+    outputs = ("P", "pout")
 
     def setup(self, system):
         super().setup(system)
@@ -85,4 +85,4 @@ class IEESGO(MachineControl):
         f[..., self._sls[4]] = self.F5.deriv(f5, y4)
         pout = (1 - p["K2"]) * y3 + (1 - p["K3"]) * y4 + y5
         ctx.sig["tm"][..., m] = pout
-        ctx.out["IEESGO.pout"] = pout
+        ctx.out["IEESGO.P"], ctx.out["IEESGO.pout"] = pv, pout
