@@ -325,3 +325,63 @@ def piecewise_linear(u, points, values):
             seg = y0 + (u - x0) * (y1 - y0) / (x1 - x0)
         y = np.where(u > x0, np.where(u <= x1, seg, y1), y)
     return y
+
+
+class WashoutOrLag(Washout):
+    r"""Washout :math:`sK/(1+sT)` that becomes the lag :math:`1/(1+sT)` when ``K <= 0``.
+
+    The PSS/E/ANDES convention for a washout whose numerator time constant is
+    zero (e.g. ``T3 = 0`` of ST2CUT): the block does not switch the signal off,
+    it degenerates into a low-pass filter. State ``x`` obeys :math:`T\dot x = u - x`.
+
+    Parameters
+    ----------
+    K : array_like
+        Numerator gain [pu·s] (``K = T_num`` for the classical washout).
+    T : array_like
+        Time constant [s] (> 0).
+    """
+
+    def __init__(self, K, T):
+        super().__init__(K, T)
+        self._lag = self.K <= 0
+        self._all = self._all and not bool(np.any(self._lag))
+
+    def output(self, x, u):
+        if self._all:
+            return self._g * (u - x)
+        return np.where(self._lag, x, np.where(self._on, self._g * (u - x), 0.0))
+
+
+class IntegratorNonWindup(Integrator):
+    r"""Integrator :math:`K/s` whose state is held in ``[lower, upper]`` (non-windup).
+
+    Parameters
+    ----------
+    K : array_like
+        Gain [1/s].
+    lower, upper : array_like
+        State (= output) limits.
+    """
+
+    def __init__(self, K, lower, upper):
+        super().__init__(K)
+        self.lower = np.asarray(lower, dtype=float)
+        self.upper = np.asarray(upper, dtype=float)
+
+
+def hard_limit(u, lower, upper):
+    """Static (windup) limiter: ``u`` clipped to ``[lower, upper]`` (no state involved)."""
+    return np.minimum(np.maximum(u, lower), upper)
+
+
+def rectifier_fex(IN):
+    r"""Rectifier regulation factor :math:`F_{EX}(I_N)` of IEEE 421.5 AC/ST exciters.
+
+    :math:`F_{EX} = 1` for :math:`I_N \le 0`; :math:`1 - 0.577 I_N` up to 0.433;
+    :math:`\sqrt{0.75 - I_N^2}` up to 0.75; :math:`1.732(1 - I_N)` up to 1; 0 beyond.
+    ``IN = KC * XadIfd / VE`` is the normalized field current (load of the rectifier).
+    """
+    IN = np.asarray(IN, dtype=float)
+    return np.select([IN <= 0, IN <= 0.433, IN <= 0.75, IN <= 1.0],
+                     [np.ones_like(IN), 1 - 0.577 * IN, np.sqrt(np.abs(0.75 - IN * IN)), 1.732 * (1 - IN)], 0.0)

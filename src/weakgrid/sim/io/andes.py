@@ -56,6 +56,22 @@ _CONTROL_FIELDS = {
     "TGOV1": ("Tn", "wref0", "R", "VMAX", "VMIN", "T1", "T2", "T3", "Dt"),
     "IEEEST": ("MODE", "A1", "A2", "A3", "A4", "A5", "A6", "T1", "T2", "T3", "T4", "T5", "T6", "KS",
                "LSMAX", "LSMIN", "VCU", "VCL"),
+    "ESST3A": ("TR", "VIMAX", "VIMIN", "KM", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KG", "KP", "KI",
+               "VBMAX", "KC", "XL", "VGMAX", "THETAP", "TM", "VMMAX", "VMMIN"),
+    "EXST1": ("TR", "VIMAX", "VIMIN", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KC", "KF", "TF"),
+    "IEEEX1": ("TR", "TA", "TC", "TB", "TE", "TF1", "KF1", "KA", "KE", "VRMAX", "VRMIN", "E1", "SE1", "E2", "SE2"),
+    "IEEET1": ("TR", "KA", "TA", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF", "Switch", "E1", "SE1", "E2", "SE2"),
+    "EXAC1": ("TR", "TB", "TC", "KA", "TA", "VRMAX", "VRMIN", "TE", "KF", "TF", "KC", "KD", "KE",
+              "E1", "SE1", "E2", "SE2"),
+    "ESDC2A": ("TR", "KA", "TA", "TB", "TC", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF1", "Switch",
+               "E1", "SE1", "E2", "SE2"),
+    "IEEEG1": ("Tn", "wref0", "K", "T1", "T2", "T3", "UO", "UC", "PMAX", "PMIN", "T4", "K1", "K2", "T5", "K3",
+               "K4", "T6", "K5", "K6", "T7", "K7", "K8"),
+    "IEESGO": ("Tn", "wref0", "T1", "T2", "T3", "T4", "T5", "T6", "K1", "K2", "K3", "PMAX", "PMIN"),
+    "TG2": ("Tn", "wref0", "R", "pmax", "pmin", "dbl", "dbu", "dbc", "T1", "T2"),
+    "TGOV1N": ("Tn", "wref0", "R", "VMAX", "VMIN", "T1", "T2", "T3", "Dt"),
+    "ST2CUT": ("MODE", "MODE2", "K1", "K2", "T1", "T2", "T3", "T4", "T5", "T6", "T7", "T8", "T9", "T10",
+               "LSMAX", "LSMIN", "VCU", "VCL"),
 }
 
 
@@ -273,9 +289,19 @@ def from_andes(ss, include_events: bool = True):
                     notes.append(f"{dev}: its machine is out of service, skipped")
                     continue
                 name = f"{mname}_{m.idx.v[k]}"
+                params = _params(cls, m, k)
+                extra = {}
+                if mname == "ST2CUT":
+                    params["MODE2"] = 0.0 if not np.isfinite(params["MODE2"]) else params["MODE2"]
+                    for fld in ("busr", "busr2"):
+                        if getattr(m, fld).v[k] not in (None, ""):
+                            raise DataError(f"ANDES ST2CUT {m.idx.v[k]}", fld, getattr(m, fld).v[k],
+                                            "remote-bus inputs are not supported; leave it empty")
+                if mname == "IEEEG1" and m.syn2.v[k] not in (None, ""):
+                    extra["machine2"] = syn_name[m.syn2.v[k]]   # cross-compound: LP machine
                 if kind == "exciter":
                     avr_syn[m.idx.v[k]] = syn
-                add[kind](mname, name, syn, **_params(cls, m, k))
+                add[kind](mname, name, syn, **extra, **params)
     # devices that are not machine controls (renewables, loads): their own importers
     dev_name = {}
     for mname, cls in reg.items():
