@@ -277,3 +277,111 @@ def quad_saturation_coeffs(E1, SE1, E2, SE2):
 def quad_saturation(x, A, B):
     r"""Quadratic saturation product :math:`x\,S(x) = B(x-A)^2` for ``x >= A`` else 0."""
     return np.where(x >= A, B * (x - A) ** 2, 0.0)
+
+
+class LagRate:
+    r"""First-order lag :math:`K/(1+sT)` with a rate limit, ANDES 2.0 convention.
+
+    :math:`T\dot x = \mathrm{clip}(Ku - x,\ r_{lo},\ r_{hi})`: the limits bound
+    :math:`T\dot x` (ANDES ``RateLimiter`` clips the equation value of a state
+    whose time constant is ``T``), i.e. :math:`\dot x` is bounded by ``r/T``.
+    A limit with ``enable = False`` is inactive.
+
+    Parameters
+    ----------
+    K, T : array_like
+        Gain and time constant [s] (> 0).
+    r_lo, r_hi : array_like
+        Rate limits [pu] on ``T dx/dt``.
+    """
+
+    nx = 1
+
+    def __init__(self, K, T, r_lo=-np.inf, r_hi=np.inf):
+        self.K = np.asarray(K, dtype=float)
+        self.T = _safe(T)
+        self.r_lo = np.asarray(r_lo, dtype=float)
+        self.r_hi = np.asarray(r_hi, dtype=float)
+
+    def init(self, u0):
+        return self.K * np.asarray(u0, dtype=float)
+
+    def deriv(self, x, u):
+        return np.clip(self.K * u - x, self.r_lo, self.r_hi) / self.T
+
+
+def piecewise_linear(u, points, values):
+    """Continuous piecewise-linear characteristic through ``(points[k], values[k])``, flat outside.
+
+    ``points`` and ``values`` are sequences of arrays (one entry per device); points must
+    be non-decreasing.
+    """
+    u = np.asarray(u, dtype=float)
+    y = np.broadcast_to(np.asarray(values[0], float), u.shape).copy()
+    for k in range(1, len(points)):
+        x0, x1 = points[k - 1], points[k]
+        y0, y1 = values[k - 1], values[k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            seg = y0 + (u - x0) * (y1 - y0) / (x1 - x0)
+        y = np.where(u > x0, np.where(u <= x1, seg, y1), y)
+    return y
+
+
+class WashoutOrLag(Washout):
+    r"""Washout :math:`sK/(1+sT)` that becomes the lag :math:`1/(1+sT)` when ``K <= 0``.
+
+    The PSS/E/ANDES convention for a washout whose numerator time constant is
+    zero (e.g. ``T3 = 0`` of ST2CUT): the block does not switch the signal off,
+    it degenerates into a low-pass filter. State ``x`` obeys :math:`T\dot x = u - x`.
+
+    Parameters
+    ----------
+    K : array_like
+        Numerator gain [pu·s] (``K = T_num`` for the classical washout).
+    T : array_like
+        Time constant [s] (> 0).
+    """
+
+    def __init__(self, K, T):
+        super().__init__(K, T)
+        self._lag = self.K <= 0
+        self._all = self._all and not bool(np.any(self._lag))
+
+    def output(self, x, u):
+        if self._all:
+            return self._g * (u - x)
+        return np.where(self._lag, x, np.where(self._on, self._g * (u - x), 0.0))
+
+
+class IntegratorNonWindup(Integrator):
+    r"""Integrator :math:`K/s` whose state is held in ``[lower, upper]`` (non-windup).
+
+    Parameters
+    ----------
+    K : array_like
+        Gain [1/s].
+    lower, upper : array_like
+        State (= output) limits.
+    """
+
+    def __init__(self, K, lower, upper):
+        super().__init__(K)
+        self.lower = np.asarray(lower, dtype=float)
+        self.upper = np.asarray(upper, dtype=float)
+
+
+def hard_limit(u, lower, upper):
+    """Static (windup) limiter: ``u`` clipped to ``[lower, upper]`` (no state involved)."""
+    return np.minimum(np.maximum(u, lower), upper)
+
+
+def rectifier_fex(IN):
+    r"""Rectifier regulation factor :math:`F_{EX}(I_N)` of IEEE 421.5 AC/ST exciters.
+
+    :math:`F_{EX} = 1` for :math:`I_N \le 0`; :math:`1 - 0.577 I_N` up to 0.433;
+    :math:`\sqrt{0.75 - I_N^2}` up to 0.75; :math:`1.732(1 - I_N)` up to 1; 0 beyond.
+    ``IN = KC * XadIfd / VE`` is the normalized field current (load of the rectifier).
+    """
+    IN = np.asarray(IN, dtype=float)
+    return np.select([IN <= 0, IN <= 0.433, IN <= 0.75, IN <= 1.0],
+                     [np.ones_like(IN), 1 - 0.577 * IN, np.sqrt(np.abs(0.75 - IN * IN)), 1.732 * (1 - IN)], 0.0)

@@ -340,8 +340,12 @@ class Simulator:
         residual = self.sys.residual
         tol = self.tol
         c = x_n + 0.5 * h * f_n
+        var_lim = fi is not None and bool(self.sys._var_lim)
         for it in range(self.max_iter):
             F, ctx = residual(t1, z)
+            if var_lim:   # held at a limit that moves with the solution (VRMAX*Vt): implicit in the limit
+                self.sys.update_limits(ctx)
+                limval = np.where(self.frozen > 0, self.sys.lim_hi, self.sys.lim_lo)[fz]
             f = F[:nx].copy()
             R = F
             R[:nx] = z[:nx] - c - 0.5 * h * f
@@ -366,6 +370,8 @@ class Simulator:
         """Advance one step of size ``h`` (may be shortened on failure). Returns the step taken."""
         t, z_n, f_n = self.t, self.z, self._f
         li = self.sys.lim_idx
+        if self.sys._var_lim:   # limits that move with the solution, taken at t_n
+            self.sys.update_limits(self._ctx)
         guess = None            # linearly implicit predictor (see _newton)
         refreshed = False
         corr = self._corr if (self._corr is not None and abs(self._corr_h - h) <= 1e-9 * h) else None
@@ -386,6 +392,8 @@ class Simulator:
                 guess = corr = None
                 continue
             f1, ctx = last      # evaluated at the accepted point
+            if self.sys._var_lim:   # limits at the new point
+                self.sys.update_limits(ctx)
             if len(li):
                 xl = z[li]
                 new_hi = (self.frozen == 0) & (xl > self.sys.lim_hi + 1e-9)

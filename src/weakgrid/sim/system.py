@@ -86,8 +86,17 @@ def _registry():
     from .governors import HYGOV, TGOV1
     from .machines import GENCLS, GENROU
     from .pss import IEEEST
+    from .loads import ZIP
+    from .renewables import PVD1, REGCA1
 
-    return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST)}
+    from .exciters import ESDC2A, ESST3A, EXAC1, EXST1, IEEET1, IEEEX1
+    from .governors import IEEEG1, IEESGO, TG2, TGOV1N
+    from .pss import ST2CUT
+
+    return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
+                                    ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
+                                    IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT)
+            + (REGCA1, PVD1, ZIP)}
 
 
 class System:
@@ -144,7 +153,7 @@ class System:
         self.is_setup = False
         return name
 
-    def _add_control(self, kind, model, name, machine, params):
+    def _add_control(self, kind, model, name, machine, params, link=None):
         if machine not in self._machine_num:
             raise DataError(f"{model} '{name}'", "machine", machine,
                             f"no such machine; known machines are {sorted(self._machine_num)}")
@@ -152,7 +161,7 @@ class System:
         for c in self.components.values():
             if c.kind == kind and machine in [lk.get("machine") for lk in c.links]:
                 raise DataError(f"{model} '{name}'", "machine", machine, f"this machine already has a {kind}")
-        comp.add(name, {"machine": machine}, params)
+        comp.add(name, {"machine": machine, **(link or {})}, params)
         self.is_setup = False
         return name
 
@@ -160,9 +169,14 @@ class System:
         """Add an exciter (AVR) driving the field voltage of ``machine``."""
         return self._add_control("exciter", model, name, machine, params)
 
-    def add_governor(self, model: str, name: str, machine: str, **params):
-        """Add a turbine-governor driving the mechanical torque of ``machine``."""
-        return self._add_control("governor", model, name, machine, params)
+    def add_governor(self, model: str, name: str, machine: str, machine2: str | None = None, **params):
+        """Add a turbine-governor driving the mechanical torque of ``machine`` (and of the
+        low-pressure ``machine2`` of a cross-compound unit, IEEEG1)."""
+        if machine2 is not None and machine2 not in self._machine_num:
+            raise DataError(f"{model} '{name}'", "machine2", machine2,
+                            f"no such machine; known machines are {sorted(self._machine_num)}")
+        return self._add_control("governor", model, name, machine, params,
+                                 None if machine2 is None else {"machine2": machine2})
 
     def add_pss(self, model: str, name: str, machine: str, **params):
         """Add a power system stabilizer whose output enters the exciter of ``machine``."""
@@ -255,7 +269,7 @@ class System:
         for c in self.comps:
             if c.kind == "machine" or (c.kind == "device" and hasattr(c, "gen")):
                 for i, g in enumerate(c.gen):
-                    if g in gen_used:
+                    if g in gen_used and not getattr(c, "gen_shared", False):
                         raise DataError(c.element(i), "gen", int(g), f"gen row already used by {gen_used[g]}")
                     gen_used[g] = c.element(i)
         from .network import GEN_STATUS
@@ -283,11 +297,15 @@ class System:
         self.z0 = np.concatenate([x0, V0.real, V0.imag])
         # non-windup limits
         li, lo, hi = [], [], []
+        self._var_lim = []   # components whose limits move with the solution (limit_values(ctx))
         for c in self.comps:
+            start = sum(len(i) for i in li)
             for idx, l, h in c.limits():
                 li.append(np.asarray(idx, int))
                 lo.append(np.broadcast_to(np.asarray(l, float), len(idx)))
                 hi.append(np.broadcast_to(np.asarray(h, float), len(idx)))
+            if hasattr(c, "limit_values"):
+                self._var_lim.append((c, slice(start, sum(len(i) for i in li))))
         self.lim_idx = np.concatenate(li) if li else np.zeros(0, int)
         self.lim_lo = np.concatenate(lo) if lo else np.zeros(0)
         self.lim_hi = np.concatenate(hi) if hi else np.zeros(0)
@@ -367,6 +385,11 @@ class System:
                             f"the devices' currents do not balance the network at this bus "
                             f"({worst_g:.3g} pu > {tol:g}); check the machines/devices connected to it")
 
+    def update_limits(self, ctx):
+        """Refresh the non-windup limits that depend on the solution (e.g. ``VRMAX * Vt``) from ``ctx``."""
+        for c, s in self._var_lim:
+            self.lim_lo[s], self.lim_hi[s] = c.limit_values(ctx)
+
     # ----------------------------------------------------------------- network
     def update_network(self):
         """Rebuild the network admittance matrix after a topology/load/fault change.
@@ -420,6 +443,7 @@ class System:
             elif c.kind in ("exciter", "governor", "pss"):
                 for i in range(c.n):
                     mgroups[c.mach[i]] += c.instance_states(i)
+                groups += c.pattern(self) or []   # couplings beyond the own machine (IEEEG1 machine2)
             else:
                 groups += c.pattern(self) or []
         for idx in mgroups.values():

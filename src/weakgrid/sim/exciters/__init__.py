@@ -1,6 +1,12 @@
 """Excitation systems (AVRs)."""
 
+from .esdc2a import ESDC2A
+from .esst3a import ESST3A
+from .exac1 import EXAC1
 from .exdc2 import EXDC2
+from .exst1 import EXST1
+from .ieeet1 import IEEET1
+from .ieeex1 import IEEEX1
 from .sexs import SEXS
 
-__all__ = ["EXDC2", "SEXS"]
+__all__ = ["EXDC2", "SEXS", "ESST3A", "EXST1", "IEEEX1", "IEEET1", "EXAC1", "ESDC2A"]

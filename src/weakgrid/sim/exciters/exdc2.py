@@ -49,6 +49,8 @@ class EXDC2(MachineControl):
     )
     states = ("LS", "LL", "VR", "vp", "W")
     outputs = ("vi", "vref", "vout")
+    #: the field voltage is the speed times the exciter voltage (EXDC2); IEEEX1 outputs vp
+    speed_times_vp = True
 
     def setup(self, system):
         super().setup(system)
@@ -59,6 +61,7 @@ class EXDC2(MachineControl):
         self.W = Washout(p["KF1"], p["TF1"])
         self.SA, self.SB = quad_saturation_coeffs(p["E1"], p["SE1"], p["E2"], p["SE2"])
         self._nosat = bool(np.all(self.SB == 0))
+        self._keys = tuple(f"{self.type_name}.{o}" for o in self.outputs)
 
     #: parameter names of the limits of each limited state (for error messages)
     limit_fields = {"VR": ("VRMIN", "VRMAX")}
@@ -92,7 +95,7 @@ class EXDC2(MachineControl):
         W = self.W.output(w, vp)
         vi = self.vref0 - self.LS.output(ls, v) - W + ctx.sig["vs"][..., m]
         vll = self.LL.output(ll, vi)
-        vout = omega * vp
+        vout = omega * vp if self.speed_times_vp else vp
         sat = 0.0 if self._nosat else np.where(vout >= self.SA, quad_saturation(vp, self.SA, self.SB), 0.0)
         f = ctx.f
         f[..., self._sls[0]] = self.LS.deriv(ls, v)
@@ -102,4 +105,5 @@ class EXDC2(MachineControl):
         f[..., self._sls[4]] = self.W.deriv(w, vp)
         ctx.sig["vf"][..., m] = vout
         o = ctx.out
-        o["EXDC2.vi"], o["EXDC2.vref"], o["EXDC2.vout"] = vi, self.vref0 + 0 * vi, vout
+        k = self._keys
+        o[k[0]], o[k[1]], o[k[2]] = vi, self.vref0 + 0 * vi, vout

@@ -1,6 +1,10 @@
 """Turbine-governor models."""
 
 from .hygov import HYGOV
+from .ieeeg1 import IEEEG1
+from .ieesgo import IEESGO
+from .tg2 import TG2
 from .tgov1 import TGOV1
+from .tgov1n import TGOV1N
 
-__all__ = ["TGOV1", "HYGOV"]
+__all__ = ["TGOV1", "TGOV1N", "HYGOV", "IEEEG1", "IEESGO", "TG2"]

@@ -47,6 +47,7 @@ class TGOV1(MachineControl):
         self.LAG = LagNonWindup(1.0, p["T1"], p["VMIN"], p["VMAX"])
         self.LL = LeadLag(p["T2"], p["T3"])
         self.paux = np.zeros(self.n)
+        self._key = f"{self.type_name}.pout"
 
     #: parameter names of the limits of each limited state (for error messages)
     limit_fields = {"LAG": ("VMIN", "VMAX")}
@@ -60,14 +61,18 @@ class TGOV1(MachineControl):
         x[self.sl(0)] = tm0
         x[self.sl(1)] = self.LL.init(tm0)
 
+    def _pd(self, wd):
+        """Valve demand: reference and auxiliary input plus droop, before the valve lag."""
+        return self.pref0 + (self.paux - wd) / self.p["R"]
+
     def compute(self, ctx):
         p = self.p
         m = self._mi
         lag, ll = ctx.x[..., self._sls[0]], ctx.x[..., self._sls[1]]
         wd = ctx.sig["omega"][..., m] - p["wref0"]
-        pd = self.pref0 + (self.paux - wd) / p["R"]
+        pd = self._pd(wd)
         ctx.f[..., self._sls[0]] = self.LAG.deriv(lag, pd)
         ctx.f[..., self._sls[1]] = self.LL.deriv(ll, lag)
         pout = self.LL.output(ll, lag) - p["Dt"] * wd
         ctx.sig["tm"][..., m] = pout
-        ctx.out["TGOV1.pout"] = pout
+        ctx.out[self._key] = pout

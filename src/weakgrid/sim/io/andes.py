@@ -1,15 +1,27 @@
 """Import an ANDES system (loaded with ``andes.load(..., setup=False)``) into weakgrid.
 
-Supported ANDES models: ``Bus``, ``Line``, ``PQ``, ``Shunt``, ``PV``, ``Slack``,
-``GENCLS``, ``GENROU``, ``EXDC2``, ``SEXS``, ``TGOV1``, ``IEEEST`` (modes 1, 3,
-4, 5) and the events ``Toggle`` (of a ``Line``: each toggle flips the line's status, so
-a second toggle recloses it) and ``Fault``. Any other model
-with devices raises :class:`~weakgrid.sim.errors.DataError`.
+Supported ANDES models: the network (``Bus``, ``Line``, ``PQ``, ``Shunt``,
+``PV``, ``Slack``), every dynamic model registered in
+:func:`weakgrid.sim.system._registry` (machines, exciters, governors, PSS,
+renewables, ZIP loads; parameters are read by their ANDES names), and the
+events ``Toggle`` (of a ``Line``: each toggle flips the line's status, so
+a second toggle recloses it) and ``Fault``. Measurement-only models
+(``BusFreq``, ``COI``, ``PMU``, ``ACEc``) and bookkeeping (``Area``,
+``Summary``) are ignored with a note in ``system.import_notes``: they feed no
+signal back into the grid models weakgrid has. Any other model with
+in-service devices raises one :class:`~weakgrid.sim.errors.DataError` that
+lists *all* of them. Devices with ``u = 0`` are skipped (with their controls).
 
 Raw ANDES input data are used (device bases); the per-unit conversions are
 done by weakgrid exactly as ANDES does (impedances by ``(Vn^2/Sn)/(Vb^2/Sb)``,
 powers and inertias by ``Sn/Sb``). PQ loads become constant impedances in the
 time domain, as with ANDES's default ``p2z = q2z = 1``.
+
+PSS/E data: ``andes.load(raw, addfile=dyr, setup=False)`` parses a ``.raw`` +
+``.dyr`` pair into the same ANDES models, which this module then imports.
+
+Islands: every island of the in-service network (at t = 0) must hold a slack
+(reference) bus; an island without one is refused naming its buses.
 
 ANDES is an optional dependency and is not imported by this module; pass the
 loaded ``andes.System``.
@@ -21,10 +33,17 @@ import numpy as np
 
 from ..errors import DataError
 from ..events import Fault, LineTrip
-from ..system import System
+from ..system import System, _registry
 
-_SUPPORTED = {"Bus", "Line", "PQ", "Shunt", "PV", "Slack", "GENCLS", "GENROU", "EXDC2", "SEXS",
-              "TGOV1", "IEEEST", "Toggle", "Fault", "Area", "Summary", "BusFreq", "COI"}
+_NETWORK = {"Bus", "Line", "PQ", "Shunt", "PV", "Slack", "Toggle", "Fault"}
+#: models ignored on import (measurements and bookkeeping; nothing in the grid reads them)
+_IGNORED = {"Area", "Summary", "BusFreq", "COI", "PMU", "ACEc"}
+_SUPPORTED = _NETWORK | _IGNORED   # plus the registry (see _supported())
+
+
+def _supported():
+    return _SUPPORTED | set(_registry())
+
 
 _MACHINE_FIELDS = {
     "GENCLS": ("Sn", "Vn", "fn", "D", "M", "ra", "xd1"),
@@ -36,6 +55,22 @@ _CONTROL_FIELDS = {
     "SEXS": ("TATB", "TB", "K", "TE", "EMIN", "EMAX"),
     "TGOV1": ("Tn", "wref0", "R", "VMAX", "VMIN", "T1", "T2", "T3", "Dt"),
     "IEEEST": ("MODE", "A1", "A2", "A3", "A4", "A5", "A6", "T1", "T2", "T3", "T4", "T5", "T6", "KS",
+               "LSMAX", "LSMIN", "VCU", "VCL"),
+    "ESST3A": ("TR", "VIMAX", "VIMIN", "KM", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KG", "KP", "KI",
+               "VBMAX", "KC", "XL", "VGMAX", "THETAP", "TM", "VMMAX", "VMMIN"),
+    "EXST1": ("TR", "VIMAX", "VIMIN", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KC", "KF", "TF"),
+    "IEEEX1": ("TR", "TA", "TC", "TB", "TE", "TF1", "KF1", "KA", "KE", "VRMAX", "VRMIN", "E1", "SE1", "E2", "SE2"),
+    "IEEET1": ("TR", "KA", "TA", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF", "Switch", "E1", "SE1", "E2", "SE2"),
+    "EXAC1": ("TR", "TB", "TC", "KA", "TA", "VRMAX", "VRMIN", "TE", "KF", "TF", "KC", "KD", "KE",
+              "E1", "SE1", "E2", "SE2"),
+    "ESDC2A": ("TR", "KA", "TA", "TB", "TC", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF1", "Switch",
+               "E1", "SE1", "E2", "SE2"),
+    "IEEEG1": ("Tn", "wref0", "K", "T1", "T2", "T3", "UO", "UC", "PMAX", "PMIN", "T4", "K1", "K2", "T5", "K3",
+               "K4", "T6", "K5", "K6", "T7", "K7", "K8"),
+    "IEESGO": ("Tn", "wref0", "T1", "T2", "T3", "T4", "T5", "T6", "K1", "K2", "K3", "PMAX", "PMIN"),
+    "TG2": ("Tn", "wref0", "R", "pmax", "pmin", "dbl", "dbu", "dbc", "T1", "T2"),
+    "TGOV1N": ("Tn", "wref0", "R", "VMAX", "VMIN", "T1", "T2", "T3", "Dt"),
+    "ST2CUT": ("MODE", "MODE2", "K1", "K2", "T1", "T2", "T3", "T4", "T5", "T6", "T7", "T8", "T9", "T10",
                "LSMAX", "LSMIN", "VCU", "VCL"),
 }
 
@@ -54,27 +89,85 @@ def _raw(m, name):
     return np.asarray(v, dtype=float)
 
 
+def _in_service(m):
+    """Number of devices of ANDES model ``m`` with ``u > 0``."""
+    if m.n == 0:
+        return 0
+    if "u" not in m.params:
+        return m.n
+    return int(np.sum(_raw(m, "u") > 0))
+
+
+def _params(cls, m, k):
+    """Values of the weakgrid parameters of ``cls`` read by name from ANDES device ``k`` of ``m``."""
+    fields = _MACHINE_FIELDS.get(cls.__name__) or _CONTROL_FIELDS.get(cls.__name__)
+    if fields is None:
+        fields = [p.name for p in cls.params if p.name in m.params]
+    return {f: float(_raw(m, f)[k]) for f in fields}
+
+
+def check_supported(ss):
+    """Raise one :class:`DataError` listing every ANDES model with in-service devices weakgrid lacks."""
+    sup = _supported()
+    missing = {name: _in_service(mdl) for name, mdl in ss.models.items()
+               if name not in sup and _in_service(mdl) > 0}
+    if missing:
+        lst = ", ".join(f"{k} ({v})" for k, v in sorted(missing.items()))
+        raise DataError("ANDES case", "models", sorted(missing),
+                        f"models not supported by weakgrid.sim (in-service devices): {lst}. "
+                        f"Supported: {sorted(sup)}. Set their u = 0 or remove them")
+
+
+def _check_islands(case, bus_names):
+    """Every island of the in-service branch graph needs a slack bus; refuse naming the buses."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    B, L = case["bus"], case["branch"]
+    nb = B.shape[0]
+    on = L[:, 10] > 0
+    f = L[on, 0].astype(int) - 1
+    t = L[on, 1].astype(int) - 1
+    A = coo_matrix((np.ones(len(f)), (f, t)), shape=(nb, nb))
+    ncomp, lab = connected_components(A, directed=False)
+    bad = []
+    for c in range(ncomp):
+        members = np.nonzero(lab == c)[0]
+        if not np.any(B[members, 1] == 3):
+            bad.append([bus_names[i] for i in members])
+    if bad:
+        raise DataError("ANDES case", "island", bad,
+                        f"the bus groups {'; '.join(map(str, bad))} form islands without a slack (reference) "
+                        "bus; add a Slack device in each, connect them, or remove their buses")
+    return ncomp
+
+
 def from_andes(ss, include_events: bool = True):
     """Build a weakgrid :class:`System` and its event list from an ANDES system.
 
     Parameters
     ----------
     ss : andes.System
-        Loaded with ``setup=False`` (the raw device data are read).
+        Loaded with ``setup=False`` (the raw device data are read), from an
+        ANDES file or a PSS/E ``.raw`` + ``.dyr`` pair
+        (``andes.load(raw, addfile=dyr, setup=False)``).
     include_events : bool
         Convert ANDES ``Toggle`` (line) and ``Fault`` devices into weakgrid events.
 
     Returns
     -------
     system : System
-        Not yet set up (call :meth:`System.setup`).
+        Not yet set up (call :meth:`System.setup`). ``system.import_notes``
+        lists what was ignored or skipped.
     events : list
         weakgrid events equivalent to the case's own timed events.
     """
-    for name, mdl in ss.models.items():
-        if mdl.n > 0 and name not in _SUPPORTED:
-            raise DataError(f"ANDES model {name}", "n", mdl.n,
-                            f"not supported by weakgrid.sim; supported: {sorted(_SUPPORTED)}")
+    check_supported(ss)
+    reg = _registry()
+    notes = []
+    for name in sorted(_IGNORED - {"Area", "Summary"}):
+        if name in ss.models and ss.models[name].n:
+            notes.append(f"{name} ({ss.models[name].n}): measurement-only, ignored")
     Sb = float(ss.config.mva)
     bus = ss.Bus
     nb = bus.n
@@ -116,10 +209,13 @@ def from_andes(ss, include_events: bool = True):
             u = _raw(m, "u")[k]
             if u > 0:
                 B[i, 1] = max(B[i, 1], btype) if btype == 2 else 3
+            else:
+                notes.append(f"{mname} {m.idx.v[k]}: out of service (u = 0), skipped")
             v0 = _raw(m, "v0")[k]
-            B[i, 7] = v0
-            if mname == "Slack":
-                B[i, 8] = np.degrees(_raw(m, "a0")[k])
+            if u > 0:
+                B[i, 7] = v0
+                if mname == "Slack":
+                    B[i, 8] = np.degrees(_raw(m, "a0")[k])
             row = np.zeros(21)
             row[0] = i + 1
             row[1] = _raw(m, "p0")[k] * Sb
@@ -148,6 +244,7 @@ def from_andes(ss, include_events: bool = True):
                    0, 0, 0, 0 if tap == 1 else tap, np.degrees(_raw(line, "phi")[k]),
                    1 if _raw(line, "u")[k] > 0 else 0, -360, 360]
     case = {"baseMVA": Sb, "bus": B, "gen": np.array(G), "branch": L}
+    _check_islands(case, bidx)
     fn = 60.0
     if "GENROU" in ss.models and ss.GENROU.n:
         fn = float(_raw(ss.GENROU, "fn")[0])
@@ -156,42 +253,85 @@ def from_andes(ss, include_events: bool = True):
     system = System(_network(case, fn))
     # machines
     syn_name = {}
-    for mname, fields in _MACHINE_FIELDS.items():
+    for mname, cls in reg.items():
         m = ss.models.get(mname)
-        if m is None:
+        if cls.kind != "machine" or m is None:
             continue
         for k in range(m.n):
             if _raw(m, "u")[k] <= 0:
+                notes.append(f"{mname} {m.idx.v[k]}: out of service (u = 0), skipped")
                 continue
             for fld in ("gammap", "gammaq"):
                 if _raw(m, fld)[k] != 1:
                     raise DataError(f"ANDES {mname} {m.idx.v[k]}", fld, _raw(m, fld)[k],
                                     "only one machine per static generator (gamma = 1) is supported")
-            params = {f: float(_raw(m, f)[k]) for f in fields}
-            name = str(m.name.v[k]) if m.name.v[k] not in syn_name.values() else f"{mname}_{m.idx.v[k]}"
-            name = f"{mname}_{m.idx.v[k]}"
-            system.add_machine(mname, name, gen_row[m.gen.v[k]], **params)
-            syn_name[m.idx.v[k]] = name
-    avr_syn = {}
-    for mname, fields in _CONTROL_FIELDS.items():
-        m = ss.models.get(mname)
-        if m is None:
-            continue
-        for k in range(m.n):
-            if _raw(m, "u")[k] <= 0:
+            if G[gen_row[m.gen.v[k]]][7] <= 0:
+                notes.append(f"{mname} {m.idx.v[k]}: its static generator {m.gen.v[k]} is out of service, skipped")
                 continue
-            params = {f: float(_raw(m, f)[k]) for f in fields}
             name = f"{mname}_{m.idx.v[k]}"
-            if mname == "IEEEST":
-                syn = avr_syn[m.avr.v[k]]
-                system.add_pss(mname, name, syn, **params)
-            else:
-                syn = syn_name[m.syn.v[k]]
-                if mname in ("EXDC2", "SEXS"):
+            system.add_machine(mname, name, gen_row[m.gen.v[k]], **_params(cls, m, k))
+            syn_name[m.idx.v[k]] = name
+    # machine controls: exciters and governors link to `syn`, stabilizers to `avr`
+    avr_syn = {}
+    add = {"exciter": system.add_exciter, "governor": system.add_governor, "pss": system.add_pss}
+    for kind in ("exciter", "governor", "pss"):
+        for mname, cls in reg.items():
+            m = ss.models.get(mname)
+            if cls.kind != kind or m is None:
+                continue
+            for k in range(m.n):
+                dev = f"{mname} {m.idx.v[k]}"
+                if _raw(m, "u")[k] <= 0:
+                    notes.append(f"{dev}: out of service (u = 0), skipped")
+                    continue
+                syn = avr_syn.get(m.avr.v[k]) if kind == "pss" else syn_name.get(m.syn.v[k])
+                if syn is None:
+                    notes.append(f"{dev}: its machine is out of service, skipped")
+                    continue
+                name = f"{mname}_{m.idx.v[k]}"
+                params = _params(cls, m, k)
+                extra = {}
+                if mname == "ST2CUT":
+                    params["MODE2"] = 0.0 if not np.isfinite(params["MODE2"]) else params["MODE2"]
+                    for fld in ("busr", "busr2"):
+                        if getattr(m, fld).v[k] not in (None, ""):
+                            raise DataError(f"ANDES ST2CUT {m.idx.v[k]}", fld, getattr(m, fld).v[k],
+                                            "remote-bus inputs are not supported; leave it empty")
+                if mname == "IEEEG1" and m.syn2.v[k] not in (None, ""):
+                    extra["machine2"] = syn_name[m.syn2.v[k]]   # cross-compound: LP machine
+                if kind == "exciter":
                     avr_syn[m.idx.v[k]] = syn
-                    system.add_exciter(mname, name, syn, **params)
-                else:
-                    system.add_governor(mname, name, syn, **params)
+                add[kind](mname, name, syn, **extra, **params)
+    # devices that are not machine controls (renewables, loads): their own importers
+    dev_name = {}
+    for mname, cls in reg.items():
+        m = ss.models.get(mname)
+        if cls.kind != "device" or m is None or not m.n:
+            continue
+        comp = system._component(mname, "device")
+        for k in range(m.n):
+            dev = f"{mname} {m.idx.v[k]}"
+            if _raw(m, "u")[k] <= 0:
+                notes.append(f"{dev}: out of service (u = 0), skipped")
+                continue
+            link = cls.andes_link(m, k, gen_row=gen_row, pos=pos, dev_name=dev_name, Sb=Sb, ss=ss)
+            if link is None:
+                notes.append(f"{dev}: the device it controls is out of service, skipped")
+                continue
+            name = f"{mname}_{m.idx.v[k]}"
+            values = _params(cls, m, k)
+            if hasattr(cls, "andes_params"):
+                values = cls.andes_params(m, k, ss, values)
+            comp.add(name, link, values)
+            dev_name[(mname, m.idx.v[k])] = name
+    # every in-service static generator needs a dynamic model (machine or converter)
+    used = {lk["gen"] for c in system.components.values() for lk in c.links if "gen" in lk}
+    bare = [f"{mname} {ix} (bus {m.bus.v[k]})" for mname in ("Slack", "PV") for m in [ss.models[mname]]
+            for k, ix in enumerate(m.idx.v) if _raw(m, "u")[k] > 0 and gen_row[ix] not in used]
+    if bare:
+        raise DataError("ANDES case", "StaticGen", bare,
+                        f"the static generators {bare} have no in-service dynamic model (machine or "
+                        "converter); add one or set their u = 0")
     events = []
     if include_events:
         lpos = {ix: k for k, ix in enumerate(line.idx.v)}
@@ -219,6 +359,7 @@ def from_andes(ss, include_events: bool = True):
                                     rf=float(_raw(fl, "rf")[k]), xf=float(_raw(fl, "xf")[k])))
     system.andes_bus_id = {b: pos[b] + 1 for b in bidx}
     system.andes_line_row = {ix: k for k, ix in enumerate(line.idx.v)}
+    system.import_notes = notes
     return system, events
 
 

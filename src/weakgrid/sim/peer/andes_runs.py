@@ -47,7 +47,8 @@ def load_andes(case: str, fault=None, disable_toggles=False, add=(), edit=(), ad
     return ss
 
 
-def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, linesearch=None, add=(), edit=(), addfile=None):
+def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, linesearch=None,
+              add=(), edit=(), addfile=None, configure=None):
     """Simulate a stock case in ANDES with a fixed step ``h``.
 
     Returns
@@ -56,6 +57,8 @@ def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1
     ``names`` (generator idx order).
     """
     ss = load_andes(case, fault, disable_toggles, add, edit, addfile)
+    if configure is not None:   # e.g. model config flags: configure(ss) before setup
+        configure(ss)
     ss.setup()
     ss.PFlow.config.tol = 1e-11
     ss.PFlow.run()

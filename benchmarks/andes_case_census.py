@@ -1,0 +1,184 @@
+"""Census of ANDES's shipped cases: how many import into weakgrid.sim, run, and match ANDES.
+
+Every case input ANDES ships is tried: each ``.xlsx``, ``.json`` and ``.m`` file, each
+PSS/E ``.raw`` alone, and each ``.raw`` + ``.dyr`` pair (the ``.dyr`` with the ``.raw`` of its
+folder whose name is the longest prefix of its own). For each:
+
+1. ANDES's parser loads it (``andes.load(..., setup=False)``); the case's own timed events are
+   switched off and a three-phase fault is added at the bus of the first in-service PQ load,
+   1.0-1.05 s;
+2. weakgrid imports it (:func:`weakgrid.sim.io.andes.from_andes`) -- or reports why not (all
+   unsupported models at once);
+3. both simulate ``--tf`` seconds (default 5) at the same fixed step ``--h`` (default 1/120 s);
+4. speeds and rotor angles relative to the first machine are compared; a case *matches* when
+   they agree within 2e-5 pu and 0.5 deg. A case within 2e-4 pu that does not match is re-run
+   in both tools at ``h/2``: if it then matches, the difference was step error ("match at h/2").
+
+Each case runs in its own subprocess with a time limit (``--timeout``, default 300 s). Results
+are written atomically to ``--out`` (default ``benchmarks/andes_case_census.json``) after every
+case; a re-run skips the cases already there (``--fresh`` to start over). The summary counts the
+outcomes and lists the models still missing, with the number of cases each one blocks.
+
+Run:  PYTHONPATH=src python benchmarks/andes_case_census.py [--tf 5] [--only kundur] [--fresh]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+DW_TOL, DD_TOL = 2e-5, 0.5
+
+
+def case_inputs():
+    """``[(key, path, addfile)]`` of every case input shipped with ANDES."""
+    import andes
+
+    root = Path(andes.get_case("kundur/kundur_full.xlsx")).parents[1]
+    out = []
+    for p in sorted(root.rglob("*")):
+        if "__pycache__" in p.parts or not p.is_file():
+            continue
+        rel = str(p.relative_to(root))
+        if p.suffix in (".xlsx", ".json", ".m", ".raw"):
+            out.append((rel, str(p), None))
+        elif p.suffix == ".dyr":
+            raws = [r for r in p.parent.glob("*.raw") if p.stem.startswith(r.stem)]
+            raws = raws or list(p.parent.glob("*.raw"))
+            if raws:
+                raw = max(raws, key=lambda r: len(r.stem))
+                out.append((f"{raw.relative_to(root)}+{p.name}", str(raw), str(p)))
+    return out
+
+
+def run_one(path, addfile, tf, h, halve=True):
+    """Try one case; returns a dict with ``stage`` (where it stopped) and details."""
+    import numpy as np
+
+    from weakgrid.sim.errors import DataError
+    from weakgrid.sim.io.andes import from_andes
+    from weakgrid.sim.peer.andes_case import (compare_named, load_case, machine_names,
+                                              run_andes_ss, run_weakgrid_ss)
+
+    r = {"stage": "parse"}
+    try:
+        ss = load_case(path, addfile, fault="auto")
+    except Exception as exc:   # ANDES cannot read it
+        return {**r, "error": f"{type(exc).__name__}: {exc}"[:400]}
+    if not machine_names(ss):
+        return {"stage": "power-flow only", "error": "no dynamic machine models"}
+    r["stage"] = "import"
+    try:
+        system, _ = from_andes(ss)
+    except DataError as exc:
+        missing = exc.value if exc.field == "models" else None
+        return {**r, "error": str(exc)[:400], "missing": missing}
+    except Exception as exc:
+        return {**r, "error": f"{type(exc).__name__}: {exc}"[:400]}
+    r["stage"] = "setup"
+    r["notes"] = getattr(system, "import_notes", [])[:5]
+    if not system.machine_names:
+        return {**r, "error": "no dynamic machine models (power-flow-only case)"}
+    try:
+        system.setup()
+    except Exception as exc:
+        return {**r, "error": f"{type(exc).__name__}: {exc}"[:400]}
+    r["stage"] = "run"
+    try:
+        w = run_weakgrid_ss(load_case(path, addfile, fault="auto"), tf, h)
+    except Exception as exc:
+        return {**r, "error": f"{type(exc).__name__}: {exc}"[:400]}
+    if not w["ok"]:
+        return {**r, "error": "weakgrid run failed"}
+    r["stage"] = "andes"
+    try:
+        a = run_andes_ss(load_case(path, addfile, fault="auto"), tf, h)
+    except Exception as exc:
+        return {**r, "error": f"ANDES: {type(exc).__name__}: {exc}"[:400]}
+    if not a["ok"]:
+        return {**r, "error": a.get("error", "ANDES run failed")}
+    dw, dd = compare_named(a, w)
+    ok = bool(np.isfinite(dw) and dw < DW_TOL and dd < DD_TOL)
+    r = {**r, "stage": "match" if ok else "mismatch", "dw": dw, "dd": dd,
+         "wall_weakgrid": w["wall"], "wall_andes": a["wall"]}
+    if not ok and dw < 10 * DW_TOL and halve:
+        # is it step error? halve the step in both tools
+        try:
+            w2 = run_weakgrid_ss(load_case(path, addfile, fault="auto"), tf, h / 2)
+            a2 = run_andes_ss(load_case(path, addfile, fault="auto"), tf, h / 2)
+            dw2, dd2 = compare_named(a2, w2)
+            r.update(dw_h2=dw2, dd_h2=dd2)
+            if dw2 < DW_TOL and dd2 < DD_TOL:
+                r["stage"] = "match at h/2"
+        except Exception as exc:
+            r["error_h2"] = f"{type(exc).__name__}: {exc}"[:300]
+    return r
+
+
+def summarize(results):
+    for v in results.values():   # older files: power-flow-only cases were stopped at setup
+        if v["stage"] == "setup" and str(v.get("error", "")).startswith("no dynamic"):
+            v["stage"] = "power-flow only"
+    stages = Counter(v["stage"] for v in results.values())
+    missing = Counter()
+    for v in results.values():
+        for m in v.get("missing") or []:
+            missing[m] += 1
+    return stages, missing
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--tf", type=float, default=5.0)
+    ap.add_argument("--h", type=float, default=1 / 120)
+    ap.add_argument("--timeout", type=float, default=300.0)
+    ap.add_argument("--out", default=str(Path(__file__).with_name("andes_case_census.json")))
+    ap.add_argument("--only", default="", help="substring filter on case keys")
+    ap.add_argument("--fresh", action="store_true")
+    ap.add_argument("--one", nargs=2, metavar=("PATH", "ADDFILE"), help=argparse.SUPPRESS)
+    a = ap.parse_args(argv)
+    if a.one:
+        res = run_one(a.one[0], None if a.one[1] == "-" else a.one[1], a.tf, a.h)
+        print("CENSUS_RESULT " + json.dumps(res))
+        return 0
+    from weakgrid.fileio import write_json_atomic
+
+    out = Path(a.out)
+    results = {} if a.fresh or not out.exists() else json.loads(out.read_text())["cases"]
+    cases = [c for c in case_inputs() if a.only in c[0]]
+    for n, (key, path, addfile) in enumerate(cases, 1):
+        if key in results:
+            continue
+        t0 = time.perf_counter()
+        cmd = [sys.executable, __file__, "--tf", str(a.tf), "--h", repr(a.h), "--one", path, addfile or "-"]
+        try:
+            p = subprocess.run(cmd, capture_output=True, text=True, timeout=a.timeout, env=os.environ)
+            line = [ln for ln in p.stdout.splitlines() if ln.startswith("CENSUS_RESULT ")]
+            res = json.loads(line[-1][14:]) if line else {"stage": "crash", "error": p.stderr[-400:]}
+        except subprocess.TimeoutExpired:
+            res = {"stage": "timeout", "error": f"over {a.timeout:g} s"}
+        res["seconds"] = round(time.perf_counter() - t0, 1)
+        results[key] = res
+        extra = f" dw={res['dw']:.2g} dd={res['dd']:.2g}" if "dw" in res else f" {res.get('error', '')[:90]}"
+        print(f"[{n}/{len(cases)}] {key}: {res['stage']}{extra}", flush=True)
+        write_json_atomic(out, {"tf": a.tf, "h": a.h, "tolerances": [DW_TOL, DD_TOL], "cases": results})
+    stages, missing = summarize(results)
+    imported = sum(v for k, v in stages.items() if k not in ("parse", "import", "power-flow only"))
+    loose = sum(1 for v in results.values() if "dw" in v and v["dw"] < 2e-4 and v["dd"] < 1.0)
+    print(f"\n{len(results)} case inputs ({stages.get('power-flow only', 0)} without dynamic data): "
+          f"{imported} import, {stages.get('match', 0)} match ANDES "
+          f"at h, {stages.get('match at h/2', 0)} more at h/2 "
+          f"(dw < {DW_TOL:g} pu, dd < {DD_TOL:g} deg), {loose} within 2e-4 pu and 1 deg; "
+          f"stages: {dict(stages)}")
+    print("models missing (cases blocked): " + ", ".join(f"{m} ({c})" for m, c in missing.most_common()))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

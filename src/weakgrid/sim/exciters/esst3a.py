@@ -1,0 +1,128 @@
+"""ESST3A: IEEE 421.5 type ST3A static exciter (potential/compound source, inner field loop).
+
+Block diagram (pu, times in s; PSS/E ESST3A and ANDES conventions)::
+
+    v --[Lag 1/(1+sTR)]--> LG
+    vi  = vref - LG + vs                                   (vs: PSS output)
+    vil = clip(vi, VIMIN, VIMAX)
+    vil --[LeadLag (1+sTC)/(1+sTB)]--> VA
+    VA  --[Lag KA/(1+sTA), non-windup VRMIN..VRMAX]--> VR
+    VG  = min(KG*Efd, VGMAX)                               (inner field-voltage feedback)
+    (VR - VG) --[Lag KM/(1+sTM), non-windup VMMIN..VMMAX]--> VM
+    VE  = |KP e^{j THETAP} Vt + j (KI + KP e^{j THETAP} XL) It|   (source voltage)
+    IN  = KC*XadIfd/VE,  VB = min(VE * FEX(IN), VBMAX)
+    Efd = VB * VM
+
+``Vt``, ``It`` are the machine terminal voltage and current phasors on the
+system base (the magnitude does not depend on the reference frame, so the
+network frame is used). No under-excitation limiter (the UEL input is -inf,
+as in ANDES). ``vref`` is set at initialization so that ``Efd = vf0``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..blocks import Lag, LagNonWindup, LeadLag, hard_limit, rectifier_fex
+from ..control_base import MachineControl
+from ..params import Param
+
+
+def source_voltage(ctx, mach, bus, KPC, KI, XL):
+    """|KPC*Vt + j(KI + KPC*XL)*It| of machines ``mach`` at buses ``bus`` (system-base pu)."""
+    s = ctx.sig
+    V = ctx.V[..., bus]
+    S = s["Pe"][..., mach] + 1j * s["Qe"][..., mach]
+    It = np.conj(S / V)
+    return np.abs(KPC * V + 1j * (KI + KPC * XL) * It)
+
+
+class ESST3A(MachineControl):
+    """IEEE ST3A static exciter. Times [s]: TR, TC, TB, TA, TM; gains [pu]: KA, KM, KG, KP, KI, KC;
+    reactance XL [pu]; THETAP [deg]; limits VIMAX, VIMIN, VRMAX, VRMIN, VMMAX, VMMIN, VBMAX, VGMAX [pu]."""
+
+    kind = "exciter"
+    order = 2
+    params = (
+        Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
+        Param("VIMAX", 0.8, "pu", "maximum input error", ""),
+        Param("VIMIN", -0.1, "pu", "minimum input error", ""),
+        Param("KM", 500.0, "pu", "forward gain of the inner loop", "pos"),
+        Param("TC", 3.0, "s", "lead time constant", "nonneg"),
+        Param("TB", 15.0, "s", "lag time constant", "nonneg"),
+        Param("KA", 50.0, "pu", "regulator gain", "pos"),
+        Param("TA", 0.1, "s", "regulator time constant", "pos"),
+        Param("VRMAX", 8.0, "pu", "maximum regulator output", ""),
+        Param("VRMIN", 0.0, "pu", "minimum regulator output", ""),
+        Param("KG", 1.0, "pu", "inner-loop feedback gain", "nonneg"),
+        Param("KP", 4.0, "pu", "potential circuit gain", "nonneg"),
+        Param("KI", 0.1, "pu", "potential circuit (current) gain", "nonneg"),
+        Param("VBMAX", 18.0, "pu", "maximum available exciter voltage", ""),
+        Param("KC", 0.1, "pu", "rectifier loading factor", "nonneg"),
+        Param("XL", 0.01, "pu", "reactance of the potential source", "nonneg"),
+        Param("VGMAX", 4.0, "pu", "maximum inner-loop feedback", ""),
+        Param("THETAP", 0.0, "deg", "potential circuit phase angle", ""),
+        Param("TM", 0.1, "s", "inner-loop time constant", "pos"),
+        Param("VMMAX", 1.0, "pu", "maximum inner-loop output", ""),
+        Param("VMMIN", 0.1, "pu", "minimum inner-loop output", ""),
+    )
+    states = ("LG", "LL", "VR", "VM")
+    outputs = ("vi", "VE", "VB", "vout")
+
+    def setup(self, system):
+        super().setup(system)
+        p = self.p
+        self.KPC = p["KP"] * np.exp(1j * np.radians(p["THETAP"]))
+        self.LG = Lag(1.0, p["TR"])
+        self.LL = LeadLag(p["TC"], p["TB"])
+        self.LA = LagNonWindup(p["KA"], p["TA"], p["VRMIN"], p["VRMAX"])
+        self.LM = LagNonWindup(p["KM"], p["TM"], p["VMMIN"], p["VMMAX"])
+
+    def limits(self):
+        p = self.p
+        return [(self.idx("VR"), p["VRMIN"], p["VRMAX"]), (self.idx("VM"), p["VMMIN"], p["VMMAX"])]
+
+    def _vb(self, VE, XadIfd):
+        p = self.p
+        with np.errstate(divide="ignore", invalid="ignore"):
+            IN = np.where(VE > 0, p["KC"] * XadIfd / VE, 0.0)
+        return np.minimum(VE * rectifier_fex(IN), p["VBMAX"])
+
+    def init(self, system, x, sig):
+        p = self.p
+        m = self.mach
+        vf0, v = sig["vf0"][m], sig["Vt0"][m]
+        V = v * np.exp(1j * sig["theta0"][m])
+        It = np.conj((sig["Pe0"][m] + 1j * sig["Qe0"][m]) / V)
+        VE0 = np.abs(self.KPC * V + 1j * (p["KI"] + self.KPC * p["XL"]) * It)
+        VB0 = self._vb(VE0, sig["XadIfd"][m])
+        VM0 = vf0 / VB0
+        VR0 = VM0 / p["KM"] + np.minimum(p["KG"] * vf0, p["VGMAX"])
+        VA0 = VR0 / p["KA"]
+        self.vref0 = v + VA0
+        x[self.sl(0)] = self.LG.init(v)
+        x[self.sl(1)] = self.LL.init(VA0)
+        x[self.sl(2)] = VR0
+        x[self.sl(3)] = VM0
+
+    def compute(self, ctx):
+        p = self.p
+        m = self._mi
+        lg, ll, vr, vm = (ctx.x[..., s] for s in self._sls)
+        s = ctx.sig
+        v = s["Vt"][..., m]
+        vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
+        vil = hard_limit(vi, p["VIMIN"], p["VIMAX"])
+        va = self.LL.output(ll, vil)
+        VE = source_voltage(ctx, self.mach, self.bus, self.KPC, p["KI"], p["XL"])
+        VB = self._vb(VE, s["XadIfd"][..., m])
+        efd = VB * vm
+        vg = np.minimum(p["KG"] * efd, p["VGMAX"])
+        f = ctx.f
+        f[..., self._sls[0]] = self.LG.deriv(lg, v)
+        f[..., self._sls[1]] = self.LL.deriv(ll, vil)
+        f[..., self._sls[2]] = self.LA.deriv(vr, va)
+        f[..., self._sls[3]] = self.LM.deriv(vm, vr - vg)
+        s["vf"][..., m] = efd
+        o = ctx.out
+        o["ESST3A.vi"], o["ESST3A.VE"], o["ESST3A.VB"], o["ESST3A.vout"] = vi, VE, VB, efd

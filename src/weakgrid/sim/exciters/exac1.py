@@ -1,0 +1,112 @@
+"""EXAC1: IEEE type AC1 alternator-rectifier exciter (PSS/E EXAC1).
+
+Block diagram (pu, times in s)::
+
+    v --[Lag 1/(1+sTR)]--> LG
+    vi = vref - LG - WF + vs                              (vs: PSS output)
+    vi --[LeadLag (1+sTC)/(1+sTB)]--> LL
+    LL --[Lag KA/(1+sTA), non-windup VRMIN..VRMAX]--> VR
+    VFE = KE*VE + VE*SE(VE) + KD*XadIfd                   (alternator demagnetization)
+    TE dVE/dt = VR - VFE
+    VFE --[Washout s*KF/(1+sTF)]--> WF                    (rate feedback)
+    IN = KC*XadIfd/VE,  Efd = VE * FEX(IN)                (rectifier regulation)
+
+At initialization ``VE`` solves ``VE*FEX(KC*XadIfd/VE) = vf0`` (monotone in
+``VE``; solved by bisection).
+
+Difference from ANDES 2.0 (documented, not copied): ANDES feeds the unfiltered
+bus voltage to the summing junction (its ``TR`` lag is unused); here the sensed
+voltage passes through ``TR`` as in the standard. They agree for ``TR = 0``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..blocks import Lag, LagNonWindup, LeadLag, Washout, rectifier_fex
+from ..control_base import MachineControl
+from ..params import Param
+from .dc_common import SATURATION_PARAMS, DCExciter
+
+
+def _efd(VE, KC, XadIfd):
+    with np.errstate(divide="ignore", invalid="ignore"):
+        IN = np.where(VE > 0, KC * XadIfd / VE, 0.0)
+    return VE * rectifier_fex(IN)
+
+
+class EXAC1(MachineControl):
+    """IEEE AC1 exciter. Times [s]: TR, TB, TC, TA, TE, TF; gains [pu]: KA, KF, KC, KD, KE;
+    VRMAX, VRMIN [pu]; E1, SE1, E2, SE2 (saturation)."""
+
+    kind = "exciter"
+    order = 2
+    params = (
+        Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
+        Param("TB", 1.0, "s", "lag time constant", "nonneg"),
+        Param("TC", 1.0, "s", "lead time constant", "nonneg"),
+        Param("KA", 80.0, "pu", "regulator gain", "pos"),
+        Param("TA", 0.04, "s", "regulator time constant", "pos"),
+        Param("VRMAX", 8.0, "pu", "maximum regulator output", ""),
+        Param("VRMIN", 0.0, "pu", "minimum regulator output", ""),
+        Param("TE", 0.8, "s", "exciter time constant", "pos"),
+        Param("KF", 0.1, "pu", "rate feedback gain", "nonneg"),
+        Param("TF", 1.0, "s", "rate feedback time constant", "pos"),
+        Param("KC", 0.1, "pu", "rectifier loading factor", "nonneg"),
+        Param("KD", 0.0, "pu", "demagnetizing factor", "nonneg"),
+        Param("KE", 1.0, "pu", "exciter constant", ""),
+    ) + SATURATION_PARAMS
+    states = ("LG", "LL", "VR", "VE", "WF")
+    outputs = ("vi", "VFE", "vout")
+
+    def setup(self, system):
+        super().setup(system)
+        p = self.p
+        self.LG = Lag(1.0, p["TR"])
+        self.LL = LeadLag(p["TC"], p["TB"])
+        self.LA = LagNonWindup(p["KA"], p["TA"], p["VRMIN"], p["VRMAX"])
+        self.EX = DCExciter(p["KE"], p["TE"], p["E1"], p["SE1"], p["E2"], p["SE2"])
+        self.WF = Washout(p["KF"], p["TF"])
+
+    def limits(self):
+        return [(self.idx("VR"), self.p["VRMIN"], self.p["VRMAX"])]
+
+    def init(self, system, x, sig):
+        p = self.p
+        m = self.mach
+        vf0, v, xad = sig["vf0"][m], sig["Vt0"][m], sig["XadIfd"][m]
+        lo = np.asarray(vf0, float).copy()                 # Efd <= VE
+        hi = vf0 + 2.0 * p["KC"] * np.abs(xad) + 1.0         # FEX = 0 beyond IN = 1
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            below = _efd(mid, p["KC"], xad) < vf0
+            lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+        VE0 = 0.5 * (lo + hi)
+        vfe0 = self.EX.vfe(VE0) + p["KD"] * xad
+        vi0 = vfe0 / p["KA"]
+        self.vref0 = v + vi0
+        x[self.sl(0)] = self.LG.init(v)
+        x[self.sl(1)] = self.LL.init(vi0)
+        x[self.sl(2)] = vfe0
+        x[self.sl(3)] = VE0
+        x[self.sl(4)] = self.WF.init(vfe0)
+
+    def compute(self, ctx):
+        p = self.p
+        m = self._mi
+        lg, ll, vr, ve, wf = (ctx.x[..., s] for s in self._sls)
+        s = ctx.sig
+        v = s["Vt"][..., m]
+        xad = s["XadIfd"][..., m]
+        vfe = self.EX.vfe(ve) + p["KD"] * xad
+        vi = self.vref0 - self.LG.output(lg, v) - self.WF.output(wf, vfe) + s["vs"][..., m]
+        efd = _efd(ve, p["KC"], xad)
+        f = ctx.f
+        f[..., self._sls[0]] = self.LG.deriv(lg, v)
+        f[..., self._sls[1]] = self.LL.deriv(ll, vi)
+        f[..., self._sls[2]] = self.LA.deriv(vr, self.LL.output(ll, vi))
+        f[..., self._sls[3]] = (vr - vfe) / p["TE"]
+        f[..., self._sls[4]] = self.WF.deriv(wf, vfe)
+        s["vf"][..., m] = efd
+        o = ctx.out
+        o["EXAC1.vi"], o["EXAC1.VFE"], o["EXAC1.vout"] = vi, vfe, efd

@@ -1,0 +1,87 @@
+"""EXST1: IEEE type ST1 potential-source static exciter (PSS/E EXST1).
+
+Block diagram (pu, times in s)::
+
+    v --[Lag 1/(1+sTR)]--> LG
+    vi  = vref - LG - WF + vs                      (vs: PSS output)
+    vil = clip(vi, VIMIN, VIMAX)
+    vil --[LeadLag (1+sTC)/(1+sTB)]--> LL
+    LL  --[Lag KA/(1+sTA)]--> VR
+    Efd = clip(VR, VRMIN - KC*XadIfd, VRMAX - KC*XadIfd)   (field-current dependent ceiling)
+    Efd --[Washout s*KF/(1+sTF)]--> WF                     (rate feedback)
+
+Difference from ANDES 2.0 (documented, not copied): ANDES applies the output
+limiter to the rate-feedback signal instead of the regulator output (its ceiling
+is never reached) and feeds back the regulator output; here both follow the
+standard diagram. They agree whenever the output limiter is inactive.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..blocks import Lag, LeadLag, Washout, hard_limit
+from ..control_base import MachineControl
+from ..params import Param
+
+
+class EXST1(MachineControl):
+    """IEEE ST1 static exciter. Times [s]: TR, TC, TB, TA, TF; gains [pu]: KA, KC, KF;
+    limits VIMAX, VIMIN, VRMAX, VRMIN [pu]."""
+
+    kind = "exciter"
+    order = 2
+    params = (
+        Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
+        Param("VIMAX", 0.2, "pu", "maximum input error", ""),
+        Param("VIMIN", 0.0, "pu", "minimum input error", ""),
+        Param("TC", 1.0, "s", "lead time constant", "nonneg"),
+        Param("TB", 1.0, "s", "lag time constant", "nonneg"),
+        Param("KA", 80.0, "pu", "regulator gain", "pos"),
+        Param("TA", 0.05, "s", "regulator time constant", "pos"),
+        Param("VRMAX", 8.0, "pu", "maximum output", ""),
+        Param("VRMIN", -3.0, "pu", "minimum output", ""),
+        Param("KC", 0.2, "pu", "rectifier loading factor", "nonneg"),
+        Param("KF", 0.1, "pu", "rate feedback gain", "nonneg"),
+        Param("TF", 1.0, "s", "rate feedback time constant", "pos"),
+    )
+    states = ("LG", "LL", "VR", "WF")
+    outputs = ("vi", "vout")
+
+    def setup(self, system):
+        super().setup(system)
+        p = self.p
+        self.LG = Lag(1.0, p["TR"])
+        self.LL = LeadLag(p["TC"], p["TB"])
+        self.LR = Lag(p["KA"], p["TA"])
+        self.WF = Washout(p["KF"], p["TF"])
+
+    def init(self, system, x, sig):
+        p = self.p
+        m = self.mach
+        vf0, v = sig["vf0"][m], sig["Vt0"][m]
+        vi0 = vf0 / p["KA"]
+        self.vref0 = v + vi0
+        x[self.sl(0)] = self.LG.init(v)
+        x[self.sl(1)] = self.LL.init(vi0)
+        x[self.sl(2)] = self.LR.init(vi0)
+        x[self.sl(3)] = self.WF.init(vf0)
+
+    def compute(self, ctx):
+        p = self.p
+        m = self._mi
+        lg, ll, vr, wf = (ctx.x[..., s] for s in self._sls)
+        s = ctx.sig
+        v = s["Vt"][..., m]
+        xad = s["XadIfd"][..., m]
+        efd = hard_limit(vr, p["VRMIN"] - p["KC"] * xad, p["VRMAX"] - p["KC"] * xad)
+        vi = self.vref0 - self.LG.output(lg, v) - self.WF.output(wf, efd) + s["vs"][..., m]
+        vil = hard_limit(vi, p["VIMIN"], p["VIMAX"])
+        y = self.LL.output(ll, vil)
+        f = ctx.f
+        f[..., self._sls[0]] = self.LG.deriv(lg, v)
+        f[..., self._sls[1]] = self.LL.deriv(ll, vil)
+        f[..., self._sls[2]] = self.LR.deriv(vr, y)
+        f[..., self._sls[3]] = self.WF.deriv(wf, efd)
+        s["vf"][..., m] = efd
+        ctx.out["EXST1.vi"], ctx.out["EXST1.vout"] = vi, efd

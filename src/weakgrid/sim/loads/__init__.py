@@ -1,0 +1,5 @@
+"""Voltage-dependent load models."""
+
+from .zip import ZIP
+
+__all__ = ["ZIP"]

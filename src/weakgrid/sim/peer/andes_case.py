@@ -1,0 +1,142 @@
+"""Any ANDES case (file, or PSS/E ``.raw`` + ``.dyr``) in ANDES and in weakgrid, compared.
+
+Generalizes :mod:`weakgrid.sim.peer.andes_runs` (stock cases by name, one machine
+model) to any case file: machines of every model are matched by name
+(``"<model>_<idx>"``, the names :func:`weakgrid.sim.io.andes.from_andes` gives),
+the case's own timed events can be replaced by one three-phase fault, and the
+ANDES system can be modified before both tools read it (``modify(ss)``), so the
+two simulators always see the same data. ANDES (GPL) is imported, never copied.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .andes_runs import interp_to
+
+MACHINES = ("GENROU", "GENCLS")
+
+
+def load_case(path, addfile=None, fault=None, keep_events=False, modify=None):
+    """Load a case with ``andes.load(..., setup=False)``.
+
+    Parameters
+    ----------
+    path : str
+        Case file (``.xlsx``, ``.json``, ``.m``, ``.raw``, ...), or a stock case name
+        (``"kundur/kundur_full.xlsx"``), resolved with ``andes.get_case``.
+    addfile : str, optional
+        PSS/E ``.dyr`` file read with a ``.raw``.
+    fault : (bus_idx, tf, tc) or "auto" or None
+        Add a three-phase fault at that ANDES bus from ``tf`` to ``tc`` [s]; ``"auto"``: at
+        the bus of the first in-service PQ load, 1.0-1.05 s.
+    keep_events : bool
+        Keep the case's own ``Toggle``/``Fault``/``Alter`` devices (default: switch them off).
+    modify : callable, optional
+        ``modify(ss)`` applied after loading (e.g. adding devices with ``ss.add``).
+    """
+    import os
+
+    import andes
+
+    andes.config_logger(40)
+    if not os.path.exists(path):
+        path = andes.get_case(path)
+    ss = andes.load(path, addfile=addfile, setup=False, no_output=True, default_config=True)
+    if ss is None:
+        raise RuntimeError(f"ANDES could not parse {path}")
+    if not keep_events:
+        for ev in ("Toggle", "Fault", "Alter"):
+            if ev in ss.models:
+                for k in range(ss.models[ev].n):
+                    ss.models[ev].u.v[k] = 0
+    if modify is not None:
+        modify(ss)
+    if fault == "auto":
+        fault = (auto_fault_bus(ss), 1.0, 1.05)
+    if fault is not None:
+        bus, tf, tc = fault
+        ss.add("Fault", {"bus": bus, "tf": tf, "tc": tc})
+    return ss
+
+
+def auto_fault_bus(ss):
+    """ANDES idx of the bus of the first in-service PQ load (else the first bus)."""
+    pq = ss.PQ
+    for k in range(pq.n):
+        if pq.u.v[k] > 0:
+            return pq.bus.v[k]
+    return ss.Bus.idx.v[0]
+
+
+def machine_names(ss):
+    """Names ``"<model>_<idx>"`` of the in-service machines of an ANDES system."""
+    out = []
+    for m in MACHINES:
+        mdl = ss.models[m]
+        out += [f"{m}_{ix}" for k, ix in enumerate(mdl.idx.v) if mdl.u.v[k] > 0]
+    return out
+
+
+def run_andes_ss(ss, tf, h, tol=1e-8):
+    """Set up, solve the power flow and simulate ``ss`` in ANDES at the fixed step ``h``."""
+    ss.setup()
+    ss.PFlow.config.tol = 1e-11
+    ss.PFlow.run()
+    if not ss.PFlow.converged:
+        return {"ok": False, "error": "ANDES power flow did not converge"}
+    ss.TDS.config.tf = tf
+    ss.TDS.config.tstep = h
+    ss.TDS.config.fixt = 1
+    ss.TDS.config.shrinkt = 0
+    ss.TDS.config.tol = tol
+    ss.TDS.config.no_tqdm = 1
+    t0 = time.perf_counter()
+    ss.TDS.run()
+    wall = time.perf_counter() - t0
+    ts = ss.dae.ts
+    om, de, names = [], [], []
+    for m in MACHINES:
+        mdl = ss.models[m]
+        for k, ix in enumerate(mdl.idx.v):
+            if mdl.u.v[k] > 0:
+                om.append(mdl.omega.a[k])
+                de.append(mdl.delta.a[k])
+                names.append(f"{m}_{ix}")
+    return {"t": np.asarray(ts.t), "omega": np.asarray(ts.x[:, om]), "delta": np.asarray(ts.x[:, de]),
+            "names": names, "wall": wall, "ok": bool(ss.exit_code == 0), "ss": ss}
+
+
+def run_weakgrid_ss(ss, tf, h, tol=1e-8, **kw):
+    """Import ``ss`` (not set up) into weakgrid with its events and simulate at step ``h``."""
+    from ..integrate import Simulator
+    from ..io.andes import from_andes
+
+    system, events = from_andes(ss)
+    system.setup()
+    sim = Simulator(system, dt=h, tol=tol, **kw)
+    t0 = time.perf_counter()
+    res = sim.run(tf, events=events)
+    wall = time.perf_counter() - t0
+    names = list(system.machine_names)
+    return {"t": res.t, "omega": np.column_stack([res[f"{n}.omega"] for n in names]),
+            "delta": np.column_stack([res[f"{n}.delta"] for n in names]), "names": names,
+            "wall": wall, "ok": res.ok, "res": res, "system": system}
+
+
+def compare_named(a, b, t_grid=None):
+    """Largest speed difference [pu] and rotor-angle difference [deg] relative to the first
+    common machine, over machines matched by name."""
+    common = [n for n in a["names"] if n in b["names"]]
+    ia = [a["names"].index(n) for n in common]
+    ib = [b["names"].index(n) for n in common]
+    if t_grid is None:
+        t_grid = np.linspace(max(a["t"][0], b["t"][0]), min(a["t"][-1], b["t"][-1]), 4001)
+    wa = interp_to(t_grid, a["t"], a["omega"][:, ia])
+    wb = interp_to(t_grid, b["t"], b["omega"][:, ib])
+    da = interp_to(t_grid, a["t"], a["delta"][:, ia])
+    db = interp_to(t_grid, b["t"], b["delta"][:, ib])
+    ra, rb = da - da[:, :1], db - db[:, :1]
+    return float(np.max(np.abs(wa - wb))), float(np.degrees(np.max(np.abs(ra - rb))))

@@ -1,0 +1,220 @@
+"""PVD1: WECC distributed photovoltaic model (PSS/E PVD1, ANDES ``PVD1``).
+
+A current source aligned with its bus voltage (system per unit; frequencies in Hz; times in s)::
+
+    frequency measurement (as ANDES BusFreq at the bus):
+        (a - a0) --[Lag 1/(1+sTf)]--> L --[Washout (1/wn) s/(1+sTw)]--> df,  fHz = fn (1 + df)
+    trip (recovery) factors, 1 inside the normal band, linear to 0 at the trip points:
+        Ffl(fHz; ft0, ft1), Ffh(fHz; ft2, ft3), Fvl(v; vt0, vt1), Fvh(v; vt2, vt3)
+        R = Fvl Fvh Ffl Ffh if recflag else 1
+    active power: Psum = pref0 + Pext0 + ddn * deadband(fn - fHz; fdbd, 999)
+        Ipul = clip(Psum, 0, pmx) / vp       (the lower clip gives 0, as ANDES: Psum < 0 -> 0)
+    reactive power: Qsum = qref0 + Qdrp(Vcomp), Q-V droop dqdv outside [v0, v1] bounded by qmn..qmx,
+        Vcomp = |V + j xc (Ipout + j Iqout)|,    Iqul = Qsum / vp,   vp = max(v, 0.01)
+    current limit ialim, P priority (pqflag = 1) or Q priority (0):
+        Ipcmd = R clip(Ipul, 0, Ipmax),  Iqcmd = R clip(Iqul, -Iqmax, Iqmax)
+    Ipout = Lag(Ipcmd, tip),  Iqout = Lag(Iqcmd, tiq);   P = Ipout v,  Q = Iqout v
+
+Several PVD1 may share one static generator (``gammap``, ``gammaq``: shares of its P and Q,
+which must sum to 1 over the devices of one generator). ``qmx``, ``qmn``, ``pmx``, ``dqdv``,
+``ddn`` are powers and ``ialim`` a current on the device base ``Sn`` (converted by ``Sn/Sb``, as
+ANDES). The frequency-measurement constants ``Tf``, ``Tw`` are those of the ANDES ``BusFreq``
+device the PVD1 names in ``busf`` (ANDES defaults 0.02 s and 0.1 s otherwise). The lag's
+input error ``(a - a0) - L`` is formed as the angle of ``V conj(V0) exp(-jL)``, so the
+measurement stays right when the bus angle drifts past +-pi (ANDES's angle is unwrapped).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..blocks import Lag, Washout
+from ..component import Component, scatter_add
+from ..errors import DataError
+from ..network import GEN_BUS, GEN_STATUS
+from ..params import Param
+
+
+def _band_lo(u, p0, p1):
+    """0 at or below p0, linear to 1 at p1, 1 above (ANDES Limiter zones)."""
+    return np.where(u <= p0, 0.0, np.where(u >= p1, 1.0, (u - p0) / (p1 - p0)))
+
+
+def _band_hi(u, p2, p3):
+    """1 at or below p2, linear to 0 at p3, 0 above."""
+    return np.where(u <= p2, 1.0, np.where(u >= p3, 0.0, 1.0 + (p2 - u) / (p3 - p2)))
+
+
+class PVD1(Component):
+    """Distributed PV (WECC PVD1); several devices may share one static generator row."""
+
+    kind = "device"
+    order = 0
+    gen_shared = True
+    params = (
+        Param("Sn", 100.0, "MVA", "device rating", "pos"),
+        Param("fn", 60.0, "Hz", "nominal frequency", "pos"),
+        Param("xc", 0.0, "pu", "coupling reactance of the compensated voltage", ""),
+        Param("pqflag", 1.0, "-", "current priority: 1 P, 0 Q", "nonneg"),
+        Param("qmx", 0.33, "pu (Sn)", "maximum reactive power command", "", "power"),
+        Param("qmn", -0.33, "pu (Sn)", "minimum reactive power command", "", "power"),
+        Param("pmx", 9999.0, "pu (Sn)", "maximum active power", "", "power"),
+        Param("v0", 0.8, "pu", "lower voltage of the Q-V droop deadband", ""),
+        Param("v1", 1.1, "pu", "upper voltage of the Q-V droop deadband", ""),
+        Param("dqdv", -1.0, "pu (Sn)/pu", "Q-V droop (negative)", "", "power"),
+        Param("fdbd", -0.017, "Hz", "frequency deadband (lower edge)", ""),
+        Param("ddn", 0.0, "pu (Sn)/Hz", "frequency droop gain outside the deadband", "", "power"),
+        Param("ialim", 1.3, "pu (Sn)", "apparent current limit", "pos", "current"),
+        Param("vt0", 0.88, "pu", "voltage trip point 0", ""),
+        Param("vt1", 0.90, "pu", "voltage trip point 1", ""),
+        Param("vt2", 1.1, "pu", "voltage trip point 2", ""),
+        Param("vt3", 1.2, "pu", "voltage trip point 3", ""),
+        Param("vrflag", 0.0, "-", "voltage-trip latching (unused, as ANDES)", ""),
+        Param("ft0", 59.5, "Hz", "frequency trip point 0", ""),
+        Param("ft1", 59.7, "Hz", "frequency trip point 1", ""),
+        Param("ft2", 60.3, "Hz", "frequency trip point 2", ""),
+        Param("ft3", 60.5, "Hz", "frequency trip point 3", ""),
+        Param("frflag", 0.0, "-", "frequency-trip latching (unused, as ANDES)", ""),
+        Param("tip", 0.02, "s", "active current lag", "pos"),
+        Param("tiq", 0.02, "s", "reactive current lag", "pos"),
+        Param("gammap", 1.0, "-", "share of the static generator's P", "nonneg"),
+        Param("gammaq", 1.0, "-", "share of the static generator's Q", "nonneg"),
+        Param("recflag", 1.0, "-", "voltage/frequency recovery factors on (1) or off (0)", "nonneg"),
+        Param("Tf", 0.02, "s", "frequency measurement: angle filter", "pos"),
+        Param("Tw", 0.1, "s", "frequency measurement: washout", "pos"),
+    )
+    states = ("L", "WO", "Ipout", "Iqout")
+    outputs = ("fHz", "R", "Ipul", "Ipcmd", "Iqcmd", "Pe", "Qe")
+    units = {"Pe": "power", "Qe": "power"}
+
+    @classmethod
+    def andes_link(cls, m, k, gen_row, ss, **_):
+        """Link of ANDES PVD1 ``k``: its static generator row, with its BusFreq constants."""
+        return {"gen": gen_row[m.gen.v[k]], "busf": m.busf.v[k]}
+
+    @classmethod
+    def andes_params(cls, m, k, ss, values):
+        """Add ``Tf``, ``Tw`` of the BusFreq device named in ``busf`` (ANDES defaults otherwise)."""
+        bf = m.busf.v[k]
+        if bf is not None and "BusFreq" in ss.models and bf in list(ss.BusFreq.idx.v):
+            j = list(ss.BusFreq.idx.v).index(bf)
+            values["Tf"] = float(ss.BusFreq.Tf.v[j])
+            values["Tw"] = float(ss.BusFreq.Tw.v[j])
+        return values
+
+    def add_pvd1(self, name, gen, **params):
+        """Add one device on gen-table row ``gen`` (0-based)."""
+        self.add(name, {"gen": gen}, params)
+        return name
+
+    def setup(self, system):
+        super().setup(system)
+        net = system.network
+        p = self.p
+        self.gen = np.zeros(self.n, int)
+        self.bus = np.zeros(self.n, int)
+        for i, lk in enumerate(self.links):
+            g = lk["gen"]
+            if not (isinstance(g, (int, np.integer)) and 0 <= g < net.gen.shape[0]) or net.gen[g, GEN_STATUS] <= 0:
+                raise DataError(self.element(i), "gen", g, "give an in-service 0-based gen-table row")
+            self.gen[i] = g
+            self.bus[i] = net.index_of(int(net.gen[g, GEN_BUS]), self.element(i), "gen bus")
+        for f in ("gammap", "gammaq"):
+            for g in set(self.gen.tolist()):
+                on = self.gen == g
+                tot = p[f][on].sum()
+                if abs(tot - 1.0) > 1e-9:
+                    i = int(np.nonzero(on)[0][0])
+                    raise DataError(self.element(i), f, p[f][i],
+                                    f"the {f} of the PVD1 on gen row {g} sum to {tot:g}; they must sum to 1")
+        c = p["Sn"] / system.Sb
+        for prm in self.params:
+            if prm.base in ("power", "current"):
+                p[prm.name] = p[prm.name] * c
+        self._uniq = len(set(self.bus.tolist())) == self.n
+        self.iwn = 1.0 / (2 * np.pi * p["fn"])
+        self.Lb = Lag(1.0, p["Tf"])
+        self.WOb = Washout(self.iwn, p["Tw"])
+        self.Ipb = Lag(1.0, p["tip"])
+        self.Iqb = Lag(1.0, p["tiq"])
+
+    def pattern(self, system):
+        return [(self.instance_states(i) + system.bus_vars(self.bus[i]),) * 2 for i in range(self.n)]
+
+    # ---------------------------------------------------------------- algebra
+    def _commands(self, v, V, fHz, ipout, iqout):
+        p = self.p
+        vp = np.maximum(v, 0.01)
+        R = _band_lo(v, p["vt0"], p["vt1"]) * _band_hi(v, p["vt2"], p["vt3"]) \
+            * _band_lo(fHz, p["ft0"], p["ft1"]) * _band_hi(fHz, p["ft2"], p["ft3"])
+        R = np.where(p["recflag"] > 0, R, 1.0)
+        fdev = p["fn"] - fHz
+        pdrp = p["ddn"] * (np.where(fdev >= 999.0, fdev - 999.0, 0.0)
+                           + np.where(fdev <= p["fdbd"], fdev - p["fdbd"], 0.0))
+        psum = self.pref0 + pdrp
+        ipul = np.where(psum >= p["pmx"], p["pmx"], np.where(psum <= 0.0, 0.0, psum)) / vp
+        vcomp = np.abs(V + 1j * p["xc"] * (ipout + 1j * iqout))
+        qdrp = np.where(vcomp <= self.Vql, p["qmx"], 0.0) + np.where(vcomp >= self.Vqu, p["qmn"], 0.0) \
+            + np.where((vcomp > self.Vql) & (vcomp < p["v0"]), p["qmx"] + p["dqdv"] * (self.Vqu - vcomp), 0.0) \
+            + np.where((vcomp > p["v1"]) & (vcomp < self.Vqu), p["dqdv"] * (p["v1"] - vcomp), 0.0)
+        iqul = (self.qref0 + qdrp) / vp
+        pri = p["pqflag"] > 0
+        lim = p["ialim"]
+        # P priority: Ip limited by ialim, Iq by what is left; Q priority the other way round
+        ipcmd_p = R * np.clip(ipul, 0.0, lim)
+        iqmax_p = np.sqrt(np.maximum(lim ** 2 - ipcmd_p ** 2, 0.0))
+        iqcmd_p = R * np.clip(iqul, -iqmax_p, iqmax_p)
+        iqcmd_q = R * np.clip(iqul, -lim, lim)
+        ipmax_q = np.sqrt(np.maximum(lim ** 2 - iqcmd_q ** 2, 0.0))
+        ipcmd_q = R * np.clip(ipul, 0.0, ipmax_q)
+        return np.where(pri, ipcmd_p, ipcmd_q), np.where(pri, iqcmd_p, iqcmd_q), R, qdrp, ipul
+
+    def init(self, system, x, sig):
+        pf = system.network.pf
+        p = self.p
+        V = pf.V[self.bus]
+        v = np.abs(V)
+        self.V0 = V.copy()
+        self.pref0 = pf.Pg[self.gen] * p["gammap"]
+        self.qref0 = pf.Qg[self.gen] * p["gammaq"]
+        with np.errstate(divide="ignore"):
+            self.Vqu = p["v1"] - (self.qref0 - p["qmn"]) / p["dqdv"]
+            self.Vql = p["v0"] + (p["qmx"] - self.qref0) / p["dqdv"]
+        ip0, iq0 = self.pref0 / v, self.qref0 / v
+        ipc, iqc, R, qdrp, _ = self._commands(v, V, p["fn"], ip0, iq0)
+        bad = (np.abs(ipc - ip0) > 1e-9) | (np.abs(iqc - iq0) > 1e-9)
+        for i in np.nonzero(bad)[0]:
+            why = ("the voltage or frequency is in a trip band" if R[i] < 1 else
+                   "the Q-V droop is active" if qdrp[i] != 0 else "the current limit ialim binds")
+            raise DataError(self.element(i), "ialim" if R[i] == 1 and qdrp[i] == 0 else "v0",
+                            float(p["ialim"][i] if R[i] == 1 and qdrp[i] == 0 else p["v0"][i]),
+                            f"the power-flow point ({self.pref0[i]:.4g} + j{self.qref0[i]:.4g} pu at "
+                            f"{v[i]:.4g} pu) is not a steady state: {why}; correct the limits")
+        x[self.sl(0)] = 0.0
+        x[self.sl(1)] = 0.0
+        x[self.sl(2)] = ip0
+        x[self.sl(3)] = iq0
+
+    # -------------------------------------------------------------- equations
+    def compute(self, ctx):
+        x = ctx.x
+        sl = self._sls
+        L, wo, ipout, iqout = (x[..., sl[k]] for k in range(4))
+        V = ctx.V[..., self.bus]
+        v = np.abs(V)
+        # (a - a0) - L, wrapped: L stays a continuous (unwrapped) angle even when the grid
+        # frequency drifts for long (the bus angle itself is only known modulo 2 pi)
+        err = np.angle(V * np.conj(self.V0) * np.exp(-1j * L))
+        df = self.WOb.output(wo, L)
+        fHz = self.p["fn"] * (1.0 + df)
+        ipcmd, iqcmd, R, _, ipul = self._commands(v, V, fHz, ipout, iqout)
+        vs = np.where(v > 1e-6, v, 1e-6)
+        scatter_add(ctx.I, self.bus, (ipout - 1j * iqout) * V / vs, self._uniq)
+        f = ctx.f
+        f[..., sl[0]] = err / self.Lb._Ts
+        f[..., sl[1]] = self.WOb.deriv(wo, L)
+        f[..., sl[2]] = self.Ipb.deriv(ipout, ipcmd)
+        f[..., sl[3]] = self.Iqb.deriv(iqout, iqcmd)
+        o = ctx.out
+        o["PVD1.fHz"], o["PVD1.R"], o["PVD1.Ipcmd"], o["PVD1.Iqcmd"] = fHz, R, ipcmd, iqcmd
+        o["PVD1.Pe"], o["PVD1.Qe"], o["PVD1.Ipul"] = ipout * v, iqout * v, ipul

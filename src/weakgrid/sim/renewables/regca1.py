@@ -1,0 +1,195 @@
+"""REGCA1: WECC generic renewable generator/converter model A (PSS/E REGCA1, PSLF REGC_A).
+
+The converter is a controlled current source aligned with its terminal voltage
+(no PLL, as ANDES 2.0). Block diagram (system per unit; times in s)::
+
+    Ipcmd --[LagRate 1/(1+sTg), T*dx/dt <= Rrpwr; non-windup upper LVPL(S2)]--> S0
+    Ipout = S0 * LVG(v)                       low-voltage active current management
+    -Iqcmd --[LagRate 1/(1+sTg), Iqrmin..Iqrmax (only in the direction of q0)]--> S1
+    Iqout = clip(S1 - HVG(v), Iolim, 9999),  HVG = max(Khv*(v - Volim), 0)
+    v --[Lag 1/(1+sTfltr)]--> S2
+    LVG(v)   = 0 below Lvpnt0, linear to 1 at Lvpnt1, 1 above
+    LVPL(S2) = 0 below Zerox, Lvpl1*(S2 - Zerox)/(Brkpt - Zerox) up to Brkpt, then no limit
+               (no limit at all when Lvplsw = 0)
+    P = Ipout*v,  Q = Iqout*v,  I = (Ipout - j Iqout) * V/|V|   (injected)
+
+Without an electrical control (REECA1) the commands are held at their initial values
+``Ipcmd = p0/(v LVG(v))``, ``Iqcmd = -q0/v`` (as ANDES). Parameter names and per-unit
+conventions are ANDES's: ``Iolim``, ``Iqrmax``, ``Iqrmin`` are currents on the device
+base ``Sn`` (converted by ``Sn/Sb``).
+
+Limits follow ANDES: the rate limits bound ``T dx/dt``; the non-windup upper limit LVPL
+of ``S0`` holds the state while it is at or above the limit and its input pushes up, and
+the output is the limit meanwhile (ANDES also resets the state to the limit; here the state
+is held, so after the limit releases the output resumes from the held state).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..blocks import Lag, LagRate, piecewise_linear
+from ..component import Component, scatter_add
+from ..errors import DataError
+from ..network import GEN_BUS, GEN_STATUS
+from ..params import Param
+
+
+class REGCA1(Component):
+    """Renewable generator/converter model A (WECC); one per static generator row."""
+
+    kind = "device"
+    order = 0
+    params = (
+        Param("Sn", 100.0, "MVA", "device rating", "pos"),
+        Param("Tg", 0.1, "s", "converter time constant", "pos"),
+        Param("Rrpwr", 10.0, "pu", "LVPL ramp limit (on Tg*dIp/dt)", "pos"),
+        Param("Brkpt", 1.0, "pu", "LVPL breakpoint voltage", ""),
+        Param("Zerox", 0.5, "pu", "LVPL zero-crossing voltage", ""),
+        Param("Lvplsw", 1.0, "-", "LVPL switch (1 on, 0 off)", "nonneg"),
+        Param("Lvpl1", 1.0, "pu", "LVPL gain at Brkpt", ""),
+        Param("Volim", 1.2, "pu", "voltage limit of high-voltage reactive current management", ""),
+        Param("Lvpnt1", 0.8, "pu", "high point of low-voltage active current management", ""),
+        Param("Lvpnt0", 0.4, "pu", "low point of low-voltage active current management", ""),
+        Param("Iolim", -1.5, "pu (Sn)", "lower limit of the reactive current output", "", "current"),
+        Param("Tfltr", 0.1, "s", "voltage filter time constant of LVPL", "pos"),
+        Param("Khv", 0.7, "pu/pu", "overvoltage compensation gain", ""),
+        Param("Iqrmax", 1.0, "pu (Sn)", "upper rate limit of reactive current (on Tg*dIq/dt)", "", "current"),
+        Param("Iqrmin", -1.0, "pu (Sn)", "lower rate limit of reactive current (on Tg*dIq/dt)", "", "current"),
+        Param("Accel", 0.0, "-", "acceleration factor (unused, as ANDES)", ""),
+        Param("gammap", 1.0, "-", "share of the static generator's P", "pos"),
+        Param("gammaq", 1.0, "-", "share of the static generator's Q", "pos"),
+    )
+    states = ("S0", "S1", "S2")
+    outputs = ("Ipout", "Iqout", "Pe", "Qe", "LVG", "LVPL", "Ipcmd", "Iqcmd")
+    units = {"Pe": "power", "Qe": "power"}
+
+    @classmethod
+    def andes_link(cls, m, k, gen_row, **_):
+        """Link of ANDES device ``k`` of model ``m``: the gen-table row of its static generator."""
+        return {"gen": gen_row[m.gen.v[k]]}
+
+    def add_regca1(self, name, gen, **params):
+        """Add one converter replacing gen-table row ``gen`` (0-based)."""
+        self.add(name, {"gen": gen}, params)
+        return name
+
+    def setup(self, system):
+        super().setup(system)
+        net = system.network
+        p = self.p
+        self.gen = np.zeros(self.n, int)
+        self.bus = np.zeros(self.n, int)
+        for i, lk in enumerate(self.links):
+            g = lk["gen"]
+            if not (isinstance(g, (int, np.integer)) and 0 <= g < net.gen.shape[0]) or net.gen[g, GEN_STATUS] <= 0:
+                raise DataError(self.element(i), "gen", g, "give an in-service 0-based gen-table row")
+            self.gen[i] = g
+            self.bus[i] = net.index_of(int(net.gen[g, GEN_BUS]), self.element(i), "gen bus")
+            for f in ("gammap", "gammaq"):
+                if p[f][i] != 1:
+                    raise DataError(self.element(i), f, p[f][i],
+                                    "only one converter per static generator (gamma = 1) is supported")
+        c = p["Sn"] / system.Sb
+        for prm in self.params:
+            if prm.base == "current":
+                p[prm.name] = p[prm.name] * c
+        self._uniq = len(set(self.bus.tolist())) == self.n
+
+    def pattern(self, system):
+        groups = []
+        for i in range(self.n):
+            v = self.instance_states(i) + system.bus_vars(self.bus[i])
+            groups.append((v, v))
+        return groups
+
+    # ---------------------------------------------------------------- algebra
+    def _lvg(self, v):
+        p = self.p
+        return piecewise_linear(v, [p["Lvpnt0"], p["Lvpnt1"]], [0.0, 1.0])
+
+    def _lvpl(self, s2):
+        p = self.p
+        on = p["Lvplsw"] > 0
+        seg = (s2 - p["Zerox"]) * p["Lvpl1"] / (p["Brkpt"] - p["Zerox"])
+        lim = np.where(s2 <= p["Zerox"], 0.0, np.where(s2 <= p["Brkpt"], seg, 9999.0))
+        return np.where(on, lim, 9999.0)
+
+    def init(self, system, x, sig):
+        pf = system.network.pf
+        p = self.p
+        V = pf.V[self.bus]
+        v = np.abs(V)
+        self.p0 = pf.Pg[self.gen] * p["gammap"]
+        self.q0 = pf.Qg[self.gen] * p["gammaq"]
+        lvg = self._lvg(v)
+        for i in np.nonzero(lvg <= 0)[0]:
+            raise DataError(self.element(i), "Lvpnt0", p["Lvpnt0"][i],
+                            f"the initial voltage {v[i]:.4g} pu is at or below Lvpnt0: no active current "
+                            "can flow; lower Lvpnt0")
+        hv = p["Khv"] * (v - p["Volim"])
+        for i in np.nonzero(hv > 0)[0]:
+            raise DataError(self.element(i), "Volim", p["Volim"][i],
+                            f"the initial voltage {v[i]:.4g} pu exceeds Volim; raise Volim above it")
+        self.Ipcmd0 = self.p0 / v / lvg
+        self.Iqcmd0 = -self.q0 / v
+        iq = -self.Iqcmd0
+        for i in np.nonzero(iq < p["Iolim"])[0]:
+            raise DataError(self.element(i), "Iolim", p["Iolim"][i],
+                            f"the initial reactive current {iq[i]:.4g} pu is below Iolim; lower Iolim")
+        lvpl = self._lvpl(v)
+        for i in np.nonzero(self.Ipcmd0 > lvpl)[0]:
+            raise DataError(self.element(i), "Brkpt", p["Brkpt"][i],
+                            f"the initial active current {self.Ipcmd0[i]:.4g} pu exceeds the LVPL limit "
+                            f"{lvpl[i]:.4g} pu at {v[i]:.4g} pu; lower Brkpt or raise Lvpl1")
+        self.S0 = LagRate(1.0, p["Tg"], -np.inf, p["Rrpwr"])
+        self.S1 = LagRate(-1.0, p["Tg"], np.where(self.q0 < 0, p["Iqrmin"], -np.inf),
+                          np.where(self.q0 > 0, p["Iqrmax"], np.inf))
+        self.S2 = Lag(1.0, p["Tfltr"])
+        x[self.sl(0)] = self.Ipcmd0
+        x[self.sl(1)] = self.S1.init(self.Iqcmd0)
+        x[self.sl(2)] = v
+
+    # -------------------------------------------------------------- equations
+    def compute(self, ctx):
+        p = self.p
+        x = ctx.x
+        sl = self._sls
+        s0, s1, s2 = x[..., sl[0]], x[..., sl[1]], x[..., sl[2]]
+        V = ctx.V[..., self.bus]
+        v = np.abs(V)
+        lvpl = self._lvpl(s2)
+        self._lvpl_v = lvpl
+        ip = np.minimum(s0, lvpl)
+        lvg = self._lvg(v)
+        ipout = ip * lvg
+        hvg = np.maximum(p["Khv"] * (v - p["Volim"]), 0.0)
+        iqout = np.clip(s1 - hvg, p["Iolim"], 9999.0)
+        vs = np.where(v > 1e-6, v, 1e-6)
+        I = (ipout - 1j * iqout) * V / vs
+        scatter_add(ctx.I, self.bus, I, self._uniq)
+        # commands: constant unless an electrical control (REECA1) publishes them
+        shape = x.shape[:-1] + (self.n,)
+        ctx.sig["REGCA1.Ipcmd"] = np.broadcast_to(self.Ipcmd0, shape).copy()
+        ctx.sig["REGCA1.Iqcmd"] = np.broadcast_to(self.Iqcmd0, shape).copy()
+        ctx.sig["REGCA1.v"] = v
+        ctx.sig["REGCA1.Pe"] = ipout * v
+        ctx.sig["REGCA1.Qe"] = iqout * v
+        self._o = (ipout, iqout, lvg, lvpl, v)
+
+    def finish(self, ctx):
+        x = ctx.x
+        sl = self._sls
+        s0, s1, s2 = x[..., sl[0]], x[..., sl[1]], x[..., sl[2]]
+        ipcmd, iqcmd = ctx.sig["REGCA1.Ipcmd"], ctx.sig["REGCA1.Iqcmd"]
+        ipout, iqout, lvg, lvpl, v = self._o
+        d0 = self.S0.deriv(s0, ipcmd)
+        at_upper = (s0 >= lvpl) & (d0 >= 0)            # non-windup upper limit LVPL
+        ctx.f[..., sl[0]] = np.where(at_upper, 0.0, d0)
+        ctx.f[..., sl[1]] = self.S1.deriv(s1, iqcmd)
+        ctx.f[..., sl[2]] = self.S2.deriv(s2, v)
+        o = ctx.out
+        o["REGCA1.Ipout"], o["REGCA1.Iqout"] = ipout, iqout
+        o["REGCA1.Pe"], o["REGCA1.Qe"] = ipout * v, iqout * v
+        o["REGCA1.LVG"], o["REGCA1.LVPL"] = lvg, lvpl
+        o["REGCA1.Ipcmd"], o["REGCA1.Iqcmd"] = ipcmd + 0.0, iqcmd + 0.0

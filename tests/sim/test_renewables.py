@@ -1,0 +1,96 @@
+"""REGCA1 without ANDES: steady state, current injection, limits and bad input."""
+
+import numpy as np
+import pytest
+from sim_cases import two_machine_case
+
+from weakgrid.sim.errors import DataError
+from weakgrid.sim.events import Fault
+from weakgrid.sim.integrate import simulate
+from weakgrid.sim.renewables import REGCA1
+from weakgrid.sim.system import System
+
+SG = dict(Sn=200, M=8.0, D=0.0, ra=0.003, xl=0.15, xd=1.8, xq=1.7, xd1=0.3, xq1=0.55, xd2=0.25,
+          xq2=0.25, Td10=6.0, Td20=0.03, Tq10=0.4, Tq20=0.05, S10=0.05, S12=0.3)
+
+
+def build(**re):
+    s = System(two_machine_case(x_line=0.2, p=0.6))
+    s.add_machine("GENROU", "SG", 1, **SG)
+    c = s.add_component(REGCA1())
+    c.add_regca1("PV", gen=0, Sn=100, **re)
+    return s.setup()
+
+
+def test_initial_point_is_an_equilibrium():
+    s = build(Brkpt=0.8)
+    F, ctx = s.residual(0.0, s.z0)
+    assert np.max(np.abs(F)) < 1e-8
+    # it injects the power-flow power of its generator row
+    assert ctx.out["REGCA1.Pe"][0] == pytest.approx(0.6, abs=1e-9)
+
+
+def test_low_voltage_cuts_active_current_and_recovers():
+    s = build(Brkpt=0.8, Lvplsw=0)
+    res = simulate(s, 3.0, dt=1 / 240, events=[Fault(bus=1, t_on=1.0, t_off=1.1, xf=0.05)])
+    assert res.ok
+    t = res.t
+    lvg = np.asarray(res["PV.LVG"])
+    assert lvg[(t > 1.01) & (t < 1.09)].max() < 1.0         # LVG acted during the dip
+    ip = np.asarray(res["PV.Ipout"])
+    assert ip[-1] == pytest.approx(ip[0], abs=1e-9)          # back to its (constant) command
+
+
+def test_lvpl_limits_active_current_while_voltage_is_low():
+    s = build(Brkpt=0.95, Zerox=0.5, Lvpl1=1.0, Lvpnt0=0.0, Lvpnt1=0.01)
+    res = simulate(s, 2.0, dt=1 / 240, events=[Fault(bus=1, t_on=1.0, t_off=1.1, xf=0.08)])
+    ip = np.asarray(res["PV.Ipout"])
+    lvpl = np.asarray(res["PV.LVPL"])
+    assert np.all(ip <= lvpl + 1e-9)
+    assert np.any(lvpl < 0.6)                                # the limit went below the 0.6 pu command
+    assert np.isclose(ip[-1], 0.6 / abs(s.network.pf.V[0]), atol=1e-2)
+
+
+def test_initial_current_beyond_lvpl_is_refused():
+    with pytest.raises(DataError, match="Brkpt"):
+        build(Brkpt=1.5, Zerox=0.5, Lvpl1=0.1)
+
+
+def test_volim_below_initial_voltage_is_refused():
+    with pytest.raises(DataError, match="Volim"):
+        build(Brkpt=0.8, Volim=0.9)
+
+
+def build_pvd1(shares=(0.5, 0.5), **kw):
+    from weakgrid.sim.renewables import PVD1
+
+    s = System(two_machine_case(x_line=0.2, p=0.6))
+    s.add_machine("GENROU", "SG", 1, **SG)
+    c = s.add_component(PVD1())
+    for k, g in enumerate(shares):
+        c.add_pvd1(f"D{k}", gen=0, Sn=100, gammap=g, gammaq=g, **kw)
+    return s.setup()
+
+
+def test_pvd1_shares_equilibrium_and_fault_ride_through():
+    # wide frequency bands: one undamped machine without governor keeps a speed offset
+    s = build_pvd1(ft0=55.0, ft1=56.0, ft2=64.0, ft3=65.0)
+    F, ctx = s.residual(0.0, s.z0)
+    assert np.max(np.abs(F)) < 1e-8
+    assert ctx.out["PVD1.Pe"].sum() == pytest.approx(0.6, abs=1e-9)
+    res = simulate(s, 3.0, dt=1 / 240, events=[Fault(bus=1, t_on=1.0, t_off=1.1, xf=0.05)])
+    assert res.ok
+    t = res.t
+    R = np.asarray(res["D0.R"])
+    assert R[(t > 1.02) & (t < 1.09)].max() < 1.0           # voltage trip band entered: current cut
+    assert np.asarray(res["D0.Pe"])[-1] == pytest.approx(0.3, abs=2e-2)
+
+
+def test_pvd1_shares_must_sum_to_one():
+    with pytest.raises(DataError, match="gammap"):
+        build_pvd1(shares=(0.5, 0.4))
+
+
+def test_pvd1_initial_point_in_trip_band_refused():
+    with pytest.raises(DataError, match="not a steady state"):
+        build_pvd1(vt0=1.05, vt1=1.1, vt2=1.2, vt3=1.3)
