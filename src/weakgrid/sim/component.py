@@ -138,6 +138,31 @@ class Component:
         """Build parameter arrays (system base). Subclasses extend with link resolution."""
         self.p = {p.name: np.array([v[p.name] for v in self._values], dtype=float) for p in self.params}
 
+    def resolve_gen_rows(self, system):
+        """Set ``self.gen`` (the 0-based gen-table row of each instance's ``gen`` link) and
+        ``self.bus`` (its bus position), refusing a row that does not exist or is out of
+        service (naming the instance)."""
+        from .network import GEN_BUS, GEN_STATUS
+
+        net = system.network
+        self.gen = np.zeros(self.n, int)
+        self.bus = np.zeros(self.n, int)
+        for i, lk in enumerate(self.links):
+            g = lk.get("gen")
+            try:
+                ok = g is not None and int(g) == g and 0 <= int(g) < net.gen.shape[0]
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
+                raise DataError(self.element(i), "gen", g,
+                                f"give the 0-based row of the gen table (0..{net.gen.shape[0] - 1})")
+            g = int(g)
+            if net.gen[g, GEN_STATUS] <= 0:
+                raise DataError(self.element(i), "gen", g,
+                                "this generator is out of service; set GEN_STATUS = 1")
+            self.gen[i] = g
+            self.bus[i] = net.index_of(int(net.gen[g, GEN_BUS]), self.element(i), "gen bus")
+
     def assign(self, off: int) -> int:
         """Reserve state indices starting at ``off``; return the next free index."""
         self.off = off

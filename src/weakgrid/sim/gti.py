@@ -34,7 +34,6 @@ import numpy as np
 from .blocks import PID
 from .component import Component, scatter_add
 from .errors import DataError
-from .network import GEN_BUS, GEN_STATUS
 from .params import Param
 
 
@@ -87,15 +86,9 @@ class GTI(Component):
     def setup(self, system):
         super().setup(system)
         net = system.network
-        self.gen = np.zeros(self.n, int)
-        self.bus = np.zeros(self.n, int)
+        self.resolve_gen_rows(system)
         self.ref = np.zeros(self.n, int)
         for i, lk in enumerate(self.links):
-            g = lk["gen"]
-            if not (isinstance(g, (int, np.integer)) and 0 <= g < net.gen.shape[0]) or net.gen[g, GEN_STATUS] <= 0:
-                raise DataError(self.element(i), "gen", g, "give an in-service 0-based gen-table row")
-            self.gen[i] = g
-            self.bus[i] = net.index_of(int(net.gen[g, GEN_BUS]), self.element(i), "gen bus")
             self.ref[i] = net.index_of(lk["ref_bus"], self.element(i), "ref_bus")
         self.pq = np.array([lk["mode"] == "pq" for lk in self.links])
         p = self.p

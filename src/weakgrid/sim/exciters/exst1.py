@@ -18,7 +18,6 @@ standard diagram. They agree whenever the output limiter is inactive.
 
 from __future__ import annotations
 
-import numpy as np
 
 from ..blocks import Lag, LeadLag, Washout, hard_limit
 from ..control_base import MachineControl

@@ -5,8 +5,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..component import Component, fast_index, scatter_add
-from ..errors import DataError
-from ..network import GEN_BUS, GEN_STATUS
 from ..params import Param
 
 BASE_PARAMS = (
@@ -41,19 +39,7 @@ class SyncMachine(Component):
     def setup(self, system):
         super().setup(system)
         net = system.network
-        n = self.n
-        self.gen = np.zeros(n, dtype=int)
-        self.bus = np.zeros(n, dtype=int)
-        for i, link in enumerate(self.links):
-            g = link.get("gen")
-            if g is None or not (0 <= int(g) < net.gen.shape[0]):
-                raise DataError(self.element(i), "gen", g,
-                                f"give the 0-based row of the gen table (0..{net.gen.shape[0] - 1})")
-            g = int(g)
-            if net.gen[g, GEN_STATUS] <= 0:
-                raise DataError(self.element(i), "gen", g, "this generator is out of service; set GEN_STATUS = 1")
-            self.gen[i] = g
-            self.bus[i] = net.index_of(int(net.gen[g, GEN_BUS]), self.element(i), "gen bus")
+        self.resolve_gen_rows(system)
         Sb = system.Sb
         Vb = net.base_kv[self.bus]
         Vn = np.where(self.p["Vn"] > 0, self.p["Vn"], Vb)

@@ -31,7 +31,6 @@ import numpy as np
 from ..blocks import Lag, Washout
 from ..component import Component, scatter_add
 from ..errors import DataError
-from ..network import GEN_BUS, GEN_STATUS
 from ..params import Param
 
 
@@ -109,16 +108,8 @@ class PVD1(Component):
 
     def setup(self, system):
         super().setup(system)
-        net = system.network
         p = self.p
-        self.gen = np.zeros(self.n, int)
-        self.bus = np.zeros(self.n, int)
-        for i, lk in enumerate(self.links):
-            g = lk["gen"]
-            if not (isinstance(g, (int, np.integer)) and 0 <= g < net.gen.shape[0]) or net.gen[g, GEN_STATUS] <= 0:
-                raise DataError(self.element(i), "gen", g, "give an in-service 0-based gen-table row")
-            self.gen[i] = g
-            self.bus[i] = net.index_of(int(net.gen[g, GEN_BUS]), self.element(i), "gen bus")
+        self.resolve_gen_rows(system)
         for f in ("gammap", "gammaq"):
             for g in set(self.gen.tolist()):
                 on = self.gen == g
