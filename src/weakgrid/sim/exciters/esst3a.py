@@ -29,7 +29,7 @@ from ..params import Param
 
 
 def source_voltage(ctx, mach, bus, KPC, KI, XL):
-    """|KPC*Vt + j(KI + KPC*XL)*It| of machines ``mach`` at buses ``bus`` (system-base pu)."""
+    """``|KPC*Vt + j(KI + KPC*XL)*It|`` of machines ``mach`` at buses ``bus`` (system-base pu)."""
     s = ctx.sig
     V = ctx.V[..., bus]
     S = s["Pe"][..., mach] + 1j * s["Qe"][..., mach]
