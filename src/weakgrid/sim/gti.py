@@ -14,9 +14,14 @@ Phase control, ``mode="energy"`` (the paper's eq. (4)-(5))::
 
 ``mode="pq"`` (conventional baseline): PID loops (derivative filtered by ``Td``)::
 
-    phi_s  = phi_s0 + PID_P(P_ref - Pm),   P_ref = Pin/(1+chi)
+    phi_s  = phi_s0 + PID_P(P_ref - Pm),   P_ref = Pin/(1+chi) + PI_dc(Vc - Vc0)
     Vs_ref = Vs0    + PID_Q(Q_ref - Qm),   Q_ref = initial Q
     Td dPm/dt = P_ac - Pm,  Td dQm/dt = Q - Qm   (measurement filters)
+
+The outer dc-voltage loop ``PI_dc = kp_v + ki_v/s`` is how a real PQ-controlled GTI
+keeps its dc link at its set-point (a surplus of dc energy raises the power
+reference); with ``kp_v = ki_v = 0`` (the default) ``P_ref`` is fixed and the dc link
+is left to drift after a disturbance.
 
 The GTI replaces row ``gen`` of the gen table; ``Pin``, ``Vs0`` and ``phi_s0``
 follow from the power flow. Energy base: ``C*Vc^2/2`` in pu·s on ``Sb``.
@@ -52,8 +57,11 @@ class GTI(Component):
         Param("ki_q", 0.001, "1/s", "Q-loop integral gain (pq mode)", ""),
         Param("kd_q", 0.001, "s", "Q-loop derivative gain (pq mode)", ""),
         Param("Td", 0.01, "s", "derivative filter time constant", "pos"),
+        Param("kp_v", 0.0, "pu/pu", "dc-voltage loop proportional gain (pq mode): P_ref per "
+              "pu of Vc - Vc0", "nonneg"),
+        Param("ki_v", 0.0, "pu/(pu·s)", "dc-voltage loop integral gain (pq mode)", "nonneg"),
     )
-    states = ("Vc", "phi_hat", "Pm", "Qm", "xi_p", "xd_p", "xi_q", "xd_q")
+    states = ("Vc", "phi_hat", "Pm", "Qm", "xi_p", "xd_p", "xi_q", "xd_q", "xi_v")
     outputs = ("Vs", "ks", "phi_s", "P_ac", "Q", "Pe", "upsilon", "P_series", "dVc")
     units = {"P_ac": "power", "Q": "power", "Pe": "power", "P_series": "power", "phi_s": "angle",
              "phi_hat": "angle"}
@@ -122,7 +130,7 @@ class GTI(Component):
             raise DataError(self.element(i), "ks_max", p["ks_max"][i],
                             f"initial modulation index Vs0/Vc0 = {ks0[i]:.4g} exceeds it; raise ks_max or Vc0")
         x[self.sl(0)] = p["Vc0"]
-        for k in range(1, 8):
+        for k in range(1, 9):
             x[self.sl(k)] = 0.0
         x[self.sl(2)] = self.Pac0
         x[self.sl(3)] = self.Q0
@@ -138,7 +146,8 @@ class GTI(Component):
         Vs_ref = self.Vs0
         if self._any_pq:
             # PID on filtered measurements (states only: no algebraic loop)
-            eP = self.Pin / (1 + p["chi"]) - x[..., sl[2]]
+            Pref = self.Pin / (1 + p["chi"]) + p["kp_v"] * (Vc - p["Vc0"]) + x[..., sl[8]]
+            eP = Pref - x[..., sl[2]]
             eQ = self.Q0 - x[..., sl[3]]
             uP = self.pidP.output(x[..., sl[4]], x[..., sl[5]], eP)
             uQ = self.pidQ.output(x[..., sl[6]], x[..., sl[7]], eQ)
@@ -176,6 +185,7 @@ class GTI(Component):
             diq, ddq = self.pidQ.deriv(x[..., sl[6]], x[..., sl[7]], self._eQ)
             f[..., sl[4]], f[..., sl[5]] = np.where(q, dip, 0.0), np.where(q, ddp, 0.0)
             f[..., sl[6]], f[..., sl[7]] = np.where(q, diq, 0.0), np.where(q, ddq, 0.0)
+            f[..., sl[8]] = np.where(q, p["ki_v"] * (Vc - p["Vc0"]), 0.0)
         else:   # all energy mode: the pq states are constant (their f stays 0)
             f[..., sl[1]] = ups
         o = ctx.out

@@ -1,0 +1,133 @@
+"""Maps of a swept quantity over two study fields (e.g. UPQC rating × fault duration).
+
+A map is drawn from the result table of a sweep (:func:`weakgrid.sweep.run_sweep`):
+one panel per value of a facet field (e.g. the load level), the two swept fields
+on the axes as evenly spaced categories (their values as tick labels), each
+cell coloured by the quantity and labelled with its value, and with the claim's
+verdict in that cell as a mark: ``✓`` holds, ``✗`` does not, ``=`` tie within the
+numerical uncertainty, ``!`` a run failed. The setting the paper (or the shipped
+study) uses is outlined.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["plot_map", "VERDICT_MARKS"]
+
+VERDICT_MARKS = {"holds": "✓", "not": "✗", "tie": "=", "failed": "!", None: ""}
+
+
+def _fmt(v):
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "–"
+    a = abs(v)
+    if a != 0 and (a < 1e-2 or a >= 1e4):
+        return f"{v:.1e}"
+    return f"{v:.3g}"
+
+
+def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
+             facet: str | None = None, mark=None, title: str = "", value_label: str = "",
+             x_label: str = "", y_label: str = "", cmap: str = "RdBu_r", center=None,
+             mark_label: str = "the paper's setting", path=None):
+    """Draw (and optionally save) a map of ``value`` over fields ``x`` and ``y``.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        One row per run; columns ``x``, ``y``, ``value`` (and ``verdict``, ``facet``).
+        Several rows on one cell are averaged (the verdict of the first is shown).
+    x, y : str
+        Columns of the swept fields (e.g. ``"upqc.rating"``, ``"fault.duration"``).
+    value : str
+        Column of the measured quantity (e.g. the HJI/(29) cost ratio).
+    verdict : str, optional
+        Column holding ``"holds"``, ``"not"``, ``"tie"`` or ``"failed"`` per cell.
+    facet : str, optional
+        Column whose values get one panel each (e.g. ``"load"``).
+    mark : tuple, optional
+        ``(x_value, y_value)`` of the paper's setting, outlined in every panel
+        (described in the legend by ``mark_label``).
+    center : float, optional
+        Value at the middle of the colour scale (e.g. 1 for a ratio, 0 for a
+        difference); default: no centring.
+    path : str or Path, optional
+        Where to save the figure (PNG or SVG, atomically).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import TwoSlopeNorm
+
+    facets = [None] if facet is None else list(dict.fromkeys(table[facet].tolist()))
+    xs = sorted(dict.fromkeys(table[x].tolist()))
+    ys = sorted(dict.fromkeys(table[y].tolist()))
+    vals = table[value].astype(float).to_numpy()
+    finite = vals[np.isfinite(vals)]
+    vmin, vmax = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+    if vmin == vmax:
+        vmin, vmax = vmin - 0.5, vmax + 0.5
+    norm = None
+    if center is not None and vmin < center < vmax:
+        norm = TwoSlopeNorm(vcenter=center, vmin=vmin, vmax=vmax)
+    fig, axes = plt.subplots(1, len(facets), figsize=(1.2 + 0.9 * len(xs) * len(facets) + 1.2,
+                                                       1.4 + 0.55 * len(ys)),
+                             squeeze=False, constrained_layout=True)
+    im = None
+    for ax, fv in zip(axes[0], facets):
+        sub = table if fv is None else table[table[facet] == fv]
+        Z = np.full((len(ys), len(xs)), np.nan)
+        V = [["" for _ in xs] for _ in ys]
+        for (xv, yv), grp in sub.groupby([x, y], sort=False):
+            i, j = ys.index(yv), xs.index(xv)
+            Z[i, j] = float(np.nanmean(grp[value].astype(float))) if \
+                np.isfinite(grp[value].astype(float)).any() else np.nan
+            if verdict is not None:
+                V[i][j] = VERDICT_MARKS.get(grp[verdict].iloc[0], "?")
+        im = ax.pcolormesh(np.arange(len(xs) + 1) - 0.5, np.arange(len(ys) + 1) - 0.5,
+                           np.ma.masked_invalid(Z), cmap=cmap, norm=norm,
+                           vmin=None if norm else vmin, vmax=None if norm else vmax,
+                           shading="flat", edgecolors="white", linewidth=0.5)
+        for i in range(len(ys)):
+            for j in range(len(xs)):
+                txt = _fmt(Z[i, j]) + (f"\n{V[i][j]}" if V[i][j] else "")
+                dark = False
+                if np.isfinite(Z[i, j]):
+                    r, g, b, _ = im.cmap(im.norm(Z[i, j]))
+                    dark = 0.299 * r + 0.587 * g + 0.114 * b < 0.5
+                ax.text(j, i, txt, ha="center", va="center", fontsize=8,
+                        color="white" if dark else "black")
+        if mark is not None and mark[0] in xs and mark[1] in ys:
+            j, i = xs.index(mark[0]), ys.index(mark[1])
+            ax.add_patch(plt.Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, lw=2.5,
+                                       edgecolor="black"))
+        ax.set_xticks(range(len(xs)), [_fmt(v) if isinstance(v, float) else str(v) for v in xs])
+        ax.set_yticks(range(len(ys)), [_fmt(v) if isinstance(v, float) else str(v) for v in ys])
+        ax.set_xlabel(x_label or x)
+        ax.set_ylabel(y_label or y)
+        if fv is not None:
+            ax.set_title(f"{facet} = {fv}", fontsize=10)
+    cb = fig.colorbar(im, ax=axes[0].tolist(), shrink=0.9)
+    cb.set_label(value_label or value)
+    legend = ""
+    if mark is not None:
+        legend += f"outlined: {mark_label}"
+    if verdict is not None:
+        legend += ("; " if legend else "") + ("✓ holds  ✗ does not  = tie (within the "
+                                              "numerical uncertainty)  ! a run failed")
+    if title or legend:
+        fig.suptitle("\n".join(t for t in (title, legend) if t), fontsize=10)
+    if path is not None:
+        from ..fileio import replace_atomic
+
+        fmt = str(path).rsplit(".", 1)[-1]
+        replace_atomic(path, lambda tmp: fig.savefig(tmp, format=fmt, dpi=120))
+    return fig

@@ -1,0 +1,17 @@
+"""Sweeps: many independent runs on ``dask.distributed``, cached and resumable.
+
+Knows nothing about power systems: a sweep is a list of inputs (a base input
+with some fields varied along axes, :mod:`weakgrid.sweep.axes`), a function
+that runs one input and returns its metrics, and a cache of finished runs keyed
+by a hash of their full input and the code (:mod:`weakgrid.sweep.cache`).
+:func:`run_sweep` runs them on a local cluster (one worker process per core) or
+an existing one, with a progress bar, and returns one table, a row per run.
+"""
+
+from .axes import Axis, Point, expand, get_path, set_path
+from .cache import ResultCache, canonical_json, code_fingerprint, run_key
+from .engine import SweepInterrupted, execute, results_table, run_sweep
+
+__all__ = ["Axis", "Point", "expand", "get_path", "set_path", "ResultCache", "canonical_json",
+           "code_fingerprint", "run_key", "SweepInterrupted", "execute", "results_table",
+           "run_sweep"]

@@ -1,0 +1,148 @@
+"""Sweep axes over the fields of a nested input (a study as a dict).
+
+A field is named by its dotted path, e.g. ``"upqc.rating"`` or
+``"scenarios.0.fault.duration"`` (an integer part indexes a list). Axes combine
+as a Cartesian product, or as listed points (every axis the same length,
+the k-th values taken together).
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import math
+from dataclasses import dataclass, field
+
+from ..game.errors import ParameterError
+
+__all__ = ["Axis", "Point", "expand", "get_path", "set_path"]
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One swept field.
+
+    Attributes
+    ----------
+    path : str
+        Dotted path of the field in the input, e.g. ``"upqc.rating"``.
+    values : tuple
+        The values it takes (numbers, strings or booleans).
+    """
+
+    path: str
+    values: tuple
+
+    def __post_init__(self):
+        if not isinstance(self.path, str) or not self.path or any(p == "" for p in
+                                                                 self.path.split(".")):
+            raise ParameterError("sweep.axes.path", self.path,
+                                 "give a dotted field path such as 'upqc.rating'")
+        vals = tuple(self.values) if isinstance(self.values, (list, tuple)) else None
+        if not vals:
+            raise ParameterError(f"sweep.axes['{self.path}'].values", self.values,
+                                 "give a non-empty list of values")
+        for v in vals:
+            if isinstance(v, float) and not math.isfinite(v):
+                raise ParameterError(f"sweep.axes['{self.path}'].values", v,
+                                     "every value must be finite")
+        object.__setattr__(self, "values", vals)
+
+
+@dataclass
+class Point:
+    """One run of a sweep: its axis values and its full input.
+
+    Attributes
+    ----------
+    params : dict
+        ``path -> value`` of the swept fields (the columns of the result table).
+    inputs : dict
+        The full input of the run (the base input with the swept fields set).
+    """
+
+    params: dict
+    inputs: dict = field(repr=False)
+
+
+def _parts(path):
+    return [int(p) if p.lstrip("-").isdigit() else p for p in path.split(".")]
+
+
+def get_path(obj, path: str):
+    """The value at dotted ``path`` of a nested dict/list ``obj``.
+
+    Raises
+    ------
+    ParameterError
+        If a part of the path does not exist (the message lists what does).
+    """
+    cur = obj
+    done = []
+    for p in _parts(path):
+        if isinstance(cur, dict) and p in cur:
+            cur = cur[p]
+        elif isinstance(cur, list) and isinstance(p, int) and -len(cur) <= p < len(cur):
+            cur = cur[p]
+        else:
+            where = ".".join(map(str, done)) or "the input"
+            have = sorted(map(str, cur)) if isinstance(cur, dict) else \
+                (f"indices 0..{len(cur) - 1}" if isinstance(cur, list) else "a value")
+            raise ParameterError("sweep.axes.path", path,
+                                 f"'{p}' is not a field of {where} (it has: {have})")
+        done.append(p)
+    return cur
+
+
+def set_path(obj, path: str, value):
+    """Set the value at dotted ``path`` (the field must exist: a typo is an error)."""
+    parts = _parts(path)
+    parent = get_path(obj, ".".join(map(str, parts[:-1]))) if len(parts) > 1 else obj
+    get_path(obj, path)  # checks the leaf exists
+    parent[parts[-1]] = value
+
+
+def expand(base: dict, axes, mode: str = "product") -> list[Point]:
+    """The points of a sweep over ``base``.
+
+    Parameters
+    ----------
+    base : dict
+        The input every run starts from (not modified).
+    axes : list of Axis or dict
+        The swept fields; a dict maps path → list of values.
+    mode : {"product", "points"}
+        Cartesian product of the axes, or listed points (all axes equally long).
+
+    Returns
+    -------
+    list of Point
+        In a stable order (the first axis varies slowest).
+    """
+    if isinstance(axes, dict):
+        axes = [Axis(p, v) for p, v in axes.items()]
+    axes = list(axes)
+    if not axes:
+        raise ParameterError("sweep.axes", axes, "give at least one axis")
+    paths = [a.path for a in axes]
+    if len(set(paths)) != len(paths):
+        raise ParameterError("sweep.axes", paths, "each field may be swept by one axis only")
+    for a in axes:
+        get_path(base, a.path)
+    if mode == "product":
+        combos = list(itertools.product(*(a.values for a in axes)))
+    elif mode == "points":
+        n = {len(a.values) for a in axes}
+        if len(n) != 1:
+            raise ParameterError("sweep.mode", mode, "with mode = 'points' every axis needs the "
+                                 f"same number of values (got {[len(a.values) for a in axes]})")
+        combos = list(zip(*(a.values for a in axes)))
+    else:
+        raise ParameterError("sweep.mode", mode, "choose 'product' or 'points'")
+    out = []
+    for combo in combos:
+        inp = copy.deepcopy(base)
+        for p, v in zip(paths, combo):
+            set_path(inp, p, v)
+        out.append(Point(dict(zip(paths, combo)), inp))
+    return out

@@ -1,0 +1,241 @@
+"""Run the points of a sweep on ``dask.distributed`` with a result cache.
+
+Every point is one task. Tasks run on a :class:`distributed.LocalCluster` (one
+single-threaded worker process per core by default) or on an existing cluster
+given by its scheduler address. A finished run is written to the cache as soon
+as it arrives, so an interrupted sweep (Ctrl-C, SIGTERM) loses nothing and a
+repeated one runs nothing. A run that raises is a row with ``status = "failed"``
+and its cause, never the end of the sweep.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import math
+import os
+import signal
+import time
+import traceback
+from pathlib import Path
+
+import pandas as pd
+
+from .. import __version__
+from ..fileio import replace_atomic
+from ..game.errors import ParameterError, WeakgridError
+from .cache import ResultCache, run_key
+
+__all__ = ["run_sweep", "execute", "SweepInterrupted", "results_table"]
+
+
+class SweepInterrupted(WeakgridError, KeyboardInterrupt):
+    """The sweep was stopped (SIGINT/SIGTERM); finished runs are cached.
+
+    Attributes
+    ----------
+    done, total : int
+        Runs finished (cached) and runs in the sweep.
+    cache_dir : Path
+    """
+
+    def __init__(self, done, total, cache_dir):
+        self.done, self.total, self.cache_dir = done, total, Path(cache_dir)
+        super().__init__(f"interrupted: {done} of {total} runs finished and kept in "
+                         f"{cache_dir}; run the same command again to continue")
+
+
+def execute(run, inputs: dict, key: str) -> dict:
+    """Run one point (on a worker) and return its record; never raises for a failed run.
+
+    ``run(inputs)`` returns a dict of metrics, or ``(metrics, signals)`` with signals a
+    DataFrame. Metrics may carry ``status`` ("ok"/"failed") and ``failure`` (its cause)
+    when the run failed without raising (e.g. a simulation that lost synchronism).
+    """
+    t0 = time.perf_counter()
+    signals = None
+    try:
+        out = run(inputs)
+        if isinstance(out, tuple):
+            out, signals = out
+        metrics = dict(out)
+        status = str(metrics.pop("status", "ok"))
+        failure = str(metrics.pop("failure", "") or "")
+        kind = str(metrics.pop("failure_kind", "") or "")
+    except Exception as exc:  # a failing run is a row, whatever it raised
+        metrics, status = {}, "failed"
+        failure = f"{type(exc).__name__}: {exc}"
+        kind = type(exc).__name__
+        tb = traceback.format_exc(limit=-3)
+        metrics["traceback_tail"] = tb[-2000:]
+    wall = time.perf_counter() - t0
+    rec = {"key": key, "status": status, "failure": failure, "failure_kind": kind,
+           "wall_s": wall, "metrics": metrics, "weakgrid_version": __version__}
+    return {"record": rec, "signals": signals}
+
+
+def _store(cache, res):
+    rec = res["record"]
+    sig = res.get("signals")
+    cache.put(rec, signals=sig)
+    return cache.get(rec["key"])
+
+
+@contextlib.contextmanager
+def _sigterm_as_interrupt():
+    """Inside the block, SIGTERM raises KeyboardInterrupt (main thread only)."""
+    def handler(signum, frame):
+        raise KeyboardInterrupt
+
+    try:
+        old = signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # not the main thread
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
+
+
+@contextlib.contextmanager
+def _client(scheduler, workers):
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        client = Client(scheduler, timeout="20s")
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    n = workers or os.cpu_count() or 1
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                           dashboard_address=None, silence_logs=logging.ERROR)
+    client = Client(cluster)
+    try:
+        yield client
+    finally:
+        client.close()
+        cluster.close()
+
+
+def _progress(total, initial, enabled, desc):
+    from tqdm.auto import tqdm
+
+    return tqdm(total=total, initial=initial, disable=not enabled, desc=desc, unit="run",
+                dynamic_ncols=True, mininterval=0.5)
+
+
+def results_table(points, records) -> pd.DataFrame:
+    """One row per point, in the sweep's order: run number, key, the swept fields,
+    status, failure cause, wall time, then every metric."""
+    rows = []
+    for i, (pt, rec) in enumerate(zip(points, records)):
+        row = {"run": i, "key": rec["key"]}
+        for k, v in pt.params.items():
+            row[k] = v if isinstance(v, (int, float, str, bool)) or v is None else str(v)
+        row["status"] = rec["status"]
+        row["failure"] = rec.get("failure", "")
+        row["wall_s"] = rec.get("wall_s", math.nan)
+        for k, v in (rec.get("metrics") or {}).items():
+            if k in row:
+                k = f"metric.{k}"
+            row[k] = math.nan if v is None else v
+        rows.append(row)
+    df = pd.DataFrame(rows)
+    for c in df.columns:  # text columns: missing is None (as Parquet reads it back)
+        if df[c].dtype == object:
+            df[c] = df[c].astype(object).where(df[c].notna(), None)
+    return df
+
+
+def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
+              workers: int | None = None, progress: bool = True, table_path=None,
+              desc: str = "sweep", log=None) -> pd.DataFrame:
+    """Run every point (skipping those already cached) and return the result table.
+
+    Parameters
+    ----------
+    points : list of weakgrid.sweep.axes.Point
+        What to run (``point.inputs`` is passed to ``run``).
+    run : callable
+        ``run(inputs) -> metrics`` or ``(metrics, signals)``; must be picklable (a
+        module-level function or a :func:`functools.partial` of one).
+    cache_dir : str or Path
+        Where finished runs are kept (created if missing).
+    scheduler : str, optional
+        Address of an existing Dask scheduler (``tcp://host:port``). Default: a
+        LocalCluster.
+    workers : int, optional
+        Worker processes of the LocalCluster (default: one per core). ``0`` runs the
+        points serially in this process (no Dask).
+    progress : bool
+        Show a progress bar (tqdm) on stderr.
+    table_path : str or Path, optional
+        Write the table as Parquet there (atomically).
+    log : callable, optional
+        Receives one-line messages (start, interruption).
+
+    Returns
+    -------
+    pandas.DataFrame
+        See :func:`results_table`. Columns ``status``/``failure`` tell failed runs.
+
+    Raises
+    ------
+    SweepInterrupted
+        On SIGINT/SIGTERM, after every finished run is cached.
+    """
+    if workers is not None and (not isinstance(workers, int) or workers < 0):
+        raise ParameterError("workers", workers, "give a whole number ≥ 0 (0 = serial)")
+    log = log or (lambda msg: None)
+    cache = ResultCache(cache_dir)
+    keys = [run_key(p.inputs, run) for p in points]
+    if len(set(keys)) != len(keys):
+        dup = len(keys) - len(set(keys))
+        log(f"note: {dup} point(s) have the same input as another and run once")
+    records: dict[str, dict] = {}
+    for k in keys:
+        rec = cache.get(k)
+        if rec is not None:
+            records[k] = rec
+    todo = [(p, k) for p, k in zip(points, keys) if k not in records]
+    todo_unique = list({k: (p, k) for p, k in todo}.values())
+    total = len(set(keys))
+    log(f"{desc}: {total} runs, {total - len(todo_unique)} already done, "
+        f"{len(todo_unique)} to run" + ("" if not todo_unique else
+                                         (" serially" if workers == 0 else
+                                          f" on {scheduler or 'a local cluster'}")))
+    bar = _progress(total, total - len(todo_unique), progress, desc)
+    try:
+        with _sigterm_as_interrupt():
+            if todo_unique and workers == 0:
+                for p, k in todo_unique:
+                    records[k] = _store(cache, execute(run, p.inputs, k))
+                    bar.update(1)
+            elif todo_unique:
+                from distributed import as_completed
+
+                with _client(scheduler, workers) as client:
+                    futs = [client.submit(execute, run, p.inputs, k, key=f"weakgrid-run-{k}",
+                                          pure=False) for p, k in todo_unique]
+                    try:
+                        for fut in as_completed(futs):
+                            res = fut.result()
+                            records[res["record"]["key"]] = _store(cache, res)
+                            bar.update(1)
+                    finally:
+                        for f in futs:
+                            if not f.done():
+                                f.cancel()
+    except KeyboardInterrupt:
+        bar.close()
+        exc = SweepInterrupted(len(records), total, cache.folder)
+        log(str(exc))
+        raise exc from None
+    bar.close()
+    table = results_table(points, [records[k] for k in keys])
+    if table_path is not None:
+        replace_atomic(table_path, lambda tmp: table.to_parquet(tmp, index=False))
+    return table

@@ -1,0 +1,168 @@
+"""The sweep engine: axes, cache keys, failures as rows, resume, Dask clusters."""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import cloudpickle
+import pandas as pd
+import pytest
+
+from weakgrid.game.errors import ParameterError
+from weakgrid.sweep import Axis, expand, get_path, run_key, run_sweep, set_path
+
+cloudpickle.register_pickle_by_value(sys.modules[__name__])
+
+BASE = {"upqc": {"rating": 0.15, "structure": "conventional"},
+        "scenarios": [{"fault": {"duration": 0.05, "x": 0.1}}], "load": "high"}
+
+
+def toy_run(inputs):
+    """A deterministic 'simulation': fails for a negative rating."""
+    r = inputs["upqc"]["rating"]
+    d = inputs["scenarios"][0]["fault"]["duration"]
+    if r < 0:
+        raise ValueError(f"rating {r} < 0")
+    if r == 0:
+        return {"status": "failed", "failure": "loss of synchronism at t = 1.2 s", "peak": math.nan}
+    return {"peak": r * d, "cost": math.sin(r) / (1 + d), "label": inputs["load"]}
+
+
+def _tab(df):
+    return df.drop(columns=["wall_s"]).reset_index(drop=True)
+
+
+def test_expand_product_and_points():
+    pts = expand(BASE, {"upqc.rating": [0.1, 0.3], "scenarios.0.fault.duration": [0.05, 0.1, 0.2]})
+    assert len(pts) == 6
+    assert pts[0].params == {"upqc.rating": 0.1, "scenarios.0.fault.duration": 0.05}
+    assert pts[-1].inputs["scenarios"][0]["fault"]["duration"] == 0.2
+    assert BASE["upqc"]["rating"] == 0.15  # the base is not modified
+    pts = expand(BASE, [Axis("upqc.rating", [0.1, 0.3]), Axis("load", ["high", "low"])],
+                 mode="points")
+    assert [p.params for p in pts] == [{"upqc.rating": 0.1, "load": "high"},
+                                       {"upqc.rating": 0.3, "load": "low"}]
+
+
+@pytest.mark.parametrize("axes, mode, word", [
+    ({"upqc.ratng": [0.1]}, "product", "ratng"),
+    ({"upqc.rating": []}, "product", "non-empty"),
+    ({"upqc.rating": [float("nan")]}, "product", "finite"),
+    ({"upqc.rating": [0.1], "load": ["a", "b"]}, "points", "same number"),
+    ({"upqc.rating": [0.1]}, "zip", "product"),
+    ({"scenarios.3.fault": [1]}, "product", "indices 0..0"),
+])
+def test_bad_axes_name_the_field(axes, mode, word):
+    with pytest.raises(ParameterError) as ei:
+        expand(BASE, axes, mode=mode)
+    assert word in str(ei.value)
+
+
+def test_paths():
+    d = {"a": {"b": [1, {"c": 2}]}}
+    assert get_path(d, "a.b.1.c") == 2
+    set_path(d, "a.b.0", 5)
+    assert d["a"]["b"][0] == 5
+
+
+def test_key_depends_on_input_and_function():
+    a = run_key({"x": 1.0, "y": [1, 2]}, toy_run)
+    assert a == run_key({"y": [1, 2], "x": 1.0}, toy_run)  # key order does not matter
+    assert a != run_key({"x": 1.0 + 1e-12, "y": [1, 2]}, toy_run)
+    assert a != run_key({"x": 1.0, "y": [1, 2]}, _tab)
+
+
+def test_serial_sweep_failures_are_rows_and_cache_is_reused(tmp_path):
+    pts = expand(BASE, {"upqc.rating": [-0.1, 0.0, 0.1, 0.3]})
+    t1 = run_sweep(pts, toy_run, cache_dir=tmp_path / "c", workers=0, progress=False,
+                   table_path=tmp_path / "t.parquet")
+    assert list(t1["status"]) == ["failed", "failed", "ok", "ok"]
+    assert "ValueError: rating -0.1 < 0" in t1["failure"][0]
+    assert "loss of synchronism" in t1["failure"][1]
+    assert t1["peak"][2] == pytest.approx(0.1 * 0.05)
+    assert math.isnan(t1["peak"][1])
+    pd.testing.assert_frame_equal(_tab(pd.read_parquet(tmp_path / "t.parquet")), _tab(t1))
+    # a repeated sweep runs nothing: the cached records (and their wall times) come back
+    mtimes = {p: p.stat().st_mtime_ns for p in (tmp_path / "c").glob("*.json")}
+    t2 = run_sweep(pts, toy_run, cache_dir=tmp_path / "c", workers=0, progress=False)
+    pd.testing.assert_frame_equal(t1, t2)
+    assert mtimes == {p: p.stat().st_mtime_ns for p in (tmp_path / "c").glob("*.json")}
+
+
+def test_local_cluster_and_scheduler_address_give_the_default_table(tmp_path):
+    from distributed import LocalCluster
+
+    pts = expand(BASE, {"upqc.rating": [-0.1, 0.1, 0.2], "scenarios.0.fault.duration": [0.05, 0.1]})
+    serial = run_sweep(pts, toy_run, cache_dir=tmp_path / "s", workers=0, progress=False)
+    local = run_sweep(pts, toy_run, cache_dir=tmp_path / "l", workers=2, progress=False)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster:
+        remote = run_sweep(pts, toy_run, cache_dir=tmp_path / "r", scheduler=cluster.scheduler_address,
+                           progress=False)
+    for t in (local, remote):
+        pd.testing.assert_frame_equal(_tab(t), _tab(serial))
+
+
+SCRIPT = textwrap.dedent('''
+    import sys, time, os
+    from weakgrid.sweep import expand, run_sweep, SweepInterrupted
+
+    LOG = sys.argv[2]
+
+    def slow(inputs):
+        time.sleep(0.5)
+        with open(LOG, "a") as fh:
+            fh.write(f"{inputs['i']}\\n")
+        return {"sq": inputs["i"] ** 2}
+
+    if __name__ == "__main__":
+        pts = expand({"i": 0}, {"i": list(range(12))})
+        try:
+            t = run_sweep(pts, slow, cache_dir=sys.argv[1], workers=2, progress=False,
+                          table_path=os.path.join(sys.argv[1], "table.parquet"), log=print)
+        except SweepInterrupted as exc:
+            print("STOPPED", exc.done, flush=True)
+            sys.exit(130)
+        print("DONE", len(t), flush=True)
+''')
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_interrupted_sweep_resumes_without_rerunning(tmp_path, sig):
+    script = tmp_path / "s.py"
+    script.write_text(SCRIPT)
+    cache, log = tmp_path / "cache", tmp_path / "log.txt"
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    p = subprocess.Popen([sys.executable, str(script), str(cache), str(log)], env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    t0 = time.time()
+    while len(list(cache.glob("*.json"))) < 3 and time.time() - t0 < 120:
+        time.sleep(0.05)
+    done_before = {p.stem for p in cache.glob("*.json")}
+    p.send_signal(sig)
+    out, err = p.communicate(timeout=120)
+    assert p.returncode == 130, (out, err)
+    assert "STOPPED" in out and "Traceback" not in err
+    done_at_stop = {p.stem for p in cache.glob("*.json")}
+    assert done_before <= done_at_stop and len(done_at_stop) < 12
+    ran_first = log.read_text().split()
+    p2 = subprocess.run([sys.executable, str(script), str(cache), str(log)], env=env,
+                        capture_output=True, text=True, timeout=180)
+    assert p2.returncode == 0, p2.stderr
+    assert "DONE 12" in p2.stdout
+    assert f"{len(done_at_stop)} already done" in p2.stdout
+    ran = log.read_text().split()
+    # each run finished before the stop ran once; only the others ran in the second sweep
+    ran_second = ran[len(ran_first):]
+    assert len(ran_second) == 12 - len(done_at_stop)
+    table = pd.read_parquet(cache / "table.parquet")
+    assert list(table["sq"]) == [i * i for i in range(12)]
+    assert (table["status"] == "ok").all()
