@@ -9,9 +9,11 @@ from .. import __version__
 from ..game.errors import WeakgridError
 from . import export, gamma, reproduce, simulate, train, verify
 from . import design, modes, run  # studies
+from . import sweep  # sweeps of studies
 
 SUBCOMMANDS = [train, gamma, verify, export, simulate, reproduce]
 SUBCOMMANDS += [design, run, modes]
+SUBCOMMANDS += [sweep]
 
 
 def build_parser() -> argparse.ArgumentParser:
