@@ -72,10 +72,6 @@ def validate_sweep(d: dict, study) -> None:
     if "design_load" in sw and sw["design_load"] not in study.loads:
         raise ParameterError("sweep.design_load", sw["design_load"],
                              f"choose one of {study.loads}")
-    for path, vals in (sw.get("dt_check") or {}).items():
-        if path not in sw.get("axes", {}) or not isinstance(vals, list):
-            raise ParameterError(f"sweep.dt_check.\"{path}\"", vals, "give a list of values of "
-                                 "a swept field (a path of [sweep.axes])")
     for where, axes in (("sweep.axes", sw.get("axes")),
                         ("sweep.quick.axes", (sw.get("quick") or {}).get("axes"))):
         if axes is None:
@@ -89,6 +85,10 @@ def validate_sweep(d: dict, study) -> None:
             get_path(d, path)   # the field exists (error names it)
             if not isinstance(vals, list) or not vals:
                 raise ParameterError(f"{where}.\"{path}\"", vals, "give a non-empty list")
+    for path, vals in (sw.get("dt_check") or {}).items():
+        if path not in sw.get("axes", {}) or not isinstance(vals, list):
+            raise ParameterError(f"sweep.dt_check.\"{path}\"", vals, "give a list of values of "
+                                 "a swept field (a path of [sweep.axes])")
 
 
 def _axes(sw: dict, quick: bool) -> dict:
