@@ -15,7 +15,8 @@ Ties: a comparison (ratio, wins) whose difference is smaller than the runs' nume
 uncertainty is a tie, not a win. The uncertainty of a metric is measured by running the
 ``[sweep.dt_check]`` points again at half the integration step: ``|m(T) − m(T/2)|`` relative
 to ``|m(T)|``, per load level and fault severity (the row of the map), applied to every cell
-of that row. A cell where a run failed is marked failed.
+of that row (a row without a check takes the largest measured at its load level). A cell where
+a run failed is marked failed.
 """
 
 from __future__ import annotations
@@ -65,6 +66,14 @@ def _rel_uncertainty(half, full, match, row_keys, metric, ctl):
     return out
 
 
+def _unc(by_row, rk):
+    """The row's measured uncertainty, else the largest measured in its facet (load level)."""
+    if rk in by_row:
+        return by_row[rk]
+    same = [v for k, v in by_row.items() if k[1:] == rk[1:]]
+    return max(same) if same else None
+
+
 def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
     """One row per map cell: the swept fields, ``value``, ``verdict`` (holds/not/tie/failed or
     None), ``uncertainty`` (relative, or NaN when not measured) and a short ``detail``."""
@@ -107,7 +116,7 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
             m = spec["metric"]
             va, vb = _num(ra.get(m)), _num(rb.get(m)) if rb is not None else math.nan
             val = va / vb if vb else math.nan
-            ua, ub = unc[(m, a)].get(rk), unc[(m, b)].get(rk)
+            ua, ub = _unc(unc[(m, a)], rk), _unc(unc[(m, b)], rk)
             if ua is not None and ub is not None:
                 u = (ua * abs(va) + ub * abs(vb)) / abs(vb) if vb else math.nan
             if fa or fb:
@@ -129,7 +138,7 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
                 res = []
                 for m in metrics:
                     va, vb = _num(ra.get(m)), _num(rb.get(m))
-                    ua, ub = unc[(m, a)].get(rk), unc[(m, b)].get(rk)
+                    ua, ub = _unc(unc[(m, a)], rk), _unc(unc[(m, b)], rk)
                     tol = (ua * abs(va) + ub * abs(vb)) if ua is not None and ub is not None \
                         else 0.0
                     if not (math.isfinite(va) and math.isfinite(vb)):
