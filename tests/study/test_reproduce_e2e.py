@@ -87,4 +87,4 @@ def test_report_is_self_contained_and_has_the_maps(output):
         assert col in table
     for st in paper_studies():
         for m in st.data["sweep"]["maps"]:
-            assert (output / "maps" / f"map-{st.name}-{m['claim']}.png").stat().st_size > 1000
+            assert (output / "maps" / f"map-{st.name}-{m.get('id', m['claim'])}.png").stat().st_size > 1000

@@ -232,9 +232,10 @@ def run_studies(studies, output, quick=False, log=print, title=None, progress=Tr
     claims = judge_all(claims_spec, {m["id"]: m for m in metrics})
     for c in claims:
         ms = [m for m in summaries if m["claim"] == c["id"]]
-        c["map_setting"] = "; ".join(m["at_setting"] for m in ms)
-        c["map_region"] = "; ".join(f"{m['region']} ({m['n_holds']} of {m['n_cells']} cells)"
-                                    for m in ms)
+        tag = (lambda m: f"[{m['id']}] ") if len(ms) > 1 else (lambda m: "")
+        c["map_setting"] = "; ".join(tag(m) + m["at_setting"] for m in ms)
+        c["map_region"] = "; ".join(f"{tag(m)}{m['region']} ({m['n_holds']} of "
+                                    f"{m['n_cells']} cells)" for m in ms)
     wall = time.perf_counter() - t0
     params = json.dumps({"studies": [{"source": st.source, "study": st.data} for st in studies],
                          "quick": quick}, indent=1, default=str)

@@ -4,6 +4,7 @@ Each ``[[sweep.maps]]`` entry of a study names a claim and how to measure it on 
 table (a row per run; :mod:`weakgrid.study.sweep`)::
 
     claim, title, label        the claim's id, the map's title and colour-bar label
+    id                         the map's own id when a claim has several maps [claim]
     kind = "ratio"             metric of controller a / of b; holds if ≤ holds_below
     kind = "value"             metric of controller a; holds if within holds_within = [lo, hi]
                                (no rule: the map only shows the quantity)
@@ -190,7 +191,7 @@ def draw_maps(study, table, folder, quick=False) -> list[dict]:
         cells = map_cells(table, spec, axes)
         x, y, facet = _axes_of(spec, axes)
         mark = (get_path(study.data, x), get_path(study.data, y)) if x and y else None
-        path = folder / f"map-{study.name}-{spec['claim']}.png"
+        path = folder / f"map-{study.name}-{spec.get('id', spec['claim'])}.png"
         if cells.empty:
             out.append({"spec": spec, "cells": cells, "path": None, "mark": mark,
                         "axes": (x, y, facet)})
@@ -222,8 +223,8 @@ def map_summaries(maps) -> list[dict]:
         spec, cells, mark = m["spec"], m["cells"], m["mark"]
         x, y, facet = m["axes"]
         if cells.empty:
-            out.append({"claim": spec["claim"], "title": spec.get("title", ""),
-                        "at_setting": "no runs", "region": "", "n_holds": 0, "n_cells": 0})
+            out.append({"claim": spec["claim"], "id": spec.get("id", spec["claim"]),
+                        "title": spec.get("title", ""), "at_setting": "no runs", "region": "", "n_holds": 0, "n_cells": 0})
             continue
         at, region = [], []
         facets = list(dict.fromkeys(cells[facet])) if facet else [None]
@@ -251,7 +252,8 @@ def map_summaries(maps) -> list[dict]:
                 parts.append(txt)
             region.append(pre + "; ".join(parts))
         nh = int((cells["verdict"] == "holds").sum())
-        out.append({"claim": spec["claim"], "title": spec.get("title", ""),
+        out.append({"claim": spec["claim"], "id": spec.get("id", spec["claim"]),
+                    "title": spec.get("title", ""),
                     "at_setting": "; ".join(at) or "the setting is not on the map",
                     "region": " | ".join(region) if region else "(quantity only, no rule)",
                     "n_holds": nh, "n_cells": int(cells["verdict"].notna().sum()),
