@@ -103,7 +103,10 @@ def sweep_points(study, quick: bool = False, scenarios=None, controllers=None):
     if not sw:
         raise ParameterError("sweep", None, f"study '{study.name}' has no [sweep] table; add "
                              "one (see weakgrid.study.sweep)")
-    base_study = copy.deepcopy(study.data)
+    # a run's full input: the study without what does not change a run (so that editing a
+    # map, a figure or a claim's wording keeps the cached runs)
+    base_study = {k: copy.deepcopy(v) for k, v in study.data.items()
+                  if k not in ("sweep", "figures", "claims")}
     t_end = (sw.get("quick") or {}).get("t_end") if quick else None
     t_end = t_end or sw.get("t_end")
     scs = scenarios or sw["scenarios"]
@@ -112,7 +115,7 @@ def sweep_points(study, quick: bool = False, scenarios=None, controllers=None):
         sc = get_path(base_study, f"scenarios.{sid}")
         ctls = controllers or sw.get("controllers") or sc["controllers"]
         for c in ctls:
-            if c not in sc["controllers"] and c not in study.controllers:
+            if c not in study.controllers:
                 raise ParameterError("sweep.controllers", c, "not a controller of the study")
         base = {"study": base_study, "scenario": sid, "controller": ctls[0],
                 "design_load": sw.get("design_load"), "t_end": t_end,
