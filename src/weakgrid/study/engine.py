@@ -147,7 +147,7 @@ def run_studies(studies, output, quick=False, log=print, title=None, progress=Tr
     plan = []   # (study, [Run], training keys)
     for st in studies:
         runs = [Run.of(st, sc, c) for sc, c in st.runs(quick)]
-        keys = sorted({(r.load, r.upqc) for r in runs if controller_kind(st, r.controller) == "hji"})
+        keys = sorted({r.design_key for r in runs if controller_kind(st, r.controller) == "hji"})
         plan.append((st, runs, keys))
     total = sum(len(r) + len(k) for _, r, k in plan)
     bar = _progress(total, progress)
@@ -190,7 +190,7 @@ def run_studies(studies, output, quick=False, log=print, title=None, progress=Tr
         client = None if serial else stack.enter_context(open_client(scheduler, workers))
         if client is not None:
             futs = {client.submit(_run_task, st, run, {k: v for k, v in tr.items()
-                                                       if k == (run.load, run.upqc)},
+                                                       if k == run.design_key},
                                   pure=False): run for st, run, tr in all_runs}
             from distributed import as_completed
 

@@ -35,12 +35,18 @@ class Run:
     t_end: float
     events: tuple
     bypass: tuple
+    design_load: str | None = None   # load the controllers are designed at (None: own load)
 
     @classmethod
     def of(cls, study, sc: dict, controller: str) -> "Run":
         return cls(f"{sc['id']}-{controller}", study.name, sc["id"], sc["load"], sc["upqc"],
                    controller, float(sc["t_end"]), tuple(dict(e) for e in sc["events"]),
-                   tuple(tuple(b) for b in sc["bypass"]))
+                   tuple(tuple(b) for b in sc["bypass"]), sc.get("design_load"))
+
+    @property
+    def design_key(self):
+        """``(design load, UPQC structure)``: the operating point its controllers are for."""
+        return (self.design_load or self.load, self.upqc)
 
     def to_dict(self):
         d = asdict(self)
@@ -148,7 +154,7 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
         The design model (10) at ``design_load`` if already derived (a sweep caches it).
     """
     setup = build_setup(study, run.load, run.upqc, controller_variant(study, run.controller))
-    dload = design_load or run.load
+    dload = design_load or run.design_load or run.load
     if design is None:
         design = setup.design if dload == run.load else \
             build_setup(study, dload, run.upqc).design

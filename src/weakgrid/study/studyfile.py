@@ -17,7 +17,8 @@ Tables (defaults in brackets)::
     [design]      T, settings (a preset giving Q, R, P, γ, Ω, mesh, basis, initial policy)
                   [cost], [mesh], [basis], [initial_policy], [solver] (override the preset)
     [controllers] compare [["hji", "lqr", "pss-only"]], [controllers.NAME] options
-    [[scenarios]] id, load, upqc, t_end, controllers, events, bypass, quick
+    [[scenarios]] id, load, upqc, t_end, controllers, events, bypass, quick,
+                  design_load [the scenario's load: the controllers designed there]
     [report]      speed_of [the controlled SG, else the first generator; "" for none], notes
     [[figures]]   id, title, panels, runs = [[run id, label]]  [one figure per scenario]
     [[claims]]    id, case, paper, rule, judge (weakgrid.study.claims.RULES), parameters
@@ -337,7 +338,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
     for i, sc in enumerate(scs):
         w = f"scenarios.{i}"
         _keys(sc, {"id", "load", "upqc", "t_end", "controllers", "events", "bypass", "quick",
-                   "description"}, w)
+                   "description", "design_load"}, w)
         sid = _need(sc, "id", w, str)
         if sid in seen:
             raise ParameterError(f"{w}.id", sid, "scenario ids must be unique")
@@ -347,6 +348,9 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         if sc["load"] not in loads:
             raise ParameterError(f"{w}.load", sc["load"], f"choose one of {loads}")
         sc["upqc"] = _choice(sc, "upqc", w, STRUCTURES, up["structure"])
+        if "design_load" in sc and sc["design_load"] not in loads:
+            raise ParameterError(f"{w}.design_load", sc["design_load"], f"choose one of {loads} "
+                                 "(the load the controllers are designed at)")
         sc["t_end"] = _num(sc, "t_end", w, positive=True)
         sc.setdefault("controllers", list(ct["compare"]))
         for c in sc["controllers"]:
