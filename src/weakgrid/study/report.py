@@ -24,7 +24,12 @@ COLUMNS = [
     ("running_cost_18", "running cost (18) [–]"), ("vu_peak_pu", "|Vu| peak [pu]"),
     ("vu_rms_pu", "|Vu| rms [pu]"), ("vu_rating_reached", "rating reached"),
     ("p_series_peak_mw", "P_series peak [MW]"),
-    ("p_series_peak_pct_line", "P_series peak [% line]"), ("failed", "failed"),
+    ("p_series_peak_pct_line", "P_series peak [% line]"),
+    ("design_load", "controllers designed at (load)"),
+    ("clip_fraction", "post-fault samples clipped by the rating [–]"),
+    ("u_demanded_peak_pu", "demanded |u| peak [pu]"), ("u_applied_peak_pu", "applied |u| peak [pu]"),
+    ("omega_reach", "reach of Ω (> 1: outside) [–]"), ("extrapolation", "extrapolation"),
+    ("vdc_final_dev_pu", "Vdc at the end − Vc0 [pu]"), ("failed", "failed"),
     ("wall_s", "wall time [s]"),
 ]
 
