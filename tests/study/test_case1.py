@@ -232,3 +232,25 @@ def test_fault_with_idle_upqc_is_survived_at_high_load():
     assert np.max(np.abs(w - 1.0)) > 5e-3 and abs(w[late].mean() - 1.0) < 5e-4
     assert np.ptp(ph[late]) < 0.85 * np.ptp(ph[early])
     assert np.ptp(w[late]) < np.ptp(w[early])
+
+
+def test_pq_baseline_dc_loop_returns_the_dc_link_to_its_set_point():
+    """The case-1 study's PQ baseline regulates its dc link (kp_v, ki_v of the study file):
+    after the shipped fault the dc-link voltage comes back to Vc0; without the loop it does
+    not (the artifact the loop removes)."""
+    from weakgrid.study.studyfile import load_study
+
+    st = load_study(NAME)
+    gti = st.data["dynamics"]["gti"][0]
+    assert gti["kp_v"] > 0 and gti["ki_v"] > 0
+    out = {}
+    for label, study in (("loop", st), ("free", st.with_values(**{"dynamics.gti.0.kp_v": 0.0,
+                                                                  "dynamics.gti.0.ki_v": 0.0}))):
+        from weakgrid.study.build import build_setup
+
+        cb = build_setup(study, "high", "conventional", "pq")
+        r = simulate(cb.system, 6.0, dt=2e-3, events=[Fault(cb.bus(3), 0.2, 0.25, xf=0.1)])
+        assert r.ok
+        out[label] = abs(r[cb.signals["dc_voltage"]][-1] - gti["Vc0"])
+    assert out["loop"] < 5e-3
+    assert out["free"] > 5 * out["loop"]

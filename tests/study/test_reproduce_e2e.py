@@ -64,7 +64,7 @@ def test_table_holds_every_metric_for_every_run(output):
 
 def test_report_has_a_verdict_per_claim(output):
     claims = json.loads((output / "claims.json").read_text())["claims"]
-    assert len(claims) == 8
+    assert len(claims) == sum(len(st.data["claims"]) for st in paper_studies()) == 10
     assert all(c["verdict"] in ("reproduced", "partly", "not", "not run") for c in claims)
     html = (output / "report.html").read_text()
     assert all(c["id"] in html for c in claims)
@@ -73,3 +73,18 @@ def test_report_has_a_verdict_per_claim(output):
     assert {d["case"] for d in designs} == {"case1-weak-grid", "case2-lv-microgrid"}
     for d in designs:
         assert d["mode_check"]["ok"], d["modes"]     # within 5 % on the paper's grids
+
+
+def test_report_is_self_contained_and_has_the_maps(output):
+    html = (output / "report.html").read_text()
+    refs = re.findall(r"""(?:src|href)\s*=\s*['"]([^'"]*)['"]""", html)
+    assert refs and all(r.startswith("data:") for r in refs)      # no file outside the page
+    assert "Where the claims hold" in html and "Protocol" in html
+    table = pd.read_parquet(output / "sweep-quick.parquet")
+    assert set(table["scenario"]) == {"c1-high-conv", "c2-high-f100"}
+    for col in ("clip_fraction", "u_demanded_peak_pu", "omega_reach", "status", "failure",
+                "wall_s", "upqc.rating"):
+        assert col in table
+    for st in paper_studies():
+        for m in st.data["sweep"]["maps"]:
+            assert (output / "maps" / f"map-{st.name}-{m.get('id', m['claim'])}.png").stat().st_size > 1000

@@ -27,9 +27,11 @@ import traceback
 from .. import __version__
 from . import export, gamma, reproduce, simulate, train, verify
 from . import design, modes, run  # studies
+from . import sweep  # sweeps of studies
 
 SUBCOMMANDS = [train, gamma, verify, export, simulate, reproduce]
 SUBCOMMANDS += [design, run, modes]
+SUBCOMMANDS += [sweep]
 
 EXIT_OK, EXIT_INPUT, EXIT_RUN, EXIT_BUG, EXIT_INTERRUPT = 0, 2, 3, 4, 130
 

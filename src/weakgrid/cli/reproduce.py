@@ -23,6 +23,11 @@ def add_parser(sub):
                    help="output folder")
     p.add_argument("--quick", action="store_true",
                    help="shorter runs and the essential subset of scenarios")
+    p.add_argument("--workers", type=int, default=None,
+                   help="worker processes of the local Dask cluster that runs the simulations "
+                        "(default: one per core; 0 = serially in this process)")
+    p.add_argument("--scheduler", default=None,
+                   help="address of an existing Dask scheduler (tcp://host:port)")
     p.set_defaults(func=run)
     return p
 
@@ -31,7 +36,8 @@ def run(args) -> int:
     """Run ``weakgrid reproduce`` with the parsed ``args``; return the exit status."""
     from ..study.reproduce import reproduce
 
-    summary = reproduce(args.output, quick=args.quick)
+    summary = reproduce(args.output, quick=args.quick, scheduler=args.scheduler,
+                        workers=args.workers)
     width = max((len(c["id"]) for c in summary["claims"]), default=0)
     print("\nclaims of the paper:")
     for c in summary["claims"]:

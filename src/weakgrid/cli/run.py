@@ -23,6 +23,11 @@ def add_parser(sub):
     p.add_argument("--quick", action="store_true",
                    help="each scenario's quick settings (shorter runs, fewer controllers)")
     p.add_argument("--list", action="store_true", help="list the shipped studies")
+    p.add_argument("--workers", type=int, default=None,
+                   help="worker processes of the local Dask cluster that runs the simulations "
+                        "(default: one per core; 0 = serially in this process)")
+    p.add_argument("--scheduler", default=None,
+                   help="address of an existing Dask scheduler (tcp://host:port)")
     p.set_defaults(func=run)
     return p
 
@@ -40,7 +45,8 @@ def run(args) -> int:
 
     st = load_study(args.study)
     out = args.output or Path(f"{st.name}-output")
-    summary = run_studies([st], out, quick=args.quick, title=st.data["study"]["title"] or st.name)
+    summary = run_studies([st], out, quick=args.quick, title=st.data["study"]["title"] or st.name,
+                          scheduler=args.scheduler, workers=args.workers)
     for d in summary["designs"]:
         print(f"  design {d['load']} {d['upqc']}: a = {d['a']}, V̄r = {d['Vr_bar']}, "
               f"ϕs0 = {d['phi_s0']}; modes {d['modes']}")

@@ -15,6 +15,7 @@ Every file is written atomically (:mod:`weakgrid.fileio`).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import time
 from pathlib import Path
@@ -31,11 +32,42 @@ from .claims import judge_all
 from .controllers import controller_kind, train_hji
 from .figures import figure_specs, write_figures
 from .report import write_html, write_tables
+from ..sweep import open_client, run_sweep
 from .runner import Run, RunRecord, run_scenario
+from .sweep import run_point, sweep_points
+from .sweep_maps import draw_maps, map_summaries
 
 __all__ = ["run_studies", "mode_check", "MODE_TOLERANCE"]
 
-MODE_TOLERANCE = 0.05   # design-model mode vs the full grid's mode: relative frequency mismatch
+MODE_TOLERANCE = 0.05
+PROTOCOL = [
+    "Maps: each claim's measured quantity and verdict over the UPQC rating × the fault "
+    "severity (fault duration) at both load levels, from the study's [sweep]; the shipped "
+    "(paper's) setting is outlined. The claim table gives the verdict at the shipped setting "
+    "(the regular runs) and, from the maps, the value there and the region where it holds.",
+    "Low load (paper's protocol): in the maps the controllers are designed at HIGH load and "
+    "applied at both loads ([sweep] design_load = \"high\"); the regular runs (c1-low-*, "
+    "c2-low-*) keep the per-load redesign as an extra row.",
+    "Rating: per run, clip_fraction = fraction of the post-fault controller samples at which "
+    "the demanded |u| exceeds the UPQC rating (u is then scaled down to it); the demanded "
+    "(u_demanded_peak_pu) and applied (u_applied_peak_pu) peaks and control costs are both "
+    "reported.",
+    "Training region Ω: omega_reach = max over samples and states of x_i / (Ω's bound on "
+    "that side); > 1 means the controller evaluates its value function outside the region it "
+    "was trained on (extrapolation = true).",
+    "C2-voltage is judged on the DEMANDED series voltage: the applied one cannot exceed the "
+    "rating, which equals the claim's threshold, so judging it would be a tautology.",
+    "Ties: the numerical uncertainty of a metric is |m(T) − m(T/2)| / |m(T)|, measured by "
+    "running the [sweep.dt_check] points again at half the integration step (per load and "
+    "fault severity, applied to every rating of that row); a difference smaller than it is "
+    "a tie (=), not a win. Not measured in --quick (no ties there).",
+    "PQ baseline: the GTI's dc link is regulated by an outer dc-voltage PI loop setting P_ref "
+    "(kp_v, ki_v in the case-1 study file), as a real PQ-controlled GTI does; without it the "
+    "dc link settled at 1.11 pu and every dc-link comparison against PQ was an artifact.",
+    "Figs. 10 and 13: J(x(t)) of (30) of the trained HJI controller along each run, beside "
+    "the accumulated running cost of the discrete-time game (18) with and without the "
+    "−γ²w'Pw term (w the worst-case disturbance at x).",
+]   # design-model mode vs the full grid's mode: relative frequency mismatch
 
 
 def _progress(total, enabled=True):
@@ -99,10 +131,20 @@ def _design_notes(study, setup, check):
     return notes
 
 
-def run_studies(studies, output, quick=False, log=print, title=None, progress=True) -> dict:
+def _run_task(study, run, trained):
+    """One (scenario, controller) on a worker: the record without the study object."""
+    return run_scenario(study, run, trained)
+
+
+def run_studies(studies, output, quick=False, log=print, title=None, progress=True,
+                scheduler=None, workers=None, maps=True) -> dict:
     """Run every (scenario, controller) of ``studies`` and write everything to ``output``.
 
-    Returns a summary dict (claims, metrics, figures, report, designs).
+    The runs (and the sweeps of the studies that have a ``[sweep]`` table, drawn as maps
+    when ``maps``) go to one Dask cluster: a local one with ``workers`` processes (default
+    one per core), or the one at ``scheduler``; ``workers = 0`` runs everything serially here.
+
+    Returns a summary dict (claims, metrics, figures, report, designs, maps).
     """
     out = Path(output)
     runs_dir = out / "runs"
@@ -111,7 +153,7 @@ def run_studies(studies, output, quick=False, log=print, title=None, progress=Tr
     plan = []   # (study, [Run], training keys)
     for st in studies:
         runs = [Run.of(st, sc, c) for sc, c in st.runs(quick)]
-        keys = sorted({(r.load, r.upqc) for r in runs if controller_kind(st, r.controller) == "hji"})
+        keys = sorted({r.design_key for r in runs if controller_kind(st, r.controller) == "hji"})
         plan.append((st, runs, keys))
     total = sum(len(r) + len(k) for _, r, k in plan)
     # a used folder: runs this plan does not make are stale; finished runs with the same
@@ -122,6 +164,7 @@ def run_studies(studies, output, quick=False, log=print, title=None, progress=Tr
     n_kept = 0
     bar = _progress(total, progress)
     designs, notes, metrics, records, claims_spec, fig_specs = [], {}, [], {}, [], []
+    all_runs = []   # (study, Run, trained controllers)
     for st, runs, keys in plan:
         trained = {}
         case_notes = list(st.data["study"]["notes"]) + list(st.data["report"]["notes"])
@@ -156,33 +199,81 @@ def run_studies(studies, output, quick=False, log=print, title=None, progress=Tr
             bar.update(1)
         notes[st.name] = case_notes
         for run in runs:
-            bar.set_postfix_str(run.id)
-            hji = trained.get((run.load, run.upqc))
+            hji = trained.get(run.design_key)
             rkey = inputs_key(study=st.data, run=run.to_dict(),
                               controller=hji.problem.get("inputs_key") if hji else None)
-            rec = load_run(runs_dir, run, rkey, RunRecord)
-            if rec is None:
-                rec = run_scenario(st, run, trained)
-                save_run(rec, runs_dir, rkey)
-            else:
-                n_kept += 1
-            records[run.id] = rec
-            metrics.append(rec.metrics)
-            bar.update(1)
+            all_runs.append((st, run, trained, rkey))
         claims_spec += st.data["claims"]
         fig_specs += figure_specs(st, quick)
-    bar.close()
-    if n_kept:
-        log(f"kept {n_kept} finished result(s) of an earlier run with the same inputs")
+    # finished runs with the same inputs (an earlier, maybe interrupted, run) are loaded
+    todo = []
+    for st, run, trained, rkey in all_runs:
+        rec = load_run(runs_dir, run, rkey, RunRecord)
+        if rec is None:
+            todo.append((st, run, trained, rkey))
+        else:
+            records[run.id] = rec
+            n_kept += 1
+            bar.update(1)
+    swept = [st for st in studies if maps and st.data.get("sweep")]
+    n_tasks = len(todo) + sum(len(sweep_points(st, quick)) for st in swept)
+    serial = workers == 0 or (scheduler is None and n_tasks <= 3)
+    sweep_table = None
+    with contextlib.ExitStack() as stack:
+        client = None if serial or not n_tasks else \
+            stack.enter_context(open_client(scheduler, workers))
+        if client is not None and todo:
+            from distributed import as_completed
+
+            futs = {client.submit(_run_task, st, run, {k: v for k, v in tr.items()
+                                                       if k == run.design_key},
+                                  pure=False): (run, rkey) for st, run, tr, rkey in todo}
+            for fut in as_completed(list(futs)):
+                run, rkey = futs[fut]
+                records[run.id] = rec = fut.result()
+                save_run(rec, runs_dir, rkey)    # kept as soon as it is finished
+                bar.set_postfix_str(run.id)
+                bar.update(1)
+        else:
+            for st, run, trained, rkey in todo:
+                bar.set_postfix_str(run.id)
+                records[run.id] = rec = run_scenario(st, run, trained)
+                save_run(rec, runs_dir, rkey)
+                bar.update(1)
+        metrics = [records[run.id].metrics for _, run, _, _ in all_runs]
+        bar.close()
+        if n_kept:
+            log(f"kept {n_kept} finished result(s) of an earlier run with the same inputs")
+        if swept:
+            pts = [p for st in swept for p in sweep_points(st, quick)]
+            sweep_table = run_sweep(pts, run_point, cache_dir=out / "sweep-cache",
+                                    workers=0 if serial else None, client=client,
+                                    progress=progress, log=log,
+                                    table_path=out / f"sweep{'-quick' if quick else ''}.parquet",
+                                    desc="maps")
+    map_list = []
+    for st in swept:
+        sub = sweep_table[sweep_table["scenario"].isin(st.data["sweep"]["scenarios"])]
+        sub = sub.dropna(axis=1, how="all")
+        map_list += [dict(m, study=st.name) for m in draw_maps(st, sub, out / "maps", quick)]
+    summaries = map_summaries(map_list)
     figs = write_figures(records, out / "figures", fig_specs)
     csv, md = write_tables(metrics, out)
     claims = judge_all(claims_spec, {m["id"]: m for m in metrics})
+    for c in claims:
+        ms = [m for m in summaries if m["claim"] == c["id"]]
+        tag = (lambda m: f"[{m['id']}] ") if len(ms) > 1 else (lambda m: "")
+        c["map_setting"] = "; ".join(tag(m) + m["at_setting"] for m in ms)
+        c["map_region"] = "; ".join(f"{tag(m)}{m['region']} ({m['n_holds']} of "
+                                    f"{m['n_cells']} cells)" for m in ms)
     wall = time.perf_counter() - t0
     params = json.dumps({"studies": [{"source": st.source, "study": st.data} for st in studies],
                          "quick": quick}, indent=1, default=str)
     report = write_html(out / "report.html", claims=claims, metrics=metrics,
-                        figures=[str(p.relative_to(out)) for p in figs if p.suffix == ".png"],
-                        designs=designs, notes=notes,
+                        figures=[p for p in figs if p.suffix == ".png"],
+                        designs=designs, notes=notes, protocol=PROTOCOL,
+                        maps=[dict(s_, path=m["path"], study=m["study"]) for s_, m in
+                              zip(summaries, map_list)],
                         meta={"version": __version__, "n_runs": len(metrics), "wall_s": wall,
                               "mode": "quick" if quick else "full", "parameters": params,
                               "title": title or ", ".join(st.name for st in studies)})
@@ -191,4 +282,5 @@ def run_studies(studies, output, quick=False, log=print, title=None, progress=Tr
     write_json_atomic(out / "designs.json", {"designs": designs, "weakgrid_version": __version__})
     log(f"wrote {report}, {csv}, {md}, {len(figs)} figure files in {wall:.0f} s")
     return {"claims": claims, "metrics": metrics, "figures": figs, "report": report,
-            "csv": csv, "markdown": md, "wall_s": wall, "designs": designs}
+            "csv": csv, "markdown": md, "wall_s": wall, "designs": designs,
+            "maps": summaries, "sweep": sweep_table}

@@ -28,7 +28,9 @@ PANELS = {
     "vu": "series voltage |Vu| [pu]",
     "p_series_mw": "UPQC injected power [MW]",
     "p_series_kw": "UPQC injected power [kW]",
-    "running_cost": "running cost of (18) [–]",
+    "running_cost": "(18): Σx'Qx+u'Ru [–]",
+    "running_cost_w": "(18) with −γ²w'Pw [–]",
+    "value_J": "J(x(t)) of (30) [–]",
     "shunt_bus_v": "shunt-bus voltage [pu]",
     "phi_hat": "GTI phase error [rad]",
     "sg_pe": "SG electrical power [pu]",
@@ -57,9 +59,29 @@ def _series(rec, key):
     s = rec.series
     if key == "p_series_kw":
         return (s["t"], s["p_series_mw"] * 1e3) if "p_series_mw" in s else None
-    if key == "running_cost":
-        return (s["tk"], s["running_cost"]) if len(s.get("tk", [])) else None
+    if key in ("running_cost", "running_cost_w", "value_J"):
+        return (s["tk"], s[key]) if len(s.get("tk", [])) and key in s else None
     return (s["t"], s[key]) if key in s else None
+
+
+VOLTAGE_PANELS = {"vu": 1, "vup": 2, "vuq": 2}   # series-voltage panels: draw the rating (±)
+
+
+def _annotate(ax, key, recs):
+    """Shade the fault windows of the drawn runs; draw the UPQC rating on series voltages."""
+    seen = set()
+    for rec in recs:
+        for ev in rec.scenario.events:
+            if ev.get("kind") == "fault" and (ev["t_on"], ev["t_off"]) not in seen:
+                seen.add((ev["t_on"], ev["t_off"]))
+                ax.axvspan(ev["t_on"], ev["t_off"], color="0.85", zorder=0,
+                           label="fault" if len(seen) == 1 else None)
+    if key in VOLTAGE_PANELS:
+        ratings = {rec.metrics.get("vu_rating_pu") for rec in recs}
+        for r in sorted(v for v in ratings if v is not None and v == v and v < 1e6):
+            ax.axhline(r, color="k", ls="--", lw=0.8, label=f"UPQC rating {r:g} pu")
+            if VOLTAGE_PANELS[key] == 2:
+                ax.axhline(-r, color="k", ls="--", lw=0.8)
 
 
 def write_figures(records: dict, folder, specs, formats=("png", "svg")) -> list[Path]:
@@ -87,6 +109,7 @@ def write_figures(records: dict, folder, specs, formats=("png", "svg")) -> list[
                 t, y = ts
                 failed = rec.metrics.get("failed")
                 ax.plot(t, y, lw=1.1, label=label + (" (simulation failed)" if failed else ""))
+            _annotate(ax, key, [records[r] for r, _ in runs if r in records])
             ax.set_ylabel(ylabel)
             ax.grid(True, alpha=0.3)
             if ax.lines:

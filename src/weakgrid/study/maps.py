@@ -124,7 +124,11 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
         legend += ("; " if legend else "") + ("✓ holds  ✗ does not  = tie (within the "
                                               "numerical uncertainty)  ! a run failed")
     if title or legend:
-        fig.suptitle("\n".join(t for t in (title, legend) if t), fontsize=10)
+        import textwrap
+
+        width = max(40, int(fig.get_figwidth() * 13))   # characters that fit at fontsize 9
+        fig.suptitle("\n".join(textwrap.fill(t, width) for t in (title, legend) if t),
+                     fontsize=9)
     if path is not None:
         from ..fileio import savefig_atomic
 

@@ -24,7 +24,12 @@ COLUMNS = [
     ("running_cost_18", "running cost (18) [–]"), ("vu_peak_pu", "|Vu| peak [pu]"),
     ("vu_rms_pu", "|Vu| rms [pu]"), ("vu_rating_reached", "rating reached"),
     ("p_series_peak_mw", "P_series peak [MW]"),
-    ("p_series_peak_pct_line", "P_series peak [% line]"), ("failed", "failed"),
+    ("p_series_peak_pct_line", "P_series peak [% line]"),
+    ("design_load", "controllers designed at (load)"),
+    ("clip_fraction", "post-fault samples clipped by the rating [–]"),
+    ("u_demanded_peak_pu", "demanded |u| peak [pu]"), ("u_applied_peak_pu", "applied |u| peak [pu]"),
+    ("omega_reach", "reach of Ω (> 1: outside) [–]"), ("extrapolation", "extrapolation"),
+    ("vdc_final_dev_pu", "Vdc at the end − Vc0 [pu]"), ("failed", "failed"),
     ("wall_s", "wall time [s]"),
 ]
 
@@ -60,14 +65,27 @@ def write_tables(metrics: list[dict], folder) -> tuple[Path, Path]:
 
 
 _CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em}
-table{border-collapse:collapse;font-size:0.85em;margin:1em 0}td,th{border:1px solid #ccc;
-padding:3px 6px;vertical-align:top}th{background:#f4f4f4}.reproduced{background:#d8f5d8}
+table{border-collapse:collapse;font-size:0.85em;margin:1em 0;display:block;overflow-x:auto;
+max-width:100%}td,th{border:1px solid #ccc;padding:3px 6px;vertical-align:top;
+overflow-wrap:anywhere;max-width:40em}pre{white-space:pre-wrap;overflow-wrap:anywhere;
+max-height:30em;overflow:auto}th{background:#f4f4f4}.reproduced{background:#d8f5d8}
 .partly{background:#fff3c4}.not{background:#f8d0d0}.notrun{background:#eee}
 img{max-width:100%;border:1px solid #ddd;margin:0.5em 0}"""
 
 
-def write_html(path, *, claims, metrics, figures, designs, meta, notes=None) -> Path:
-    """One HTML page: claims with verdicts, design models, figures, metrics."""
+def data_uri(path) -> str:
+    """A file as a ``data:`` URI (figures embedded in the report: one self-contained file)."""
+    import base64
+
+    p = Path(path)
+    mime = {".png": "image/png", ".svg": "image/svg+xml"}.get(p.suffix, "application/octet-stream")
+    return f"data:{mime};base64," + base64.b64encode(p.read_bytes()).decode("ascii")
+
+
+def write_html(path, *, claims, metrics, figures, designs, meta, notes=None, maps=None,
+               protocol=None) -> Path:
+    """One self-contained HTML page (figures embedded as data URIs): claims with verdicts,
+    maps of where they hold, the protocol, design models, figures, metrics."""
     e = html.escape
     title = meta.get("title", "study")
     parts = [f"<!doctype html><meta charset='utf-8'><title>weakgrid — {e(title)}</title>"
@@ -77,16 +95,40 @@ def write_html(path, *, claims, metrics, figures, designs, meta, notes=None) -> 
              "Every number below was measured in this run; the rules that turn them into "
              "verdicts are stated beside them.</p>",
              ]
+    with_maps = any(c.get("map_region") for c in claims)
     if claims:
         parts.append("<h2>Claims</h2><table><tr><th>claim</th><th>case</th><th>paper"
-                     "</th><th>measured</th><th>rule</th><th>verdict</th></tr>")
+                     "</th><th>measured (shipped setting)</th><th>rule</th><th>verdict at the "
+                     "shipped setting</th>" + ("<th>map: value at the shipped setting (HIGH-"
+                                               "load design)</th><th>map: where it holds</th>"
+                                               if with_maps else "") + "</tr>")
     for c in claims:
         cls = c["verdict"].replace(" ", "")
         parts.append(f"<tr><td>{e(c['id'])}</td><td>{e(c['case'])}</td><td>{e(c['paper'])}"
                      f"</td><td>{e(c['measured'] or '—')}</td><td>{e(c['rule'])}</td>"
-                     f"<td class='{cls}'>{e(c['verdict'])}</td></tr>")
+                     f"<td class='{cls}'>{e(c['verdict'])}</td>" +
+                     (f"<td>{e(c.get('map_setting') or '—')}</td>"
+                      f"<td>{e(c.get('map_region') or 'not mapped')}</td>" if with_maps else "")
+                     + "</tr>")
     if claims:
         parts.append("</table>")
+    if protocol:
+        parts.append("<h2>Protocol</h2><ul>" + "".join(f"<li>{e(p)}</li>" for p in protocol)
+                     + "</ul>")
+    if maps:
+        parts.append("<h2>Where the claims hold: maps</h2><table><tr><th>study</th><th>map"
+                     "</th><th>value at the shipped setting (verdict)</th><th>where it holds"
+                     "</th></tr>")
+        for m in maps:
+            parts.append(f"<tr><td>{e(m['study'])}</td><td>{e(m['claim'])}: {e(m['title'])}"
+                         f"</td><td>{e(m['at_setting'])}</td><td>{e(m['region'])} "
+                         f"({m['n_holds']} of {m['n_cells']} cells)</td></tr>")
+        parts.append("</table>")
+        for m in maps:
+            if m.get("path"):
+                parts.append(f"<figure><img src='{data_uri(m['path'])}' alt='"
+                             f"{e(m['claim'])} map'><figcaption>{e(m['claim'])}: "
+                             f"{e(m['title'])}</figcaption></figure>")
     cols = [("case", "study"), ("load", "load"), ("upqc", "UPQC"), ("T", "T [s]"), ("a", "a"),
             ("Vr_bar", "V̄r [pu]"), ("phi_s0", "ϕs0 [rad]"),
             ("preset", "settings preset (T, a, V̄r, ϕs0)"),
@@ -113,7 +155,7 @@ def write_html(path, *, claims, metrics, figures, designs, meta, notes=None) -> 
                          "".join(f"<li>{e(n)}</li>" for n in items) + "</ul>")
     parts.append("<h2>Figures</h2>")
     for f in figures:
-        parts.append(f"<figure><img src='{e(f)}' alt='{e(f)}'></figure>")
+        parts.append(f"<figure><img src='{data_uri(f)}' alt='{e(Path(f).stem)}'></figure>")
     parts.append("<h2>Metrics</h2><table><tr>" + "".join(f"<th>{e(lbl)}</th>"
                                                          for _, lbl in COLUMNS) + "</tr>")
     for r in metrics_frame(metrics).to_dict("records"):

@@ -19,7 +19,10 @@ def paper_studies():
     return out
 
 
-def reproduce(output="reproduce-output", quick=False, log=print) -> dict:
-    """Run the paper's case studies and write everything to ``output``."""
+def reproduce(output="reproduce-output", quick=False, log=print, scheduler=None,
+              workers=None) -> dict:
+    """Run the paper's case studies (and their sweeps, as maps) and write everything to
+    ``output``; simulations run on a Dask cluster (see :func:`run_studies`)."""
     return run_studies(paper_studies(), output, quick=quick, log=log,
-                       title="reproduction of Nazaripouya & Mehraeen (2015)")
+                       title="reproduction of Nazaripouya & Mehraeen (2015)",
+                       scheduler=scheduler, workers=workers)

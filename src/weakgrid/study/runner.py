@@ -35,12 +35,18 @@ class Run:
     t_end: float
     events: tuple
     bypass: tuple
+    design_load: str | None = None   # load the controllers are designed at (None: own load)
 
     @classmethod
     def of(cls, study, sc: dict, controller: str) -> "Run":
         return cls(f"{sc['id']}-{controller}", study.name, sc["id"], sc["load"], sc["upqc"],
                    controller, float(sc["t_end"]), tuple(dict(e) for e in sc["events"]),
-                   tuple(tuple(b) for b in sc["bypass"]))
+                   tuple(tuple(b) for b in sc["bypass"]), sc.get("design_load"))
+
+    @property
+    def design_key(self):
+        """``(design load, UPQC structure)``: the operating point its controllers are for."""
+        return (self.design_load or self.load, self.upqc)
 
     def to_dict(self):
         d = asdict(self)
@@ -129,19 +135,31 @@ def make_events(setup, run: Run):
     return out
 
 
-def run_scenario(study, run: Run, trained=None, dt=None) -> RunRecord:
+def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
+                 design=None) -> RunRecord:
     """Simulate ``run`` of ``study`` and compute its metrics.
 
     Parameters
     ----------
     trained : dict, optional
-        ``(load, upqc) -> GameController`` cache of trained HJI controllers.
+        ``(load, upqc) -> GameController`` cache of trained HJI controllers (keyed by the
+        load the controller is designed at).
     dt : float, optional
         Integration step (default: the controller's sampling period T).
+    design_load : str, optional
+        Load level the controllers are designed at (default: the run's own load). The
+        paper's low-load protocol applies the HIGH-load controllers at low load; the
+        measured design states stay deviations from the run's own operating point.
+    design : DesignModel, optional
+        The design model (10) at ``design_load`` if already derived (a sweep caches it).
     """
     setup = build_setup(study, run.load, run.upqc, controller_variant(study, run.controller))
-    ctl = (trained or {}).get((run.load, run.upqc))
-    choice = make_controller(study, run.controller, setup.design, ctl)
+    dload = design_load or run.design_load or run.load
+    if design is None:
+        design = setup.design if dload == run.load else \
+            build_setup(study, dload, run.upqc).design
+    ctl = (trained or {}).get((dload, run.upqc))
+    choice = make_controller(study, run.controller, design, ctl)
     if not choice.pss:
         _disable_pss(setup.system)
     T = setup.design.T
@@ -175,7 +193,7 @@ def run_scenario(study, run: Run, trained=None, dt=None) -> RunRecord:
         if name in res:
             series[key_] = res[name]
     metrics = {"id": run.id, "case": run.case, "load": run.load, "upqc": run.upqc,
-               "controller": run.controller, "fault": run.fault_text,
+               "controller": run.controller, "design_load": dload, "fault": run.fault_text,
                "failed": res.failure is not None,
                "failure": str(res.failure) if res.failure is not None else "",
                "wall_s": wall}
@@ -193,6 +211,7 @@ def run_scenario(study, run: Run, trained=None, dt=None) -> RunRecord:
             metrics[f"{label}_backswing_pu"] = backswing(t[ok], y[ok], after, y_final=y[0])
             metrics[f"{label}_settling_s"] = settling_time(t[ok], y[ok], after, y_final=y[0])
             metrics[f"{label}_itae"] = itae(t[ok], y[ok], after, y_final=y[0])
+            metrics[f"{label}_final_dev_pu"] = float(y[ok][-1] - y[0])  # back to set-point?
             metrics[f"{label}_verdict"] = stability_verdict(t[ok], y[ok], after) \
                 if res.failure is None else "unstable"
         else:
@@ -228,6 +247,66 @@ def run_scenario(study, run: Run, trained=None, dt=None) -> RunRecord:
         metrics["p_series_peak_pct_line"] = 100 * pk / abs(setup.line_power_mw) \
             if setup.line_power_mw else float("nan")
     metrics["line_power_mw"] = setup.line_power_mw
+    metrics.update(_protocol_metrics(study, tk, uk, xk, vmax, after))
+    if ctl is not None and len(tk):   # Fig. 10/13: J(x(t)) of (30), running cost with -γ²w'Pw
+        J, rcw = value_along(ctl, xa, ua)
+        series["value_J"], series["running_cost_w"] = J, rcw
     info = {"design": setup.design.to_dict(), "derivation": setup.derivation.to_dict(),
             "controller": choice.info}
     return RunRecord(run, metrics, series, info)
+
+
+def omega_of(study):
+    """Lower and upper corners of the training region Ω of the study's design settings."""
+    from ..models import load_preset
+
+    mesh = study.data["design"].get("mesh") or load_preset(study.data["design"]["settings"]).raw[
+        "mesh"]
+    return np.asarray(mesh["lower"], float), np.asarray(mesh["upper"], float)
+
+
+def _protocol_metrics(study, tk, uk, xk, vmax, after) -> dict:
+    """Per run: how much the rating clips u, demanded vs applied, how far x leaves Ω.
+
+    * ``clip_fraction``: fraction of the post-fault controller samples at which the demanded
+      |u| exceeds the rating (the applied u is then scaled down to it);
+    * ``u_demanded_peak_pu``: the largest demanded |u| (what a C2-voltage claim is judged on);
+    * ``omega_reach``: max over samples and states of x_i / (Ω's bound on that side): ≤ 1
+      inside the training region, > 1 = the controller extrapolates its value function;
+      ``extrapolation`` flags it.
+    """
+    out = {}
+    mag = np.hypot(uk[:, 0], uk[:, 1]) if uk.size else np.zeros(0)
+    post = tk >= after if len(tk) else np.zeros(0, bool)
+    act = post & (mag > 0) if mag.size else post
+    out["u_demanded_peak_pu"] = float(mag.max()) if mag.size else 0.0
+    out["u_applied_peak_pu"] = float(np.minimum(mag, vmax).max()) if mag.size else 0.0
+    out["clip_fraction"] = float(np.mean(mag[post] > vmax * (1 + 1e-9))) \
+        if post.any() and np.isfinite(vmax) else 0.0
+    out["clip_fraction_active"] = float(np.mean(mag[act] > vmax * (1 + 1e-9))) \
+        if act.any() and np.isfinite(vmax) else 0.0
+    lo, hi = omega_of(study)
+    x = xk[np.all(np.isfinite(xk), axis=1)] if xk.size else xk
+    if x.size:
+        reach = np.where(x >= 0, x / hi, x / lo)
+        out["omega_reach"] = float(np.max(reach))
+        out["omega_reach_phi"] = float(np.max(reach[:, 0]))
+        out["omega_reach_2"] = float(np.max(reach[:, 1]))
+    else:
+        out["omega_reach"] = out["omega_reach_phi"] = out["omega_reach_2"] = 0.0
+    out["extrapolation"] = bool(out["omega_reach"] > 1.0)
+    return out
+
+
+def value_along(ctl, x, u):
+    """``J(x_k)`` of (30) and the accumulated running cost of the discrete-time game (18),
+    ``Σ_{j≤k} x_j'Qx_j + u_j'Ru_j − γ²w_j'Pw_j`` with w the worst-case disturbance w*(x_j)
+    and Q, R, P, γ the controller's own cost, per controller sample."""
+    x = np.asarray(x, float)
+    J = np.asarray(ctl.value(x), float)
+    w = np.asarray(ctl.disturbance(x), float)
+    c = ctl.cost
+    Q, R, P = (np.atleast_2d(np.asarray(m, float)) for m in (c.Q, c.R, c.P))
+    q = np.einsum("ki,ij,kj->k", x, Q, x) + np.einsum("ki,ij,kj->k", u, R, u)
+    wpw = np.einsum("ki,ij,kj->k", w, P, w)
+    return J, np.cumsum(q - c.gamma ** 2 * wpw)

@@ -17,10 +17,12 @@ Tables (defaults in brackets)::
     [design]      T, settings (a preset giving Q, R, P, γ, Ω, mesh, basis, initial policy)
                   [cost], [mesh], [basis], [initial_policy], [solver] (override the preset)
     [controllers] compare [["hji", "lqr", "pss-only"]], [controllers.NAME] options
-    [[scenarios]] id, load, upqc, t_end, controllers, events, bypass, quick
+    [[scenarios]] id, load, upqc, t_end, controllers, events, bypass, quick,
+                  design_load [the scenario's load: the controllers designed there]
     [report]      speed_of [the controlled SG, else the first generator; "" for none], notes
     [[figures]]   id, title, panels, runs = [[run id, label]]  [one figure per scenario]
     [[claims]]    id, case, paper, rule, judge (weakgrid.study.claims.RULES), parameters
+    [sweep]       axes over study fields, mode, scenarios, controllers, maps (weakgrid.study.sweep)
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ __all__ = ["Study", "load_study", "study_from_dict", "get_path", "set_path", "sh
            "read_study_dict", "EVENT_KINDS"]
 
 TOP = {"study", "grid", "dynamics", "machine", "upqc", "design", "controllers", "scenarios",
-       "report", "figures", "claims"}
+       "report", "figures", "claims", "sweep"}
 GRID_KINDS = ("inline", "pandapower", "matpower", "andes")
 STRUCTURES = ("conventional", "reduced")
 EVENT_KINDS = ("fault", "line_trip", "load_step")
@@ -279,7 +281,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
     for i, gt in enumerate(dyn.setdefault("gti", [])):
         w = f"dynamics.gti.{i}"
         _keys(gt, {"name", "bus", "mode", "ref_bus", "C", "Vc0", "chi", "B", "ks_max", "tau",
-                   "kp_p", "ki_p", "kd_p", "kp_q", "ki_q", "kd_q", "Td"}, w)
+                   "kp_p", "ki_p", "kd_p", "kp_q", "ki_q", "kd_q", "Td", "kp_v", "ki_v"}, w)
         names.append(_need(gt, "name", w, str))
         _need(gt, "bus", w, (int, str))
         _choice(gt, "mode", w, ("energy", "pq"), "energy")
@@ -336,7 +338,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
     for i, sc in enumerate(scs):
         w = f"scenarios.{i}"
         _keys(sc, {"id", "load", "upqc", "t_end", "controllers", "events", "bypass", "quick",
-                   "description"}, w)
+                   "description", "design_load"}, w)
         sid = _need(sc, "id", w, str)
         if sid in seen:
             raise ParameterError(f"{w}.id", sid, "scenario ids must be unique")
@@ -346,6 +348,9 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         if sc["load"] not in loads:
             raise ParameterError(f"{w}.load", sc["load"], f"choose one of {loads}")
         sc["upqc"] = _choice(sc, "upqc", w, STRUCTURES, up["structure"])
+        if "design_load" in sc and sc["design_load"] not in loads:
+            raise ParameterError(f"{w}.design_load", sc["design_load"], f"choose one of {loads} "
+                                 "(the load the controllers are designed at)")
         sc["t_end"] = _num(sc, "t_end", w, positive=True)
         sc.setdefault("controllers", list(ct["compare"]))
         for c in sc["controllers"]:
@@ -375,7 +380,11 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         _choice(c, "judge", f"claims.{i}", sorted(RULES))
         for k in ("id", "paper", "rule"):
             _need(c, k, f"claims.{i}", str)
-    return Study(d, source, base_dir)
+    st = Study(d, source, base_dir)
+    from .sweep import validate_sweep
+
+    validate_sweep(d, st)
+    return st
 
 
 def _event(ev, w, t_end):

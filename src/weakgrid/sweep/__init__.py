@@ -10,8 +10,8 @@ an existing one, with a progress bar, and returns one table, a row per run.
 
 from .axes import Axis, Point, expand, get_path, set_path
 from .cache import ResultCache, canonical_json, code_fingerprint, run_key
-from .engine import SweepInterrupted, execute, results_table, run_sweep
+from .engine import SweepInterrupted, execute, open_client, results_table, run_sweep
 
 __all__ = ["Axis", "Point", "expand", "get_path", "set_path", "ResultCache", "canonical_json",
            "code_fingerprint", "run_key", "SweepInterrupted", "execute", "results_table",
-           "run_sweep"]
+           "run_sweep", "open_client"]

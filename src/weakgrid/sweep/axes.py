@@ -102,7 +102,8 @@ def set_path(obj, path: str, value):
     parent[parts[-1]] = value
 
 
-def expand(base: dict, axes, mode: str = "product") -> list[Point]:
+def expand(base: dict, axes, mode: str = "product", *, getter=None,
+           setter=None) -> list[Point]:
     """The points of a sweep over ``base``.
 
     Parameters
@@ -113,6 +114,11 @@ def expand(base: dict, axes, mode: str = "product") -> list[Point]:
         The swept fields; a dict maps path → list of values.
     mode : {"product", "points"}
         Cartesian product of the axes, or listed points (all axes equally long).
+    getter, setter : callable, optional
+        ``getter(obj, path)`` and ``setter(obj, path, value)`` addressing a field by its
+        dotted path (default: :func:`get_path`, :func:`set_path` of this module). A caller
+        whose input has its own path semantics passes them (the study engine passes
+        :func:`weakgrid.study.studyfile.get_path`/``set_path``: list elements by ``id``).
 
     Returns
     -------
@@ -127,8 +133,10 @@ def expand(base: dict, axes, mode: str = "product") -> list[Point]:
     paths = [a.path for a in axes]
     if len(set(paths)) != len(paths):
         raise ParameterError("sweep.axes", paths, "each field may be swept by one axis only")
+    getter = getter or get_path
+    setter = setter or set_path
     for a in axes:
-        get_path(base, a.path)
+        getter(base, a.path)
     if mode == "product":
         combos = list(itertools.product(*(a.values for a in axes)))
     elif mode == "points":
@@ -143,6 +151,6 @@ def expand(base: dict, axes, mode: str = "product") -> list[Point]:
     for combo in combos:
         inp = copy.deepcopy(base)
         for p, v in zip(paths, combo):
-            set_path(inp, p, v)
+            setter(inp, p, v)
         out.append(Point(dict(zip(paths, combo)), inp))
     return out

@@ -26,7 +26,7 @@ from ..fileio import replace_atomic
 from ..game.errors import ParameterError, WeakgridError
 from .cache import ResultCache, run_key
 
-__all__ = ["run_sweep", "execute", "SweepInterrupted", "results_table"]
+__all__ = ["run_sweep", "execute", "SweepInterrupted", "results_table", "open_client"]
 
 
 class SweepInterrupted(WeakgridError, KeyboardInterrupt):
@@ -99,7 +99,11 @@ def _sigterm_as_interrupt():
 
 
 @contextlib.contextmanager
-def _client(scheduler, workers):
+def open_client(scheduler=None, workers=None):
+    """A ``distributed.Client`` for the block: of the cluster at ``scheduler``
+    (``tcp://host:port``), else of a new LocalCluster with ``workers`` single-threaded
+    worker processes (default: one per core), closed at the end. One cluster can serve
+    several sweeps (pass the client to :func:`run_sweep`)."""
     from distributed import Client, LocalCluster
 
     if scheduler:
@@ -118,6 +122,9 @@ def _client(scheduler, workers):
     finally:
         client.close()
         cluster.close()
+
+
+_client = open_client
 
 
 def _progress(total, initial, enabled, desc):
@@ -152,7 +159,7 @@ def results_table(points, records) -> pd.DataFrame:
 
 def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
               workers: int | None = None, progress: bool = True, table_path=None,
-              desc: str = "sweep", log=None) -> pd.DataFrame:
+              desc: str = "sweep", log=None, client=None) -> pd.DataFrame:
     """Run every point (skipping those already cached) and return the result table.
 
     Parameters
@@ -176,6 +183,8 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
         Write the table as Parquet there (atomically).
     log : callable, optional
         Receives one-line messages (start, interruption).
+    client : distributed.Client, optional
+        An open client to run on (the caller's cluster; ``scheduler``/``workers`` ignored).
 
     Returns
     -------
@@ -210,15 +219,17 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
     bar = _progress(total, total - len(todo_unique), progress, desc)
     try:
         with _sigterm_as_interrupt():
-            if todo_unique and workers == 0:
+            if todo_unique and workers == 0 and client is None:
                 for p, k in todo_unique:
                     records[k] = _store(cache, execute(run, p.inputs, k))
                     bar.update(1)
             elif todo_unique:
                 from distributed import as_completed
 
-                with _client(scheduler, workers) as client:
-                    futs = [client.submit(execute, run, p.inputs, k, key=f"weakgrid-run-{k}",
+                ctx = contextlib.nullcontext(client) if client is not None else \
+                    _client(scheduler, workers)
+                with ctx as cl:
+                    futs = [cl.submit(execute, run, p.inputs, k, key=f"weakgrid-run-{k}",
                                           pure=False) for p, k in todo_unique]
                     try:
                         for fut in as_completed(futs):

@@ -1,0 +1,72 @@
+"""``weakgrid sweep``: a study's ``[sweep]`` on Dask — a Parquet table, a row per run."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+NAME = "sweep"
+
+
+def add_parser(sub):
+    """Add ``weakgrid sweep`` to the subcommand parsers ``sub``; return its parser."""
+    p = sub.add_parser(
+        NAME, help="run a study's sweep ([sweep]: axes over study fields) on dask.distributed",
+        description="Run every point of the study's [sweep] table (axes over study fields by "
+                    "dotted path, × scenarios × controllers) on a local Dask cluster (one "
+                    "worker process per core) or an existing one, and write one Parquet table, "
+                    "a row per run (its parameters, every metric, status, failure cause, wall "
+                    "time). Finished runs are cached under a hash of their full input and the "
+                    "code: an interrupted sweep (Ctrl-C, SIGTERM) resumes, a repeated one is "
+                    "free.",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    p.add_argument("study", help="a study file (TOML) or a shipped study's name")
+    p.add_argument("--output", "-o", type=Path, default=None,
+                   help="output folder (default: <study>-sweep)")
+    p.add_argument("--scheduler", default=None,
+                   help="address of an existing Dask scheduler (tcp://host:port); default: a "
+                        "local cluster")
+    p.add_argument("--workers", type=int, default=None,
+                   help="worker processes of the local cluster (default: one per core; 0 = "
+                        "serial, in this process)")
+    p.add_argument("--quick", action="store_true", help="the sweep's [sweep.quick] axes")
+    p.add_argument("--signals", action="store_true",
+                   help="keep every run's signals (Parquet, in the cache folder)")
+    p.add_argument("--maps", action="store_true", help="also draw the sweep's maps (PNG)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=run)
+    return p
+
+
+def run(args) -> int:
+    """Run ``weakgrid sweep`` with the parsed ``args``; return the exit status."""
+    from ..game.errors import ParameterError
+    from ..study.studyfile import load_study
+    from ..study.sweep import run_study_sweep
+    from ..sweep import SweepInterrupted
+
+    if args.workers is not None and args.workers < 0:
+        raise ParameterError("--workers", args.workers, "give a whole number ≥ 0 (0 = serial)")
+    st = load_study(args.study)
+    if args.signals and "sweep" in st.data:
+        st.data["sweep"]["signals"] = True
+    out = args.output or Path(f"{st.name}-sweep")
+    try:
+        table = run_study_sweep(st, out, quick=args.quick, scheduler=args.scheduler,
+                                workers=args.workers, progress=not args.no_progress)
+    except SweepInterrupted as exc:
+        print(f"weakgrid sweep: {exc}")
+        return 130
+    n_fail = int((table["status"] != "ok").sum())
+    print(f"{len(table)} runs, {n_fail} failed; table: "
+          f"{out / (st.name + '-sweep' + ('-quick' if args.quick else '') + '.parquet')}")
+    if n_fail:
+        for _, r in table[table["status"] != "ok"].head(10).iterrows():
+            print(f"  run {r['run']}: {r['failure'][:160]}")
+    if args.maps:
+        from ..study.sweep_maps import draw_maps, map_summaries
+
+        maps = draw_maps(st, table, out / "maps", quick=args.quick)
+        for s in map_summaries(maps):
+            print(f"  {s['claim']}: at the shipped setting {s['at_setting']}; {s['region']}")
+    return 0

@@ -1,0 +1,235 @@
+"""Sweeps of a study: its ``[sweep]`` table run on :mod:`weakgrid.sweep` (Dask, cache, resume).
+
+A study's ``[sweep]`` table::
+
+    [sweep]
+    mode = "product"                         # or "points" (the k-th values of every axis together)
+    scenarios = ["c1-high-conv"]             # scenarios run at every point [all]
+    controllers = ["hji", "nonlinear-29"]    # controllers run at every point [each scenario's]
+    t_end = 3.0                              # shorter runs for the sweep [each scenario's]
+    design_load = "high"                     # controllers designed at this load [the run's]
+    signals = false                          # keep every run's signals (Parquet) in the cache
+    [sweep.axes]                             # dotted study paths (list elements by id) → values
+    "upqc.rating" = [0.1, 0.15, 0.3, 0.6, 1.0]
+    "scenarios.c1-high-conv.load" = ["high", "low"]
+    "scenarios.c1-high-conv.events.0.t_off" = [0.22, 0.25, 0.3]
+    [sweep.quick]                            # replaces axes (and t_end) for `--quick`
+    [sweep.dt_check]                         # points (path = values) run again at half the step:
+    "upqc.rating" = [0.15]                   # the numerical uncertainty (ties in the maps)
+    [[sweep.maps]]                           # one map per claim (weakgrid.study.sweep_maps)
+
+Every run is one task: :func:`run_point` (module level, picklable) receives the full input —
+the study dict with the point's values set, the scenario id, the controller name, the design
+load — and returns its metrics. Fields are addressed by the study's own dotted paths
+(:func:`weakgrid.study.studyfile.get_path`/``set_path``), passed to
+:func:`weakgrid.sweep.expand`. The HJI controller of a design point is trained once per worker
+process (cached on the design model and the design settings).
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..game.errors import ParameterError
+from ..sweep import Point, canonical_json, expand, run_sweep
+from .studyfile import get_path, set_path, study_from_dict
+
+__all__ = ["SWEEP_KEYS", "validate_sweep", "sweep_points", "run_point", "run_study_sweep"]
+
+SWEEP_KEYS = {"axes", "mode", "scenarios", "controllers", "t_end", "design_load", "signals",
+              "quick", "maps", "dt_check"}
+
+_TRAINED: dict = {}     # per worker process: design key -> trained GameController
+_DESIGNS: dict = {}     # per worker process: (grid data, load, structure) -> design model (10)
+_NOT_DESIGN = ("scenarios", "sweep", "claims", "figures", "report", "study", "controllers")
+
+
+def validate_sweep(d: dict, study) -> None:
+    """Check a study dict's ``[sweep]`` table (fields named in every error)."""
+    sw = d.get("sweep")
+    if sw is None:
+        return
+    if not isinstance(sw, dict):
+        raise ParameterError("sweep", sw, "give a table [sweep]")
+    extra = set(sw) - SWEEP_KEYS
+    if extra:
+        raise ParameterError(f"sweep.{sorted(extra)[0]}", "…", f"unknown field; allowed: "
+                             f"{sorted(SWEEP_KEYS)}")
+    if sw.setdefault("mode", "product") not in ("product", "points"):
+        raise ParameterError("sweep.mode", sw["mode"], "choose 'product' or 'points'")
+    ids = [sc["id"] for sc in d["scenarios"]]
+    for sid in sw.setdefault("scenarios", ids):
+        if sid not in ids:
+            raise ParameterError("sweep.scenarios", sid, f"no such scenario; choose from {ids}")
+    for c in sw.get("controllers", []):
+        if c not in d["controllers"]["compare"]:
+            raise ParameterError("sweep.controllers", c, f"not in controllers.compare "
+                                 f"{d['controllers']['compare']}")
+    if "design_load" in sw and sw["design_load"] not in study.loads:
+        raise ParameterError("sweep.design_load", sw["design_load"],
+                             f"choose one of {study.loads}")
+    for where, axes in (("sweep.axes", sw.get("axes")),
+                        ("sweep.quick.axes", (sw.get("quick") or {}).get("axes"))):
+        if axes is None:
+            if where == "sweep.axes":
+                raise ParameterError(where, None, "give [sweep.axes]: dotted study path = "
+                                     "list of values, e.g. \"upqc.rating\" = [0.1, 0.3]")
+            continue
+        if not isinstance(axes, dict) or not axes:
+            raise ParameterError(where, axes, "give a table of dotted path = list of values")
+        for path, vals in axes.items():
+            get_path(d, path)   # the field exists (error names it)
+            if not isinstance(vals, list) or not vals:
+                raise ParameterError(f"{where}.\"{path}\"", vals, "give a non-empty list")
+    for path, vals in (sw.get("dt_check") or {}).items():
+        if path not in sw.get("axes", {}) or not isinstance(vals, list):
+            raise ParameterError(f"sweep.dt_check.\"{path}\"", vals, "give a list of values of "
+                                 "a swept field (a path of [sweep.axes])")
+
+
+def _axes(sw: dict, quick: bool) -> dict:
+    q = sw.get("quick") or {}
+    return dict(q["axes"]) if quick and "axes" in q else dict(sw["axes"])
+
+
+def sweep_points(study, quick: bool = False, scenarios=None, controllers=None):
+    """The points of the study's sweep: a :class:`weakgrid.sweep.Point` per (axis values ×
+    scenario × controller); its ``inputs`` is the full input of :func:`run_point`."""
+    sw = study.data.get("sweep")
+    if not sw:
+        raise ParameterError("sweep", None, f"study '{study.name}' has no [sweep] table; add "
+                             "one (see weakgrid.study.sweep)")
+    # a run's full input: the study without what does not change a run (so that editing a
+    # map, a figure or a claim's wording keeps the cached runs)
+    base_study = {k: copy.deepcopy(v) for k, v in study.data.items()
+                  if k not in ("sweep", "figures", "claims")}
+    t_end = (sw.get("quick") or {}).get("t_end") if quick else None
+    t_end = t_end or sw.get("t_end")
+    scs = scenarios or sw["scenarios"]
+    out = []
+    for sid in scs:
+        sc = get_path(base_study, f"scenarios.{sid}")
+        ctls = controllers or sw.get("controllers") or sc["controllers"]
+        for c in ctls:
+            if c not in study.controllers:
+                raise ParameterError("sweep.controllers", c, "not a controller of the study")
+        base = {"study": base_study, "scenario": sid, "controller": ctls[0],
+                "design_load": sw.get("design_load"), "t_end": t_end,
+                "signals": bool(sw.get("signals", False)), "dt_factor": 1.0}
+        axes = {f"study.{p}": v for p, v in _axes(sw, quick).items()}
+        axes["controller"] = list(ctls)
+        pts = expand(base, axes, "product", getter=get_path, setter=set_path) \
+            if sw["mode"] == "product" else _points_mode(base, axes)
+        for pt in pts:
+            pt.params = {k[6:] if k.startswith("study.") else k: v for k, v in
+                         pt.params.items()}
+            pt.params = {"scenario": sid, **pt.params, "dt_factor": 1.0}
+            out.append(pt)
+            chk = {} if quick else (sw.get("dt_check") or {})
+            if chk and all(pt.params.get(k) in v for k, v in chk.items()):
+                half = Point(dict(pt.params, dt_factor=0.5),
+                             dict(copy.deepcopy(pt.inputs), dt_factor=0.5))
+                out.append(half)
+    return out
+
+
+def _points_mode(base, axes):
+    """Listed points (every study axis equally long) × the controllers (× dt factors)."""
+    study_axes = {k: v for k, v in axes.items() if k.startswith("study.")}
+    pts = expand(base, study_axes, "points", getter=get_path, setter=set_path)
+    out = []
+    for pt in pts:
+        extra = {k: v for k, v in axes.items() if not k.startswith("study.")}
+        for sub in expand(pt.inputs, extra, "product", getter=get_path, setter=set_path):
+            sub.params = {**pt.params, **sub.params}
+            out.append(sub)
+    return out
+
+
+def _design(study, load, upqc):
+    """The design model (10) at ``load``/``upqc`` (it does not depend on the UPQC rating)."""
+    from .build import build_setup
+
+    d = {k: v for k, v in study.data.items() if k not in _NOT_DESIGN}
+    d["upqc"] = {k: v for k, v in d["upqc"].items() if k != "rating"}
+    key = canonical_json([d, load, upqc])
+    if key not in _DESIGNS:
+        _DESIGNS[key] = build_setup(study, load, upqc).design
+    return _DESIGNS[key]
+
+
+def _trained(study, design, key_extra):
+    from .controllers import train_hji
+
+    key = canonical_json([design.to_dict(), study.data["design"], key_extra])
+    ctl = _TRAINED.get(key)
+    if ctl is None:
+        ctl = train_hji(study, design)[1]
+        _TRAINED[key] = ctl
+    return ctl
+
+
+def run_point(inputs: dict):
+    """Run one point of a sweep (on a worker) and return its metrics (and signals).
+
+    ``inputs``: ``study`` (a study dict, the point's values set), ``scenario`` (id),
+    ``controller`` (name), ``design_load`` (or None: the run's own load), ``t_end`` (or None),
+    ``signals`` (bool), ``dt_factor`` (integration step = factor × T; 0.5 for the numerical
+    uncertainty check). A run that loses stability or whose Newton iteration fails returns
+    ``status = "failed"`` with its cause.
+    """
+    from .controllers import controller_kind
+    from .runner import Run, run_scenario
+
+    st = study_from_dict(inputs["study"], source=f"sweep:{inputs['study']['study']['name']}")
+    sc = next((s for s in st.scenarios() if s["id"] == inputs["scenario"]), None)
+    if sc is None:
+        raise ParameterError("scenario", inputs["scenario"], "no such scenario in the study")
+    if inputs.get("t_end"):
+        sc = dict(sc, t_end=float(inputs["t_end"]))
+    name = inputs["controller"]
+    run = Run.of(st, sc, name)
+    dload = inputs.get("design_load") or run.load
+    trained = {}
+    design = _design(st, dload, run.upqc)
+    if controller_kind(st, name) == "hji":
+        trained[(dload, run.upqc)] = _trained(st, design, [dload, run.upqc])
+    T = float(st.data["design"]["T"])
+    rec = run_scenario(st, run, trained, dt=T * float(inputs.get("dt_factor") or 1.0),
+                       design_load=dload, design=design)
+    m = dict(rec.metrics)
+    for k in ("id", "case", "controller", "load", "upqc", "wall_s"):
+        m.pop(k, None)
+    m["sim_wall_s"] = rec.metrics.get("wall_s")
+    m["run_load"] = rec.metrics.get("load")
+    if rec.metrics.get("failed"):
+        m["status"] = "failed"
+        m["failure"] = rec.metrics.get("failure") or "simulation failed"
+    m.pop("failed", None)
+    if inputs.get("signals"):
+        s = rec.series
+        t = s["t"]
+        sig = pd.DataFrame({k: v for k, v in s.items() if isinstance(v, np.ndarray) and
+                            v.shape == t.shape})
+        return m, sig
+    return m
+
+
+def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
+                    progress=True, log=print, cache_dir=None) -> pd.DataFrame:
+    """Run the study's sweep; write ``<output>/<study>-sweep.parquet``; return the table.
+
+    The cache (``<output>/cache`` unless given) keeps every finished run: an interrupted
+    sweep resumes, a repeated one runs nothing.
+    """
+    out = Path(output)
+    out.mkdir(parents=True, exist_ok=True)
+    pts = sweep_points(study, quick)
+    return run_sweep(pts, run_point, cache_dir=cache_dir or out / "cache", scheduler=scheduler,
+                     workers=workers, progress=progress, log=log,
+                     table_path=out / f"{study.name}-sweep{'-quick' if quick else ''}.parquet",
+                     desc=f"sweep {study.name}")

@@ -1,0 +1,261 @@
+"""Maps of a study's sweep: per claim, the measured quantity and its verdict per cell.
+
+Each ``[[sweep.maps]]`` entry of a study names a claim and how to measure it on the sweep's
+table (a row per run; :mod:`weakgrid.study.sweep`)::
+
+    claim, title, label        the claim's id, the map's title and colour-bar label
+    id                         the map's own id when a claim has several maps [claim]
+    kind = "ratio"             metric of controller a / of b; holds if ≤ holds_below
+    kind = "value"             metric of controller a; holds if within holds_within = [lo, hi]
+                               (no rule: the map only shows the quantity)
+    kind = "wins"              a smaller than b on every one of ``metrics`` (or b failed)
+    kind = "stable"            a's speed verdict "stable" while b's is not (or b failed)
+    x, y, facet                table columns (default: the sweep's first three axes)
+
+Ties: a comparison (ratio, wins) whose difference is smaller than the runs' numerical
+uncertainty is a tie, not a win. The uncertainty of a metric is measured by running the
+``[sweep.dt_check]`` points again at half the integration step: ``|m(T) − m(T/2)|`` relative
+to ``|m(T)|``, per load level and fault severity (the row of the map), applied to every cell
+of that row (a row without a check takes the largest measured at its load level). A cell where
+a run failed is marked failed.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pandas as pd
+
+from ..game.errors import ParameterError
+from .maps import plot_map
+
+__all__ = ["map_cells", "draw_maps", "map_summaries", "MAP_KINDS"]
+
+MAP_KINDS = ("ratio", "value", "wins", "stable")
+
+
+def _num(v):
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        return math.nan
+    return v
+
+
+def _axes_of(spec, axes):
+    ax = list(axes)
+    x = spec.get("x", ax[0] if ax else None)
+    y = spec.get("y", ax[1] if len(ax) > 1 else None)
+    facet = spec.get("facet", ax[2] if len(ax) > 2 else None)
+    return x, y, facet
+
+
+def _rel_uncertainty(half, full, match, row_keys, metric, ctl):
+    """Relative ``|m(T) − m(T/2)| / |m(T)|`` of ``metric`` for controller ``ctl``, the largest
+    per map row (``row_keys``); ``match`` are the columns that identify a run's point."""
+    out = {}
+    if half.empty or metric not in full:
+        return out
+    on = [c for c in match if c in full and c in half]
+    merged = full[full["controller"] == ctl].merge(half[half["controller"] == ctl], on=on,
+                                                   suffixes=("", "_half"))
+    for _, r in merged.iterrows():
+        a, b = _num(r.get(metric)), _num(r.get(f"{metric}_half"))
+        if math.isfinite(a) and math.isfinite(b) and a != 0:
+            key = tuple(r[k] for k in row_keys if k is not None)
+            out[key] = max(out.get(key, 0.0), abs(a - b) / abs(a))
+    return out
+
+
+def _unc(by_row, rk):
+    """The row's measured uncertainty, else the largest measured in its facet (load level)."""
+    if rk in by_row:
+        return by_row[rk]
+    same = [v for k, v in by_row.items() if k[1:] == rk[1:]]
+    return max(same) if same else None
+
+
+def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
+    """One row per map cell: the swept fields, ``value``, ``verdict`` (holds/not/tie/failed or
+    None), ``uncertainty`` (relative, or NaN when not measured) and a short ``detail``."""
+    kind = spec.get("kind")
+    if kind not in MAP_KINDS:
+        raise ParameterError(f"sweep.maps[{spec.get('claim')}].kind", kind,
+                             f"choose one of {list(MAP_KINDS)}")
+    x, y, facet = _axes_of(spec, axes)
+    keys = [k for k in (x, y, facet) if k is not None]
+    dtf = table["dt_factor"] if "dt_factor" in table else pd.Series(1.0, index=table.index)
+    full, half = table[dtf == 1.0], table[dtf != 1.0]
+    match = list(axes) + ["scenario", "controller"]
+    row_keys = [y, facet]
+    a, b = spec.get("a"), spec.get("b")
+    metrics = spec.get("metrics") or [spec.get("metric")]
+    unc = {(m, c): _rel_uncertainty(half, full, match, row_keys, m, c) for m in metrics
+           for c in (a, b) if c}
+    rows = []
+    for cell, grp in full.groupby(keys, sort=False):
+        cell = cell if isinstance(cell, tuple) else (cell,)
+        rec = dict(zip(keys, cell))
+        rk = tuple(rec[k] for k in row_keys if k is not None)
+        ra = grp[grp["controller"] == a]
+        rb = grp[grp["controller"] == b] if b else None
+        if ra.empty:
+            continue
+        ra = ra.iloc[0]
+        rb = rb.iloc[0] if rb is not None and not rb.empty else None
+        fa = ra["status"] != "ok"
+        fb = rb is not None and rb["status"] != "ok"
+        val, verdict, u, detail = math.nan, None, math.nan, ""
+        if kind == "value":
+            val = _num(ra.get(spec["metric"]))
+            if "holds_within" in spec:
+                lo, hi = spec["holds_within"]
+                verdict = "failed" if fa else ("holds" if lo <= val <= hi else "not")
+            elif fa:
+                verdict = "failed"
+        elif kind == "ratio":
+            m = spec["metric"]
+            va, vb = _num(ra.get(m)), _num(rb.get(m)) if rb is not None else math.nan
+            val = va / vb if vb else math.nan
+            ua, ub = _unc(unc[(m, a)], rk), _unc(unc[(m, b)], rk)
+            if ua is not None and ub is not None:
+                u = (ua * abs(va) + ub * abs(vb)) / abs(vb) if vb else math.nan
+            if fa or fb:
+                verdict = "failed"
+            elif math.isfinite(u) and abs(va - vb) <= u * abs(vb):
+                verdict = "tie"
+            else:
+                verdict = "holds" if val <= spec.get("holds_below", 1.0) else "not"
+        elif kind == "wins":
+            m0 = metrics[0]
+            va0 = _num(ra.get(m0))
+            vb0 = _num(rb.get(m0)) if rb is not None else math.nan
+            val = va0 / vb0 if vb0 and not fb else math.nan
+            if fa:
+                verdict = "failed"
+            elif fb:
+                verdict, detail = "holds", f"{b} failed: {rb.get('failure', '')}"[:120]
+            else:
+                res = []
+                for m in metrics:
+                    va, vb = _num(ra.get(m)), _num(rb.get(m))
+                    ua, ub = _unc(unc[(m, a)], rk), _unc(unc[(m, b)], rk)
+                    tol = (ua * abs(va) + ub * abs(vb)) if ua is not None and ub is not None \
+                        else 0.0
+                    if not (math.isfinite(va) and math.isfinite(vb)):
+                        res.append("not")
+                    elif abs(va - vb) <= tol:
+                        res.append("tie")
+                    else:
+                        res.append("holds" if va < vb else "not")
+                    detail += f"{m}: {va:.3g} vs {vb:.3g}; "
+                verdict = "not" if "not" in res else ("tie" if "tie" in res else "holds")
+        elif kind == "stable":
+            val = _num(ra.get(spec.get("metric", "speed_settling_s")))
+            sa = "unstable" if fa else ra.get("speed_verdict")
+            sb = "unstable" if fb else (rb.get("speed_verdict") if rb is not None else None)
+            detail = f"{a}: {sa}, {b}: {sb}"
+            verdict = "holds" if sa == "stable" and sb in ("unstable", "undamped") else "not"
+        if verdict == "failed":     # a failed run's metrics stop at the failure: no value
+            val = math.nan
+        rec.update(value=val, verdict=verdict, uncertainty=u, detail=detail)
+        rows.append(rec)
+    return pd.DataFrame(rows)
+
+
+def _short(path):
+    names = {"upqc.rating": "UPQC rating [pu]", "controller": "controller"}
+    if path in names:
+        return names[path]
+    tail = path.split(".")[-1]
+    return {"t_off": "fault cleared at t_off [s]", "xf": "fault reactance xf [pu]",
+            "load": "load level", "duration": "fault duration [s]"}.get(tail, path)
+
+
+def draw_maps(study, table, folder, quick=False) -> list[dict]:
+    """Draw every ``[[sweep.maps]]`` of ``study`` from its sweep ``table`` into ``folder``
+    (PNG); returns per map: spec, cells (DataFrame), path, mark."""
+    from pathlib import Path
+
+    import matplotlib.pyplot as plt
+
+    from .studyfile import get_path
+    from .sweep import _axes
+
+    sw = study.data["sweep"]
+    axes = list(_axes(sw, quick))
+    out = []
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    for spec in sw.get("maps", []):
+        cells = map_cells(table, spec, axes)
+        x, y, facet = _axes_of(spec, axes)
+        mark = (get_path(study.data, x), get_path(study.data, y)) if x and y else None
+        path = folder / f"map-{study.name}-{spec.get('id', spec['claim'])}.png"
+        if cells.empty:
+            out.append({"spec": spec, "cells": cells, "path": None, "mark": mark,
+                        "axes": (x, y, facet)})
+            continue
+        center = 1.0 if spec["kind"] in ("ratio", "wins") else None
+        fshort = facet.split(".")[-1] if facet else None
+        shown = cells.rename(columns={facet: fshort}) if facet else cells
+        fig = plot_map(shown, x, y, "value", verdict="verdict", facet=fshort, mark=mark,
+                       title=f"{spec['claim']}: {spec.get('title', '')}",
+                       value_label=spec.get("label", spec.get("metric", "")),
+                       x_label=_short(x), y_label=_short(y),
+                       cmap="RdBu_r" if center else "viridis", center=center,
+                       mark_label="the shipped (paper's) setting", path=path)
+        plt.close(fig)
+        out.append({"spec": spec, "cells": cells, "path": path, "mark": mark,
+                    "axes": (x, y, facet)})
+    return out
+
+
+def _fmtv(v):
+    return "–" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.3g}"
+
+
+def map_summaries(maps) -> list[dict]:
+    """Per map: the verdict at the shipped setting (per facet value) and the region where the
+    claim holds, in words with numbers."""
+    out = []
+    for m in maps:
+        spec, cells, mark = m["spec"], m["cells"], m["mark"]
+        x, y, facet = m["axes"]
+        if cells.empty:
+            out.append({"claim": spec["claim"], "id": spec.get("id", spec["claim"]),
+                        "title": spec.get("title", ""), "at_setting": "no runs", "region": "", "n_holds": 0, "n_cells": 0})
+            continue
+        at, region = [], []
+        facets = list(dict.fromkeys(cells[facet])) if facet else [None]
+        for fv in facets:
+            sub = cells if fv is None else cells[cells[facet] == fv]
+            pre = "" if fv is None else f"{fv}: "
+            hit = sub[(sub[x] == mark[0]) & (sub[y] == mark[1])] if mark else sub.iloc[:0]
+            if not hit.empty:
+                r = hit.iloc[0]
+                at.append(f"{pre}{_fmtv(r['value'])} ({r['verdict'] or 'no rule'})")
+            if sub["verdict"].isna().all():
+                continue
+            parts = []
+            for yv, row in sub.groupby(y, sort=True):
+                ok = row[row["verdict"] == "holds"][x].tolist()
+                ties = row[row["verdict"] == "tie"][x].tolist()
+                fails = row[row["verdict"] == "failed"][x].tolist()
+                txt = f"{_short(y).split(' [')[0]} {yv:g}: " if isinstance(yv, float) else \
+                    f"{yv}: "
+                txt += ("holds at " + ", ".join(f"{v:g}" for v in ok)) if ok else "holds nowhere"
+                if ties:
+                    txt += "; tie at " + ", ".join(f"{v:g}" for v in ties)
+                if fails:
+                    txt += "; a run failed at " + ", ".join(f"{v:g}" for v in fails)
+                parts.append(txt)
+            region.append(pre + "; ".join(parts))
+        nh = int((cells["verdict"] == "holds").sum())
+        out.append({"claim": spec["claim"], "id": spec.get("id", spec["claim"]),
+                    "title": spec.get("title", ""),
+                    "at_setting": "; ".join(at) or "the setting is not on the map",
+                    "region": " | ".join(region) if region else "(quantity only, no rule)",
+                    "n_holds": nh, "n_cells": int(cells["verdict"].notna().sum()),
+                    "x": _short(x)})
+    return out

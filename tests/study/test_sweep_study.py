@@ -1,0 +1,223 @@
+"""Sweeps of studies: [sweep] tables, `weakgrid sweep` (Dask, resume, scheduler address),
+failures as rows, maps of where a claim holds, and the self-contained HTML report."""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from weakgrid.cli.main import main
+from weakgrid.game.errors import ParameterError
+from weakgrid.study.report import write_html
+from weakgrid.study.studyfile import get_path, load_study, set_path, study_from_dict
+from weakgrid.study.sweep import run_point, sweep_points
+from weakgrid.study.sweep_maps import map_cells
+from weakgrid.sweep import expand, run_sweep
+
+MARKER = "# ------------------------------------------------------------------ where the claims hold"
+
+SMALL_SWEEP = """
+[sweep]
+mode = "product"
+scenarios = ["c1-high-conv"]
+controllers = ["nonlinear-29"]
+t_end = 0.35
+[sweep.axes]
+"upqc.rating" = RATINGS
+"scenarios.c1-high-conv.events.0.bus" = [3, 99]
+"""
+
+
+def _small_study(tmp_path, ratings=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3)) -> Path:
+    """Case 1 with a small sweep: ratings × {bus 3, a bus that does not exist (fails)}."""
+    src = resources.files("weakgrid") / "data" / "studies" / "case1-weak-grid.toml"
+    text = src.read_text(encoding="utf-8")
+    text = text[: text.index(MARKER)] + SMALL_SWEEP.replace("RATINGS", str(list(ratings)))
+    p = tmp_path / "small.toml"
+    p.write_text(text, encoding="utf-8")
+    return p
+
+
+def _tab(df):
+    return df.drop(columns=[c for c in ("wall_s", "sim_wall_s", "traceback_tail")
+                            if c in df]).reset_index(drop=True)
+
+
+def test_expand_uses_the_studys_paths():
+    st = load_study("case1-weak-grid")
+    pts = expand(st.data, {"scenarios.c1-low-conv.load": ["high"], "upqc.rating": [0.3, 0.6]},
+                 getter=get_path, setter=set_path)
+    assert [p.params["upqc.rating"] for p in pts] == [0.3, 0.6]
+    for p in pts:   # a list element addressed by its id, not by its position
+        assert get_path(p.inputs, "scenarios.c1-low-conv.load") == "high"
+        assert p.inputs["scenarios"][2]["id"] == "c1-low-conv"
+        assert p.inputs["scenarios"][2]["load"] == "high"
+    assert st.data["scenarios"][2]["load"] == "low"   # the base is not modified
+
+
+def test_sweep_points_of_a_shipped_study():
+    st = load_study("case1-weak-grid")
+    sw = st.data["sweep"]
+    pts = sweep_points(st)
+    n = math.prod(len(v) for v in sw["axes"].values()) * len(sw["controllers"])
+    chk = sw["dt_check"]                                 # these points again at T/2
+    n_half = math.prod(len(chk.get(k, v)) for k, v in sw["axes"].items()) * \
+        len(sw["controllers"])
+    assert len(pts) == n + n_half and n_half > 0
+    half = [p for p in pts if p.params["dt_factor"] == 0.5]
+    assert len(half) == n_half
+    assert all(p.params[k] in v for p in half for k, v in chk.items())
+    p = pts[0]
+    assert p.inputs["scenario"] == "c1-high-conv" and p.inputs["design_load"] == "high"
+    assert get_path(p.inputs["study"], "upqc.rating") == p.params["upqc.rating"]
+    quick = sweep_points(st, quick=True)
+    assert len(quick) < len(pts) and all(q.params["dt_factor"] == 1.0 for q in quick)
+
+
+@pytest.mark.parametrize("path, word", [("upqc.ratin", "ratin"),
+                                        ("scenarios.nope.load", "nope")])
+def test_bad_sweep_axis_names_the_field(path, word):
+    st = load_study("case1-weak-grid")
+    d = dict(st.data, sweep=dict(st.data["sweep"], axes={path: [1.0]}))
+    with pytest.raises(ParameterError, match=word):
+        study_from_dict(d)
+
+
+def test_failing_run_is_a_row_with_its_cause(tmp_path):
+    st = load_study(_small_study(tmp_path))
+    pts = [p for p in sweep_points(st) if p.params["upqc.rating"] in (0.15, 0.3)]
+    table = run_sweep(pts, run_point, cache_dir=tmp_path / "c", workers=0, progress=False)
+    assert len(table) == 4
+    bad = table[table["scenarios.c1-high-conv.events.0.bus"] == 99]
+    good = table[table["scenarios.c1-high-conv.events.0.bus"] == 3]
+    assert (bad["status"] == "failed").all() and (good["status"] == "ok").all()
+    assert bad["failure"].str.contains("99").all()          # the cause names the bad value
+    assert np.isfinite(good["control_cost"]).all() and (good["control_cost"] > 0).all()
+    # the rating bounds what is applied, not what is demanded
+    assert (good["u_applied_peak_pu"] <= good["upqc.rating"] + 1e-12).all()
+    assert (good["u_demanded_peak_pu"] >= good["u_applied_peak_pu"]).all()
+
+
+def test_sweep_against_a_scheduler_address_gives_the_default_table(tmp_path):
+    from distributed import LocalCluster
+
+    study = _small_study(tmp_path, ratings=(0.1, 0.15))
+    assert main(["sweep", str(study), "--workers", "0", "-o", str(tmp_path / "serial"),
+                 "--no-progress"]) == 0
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster:
+        assert main(["sweep", str(study), "--scheduler", cluster.scheduler_address,
+                     "-o", str(tmp_path / "remote"), "--no-progress"]) == 0
+    a = pd.read_parquet(tmp_path / "serial" / "case1-weak-grid-sweep.parquet")
+    b = pd.read_parquet(tmp_path / "remote" / "case1-weak-grid-sweep.parquet")
+    assert len(a) == 4
+    assert list(a["status"] == "failed") == list(a["scenarios.c1-high-conv.events.0.bus"] == 99)
+    pd.testing.assert_frame_equal(_tab(a), _tab(b))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_weakgrid_sweep_interrupted_and_restarted_completes_the_same_table(tmp_path, sig):
+    study = _small_study(tmp_path)
+    out = tmp_path / "out"
+    cache = out / "cache"
+    cmd = [sys.executable, "-m", "weakgrid.cli.main", "sweep", str(study), "-o", str(out),
+           "--workers", "2", "--no-progress"]
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True)
+    t0 = time.time()
+    while len(list(cache.glob("*.json"))) < 2 and time.time() - t0 < 180:
+        time.sleep(0.05)
+    p.send_signal(sig)
+    stdout, err = p.communicate(timeout=180)
+    assert p.returncode == 130, (stdout, err)
+    assert "interrupted" in stdout and "Traceback" not in err
+    done = {q.name: q.stat().st_mtime_ns for q in cache.glob("*.json")}
+    assert 2 <= len(done) < 12
+    p2 = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert p2.returncode == 0, p2.stderr
+    assert f"{len(done)} already done" in p2.stdout + p2.stderr
+    # no finished run ran again: its cached record is untouched
+    assert {q.name: q.stat().st_mtime_ns for q in cache.glob("*.json") if q.name in done} == done
+    resumed = pd.read_parquet(out / "case1-weak-grid-sweep.parquet")
+    assert main(["sweep", str(study), "--workers", "0", "-o", str(tmp_path / "ref"),
+                 "--no-progress"]) == 0
+    ref = pd.read_parquet(tmp_path / "ref" / "case1-weak-grid-sweep.parquet")
+    pd.testing.assert_frame_equal(_tab(resumed), _tab(ref))
+
+
+def _cells_table():
+    """A synthetic sweep table: 2 ratings × 1 duration × 1 load, controllers a and b, plus the
+    dt-halving repeat of rating 0.1."""
+    rows = []
+    def row(r, c, cost, dt=1.0, status="ok"):
+        rows.append({"scenario": "s", "upqc.rating": r, "t_off": 0.25, "load": "high",
+                     "controller": c, "dt_factor": dt, "status": status, "cost": cost})
+    row(0.1, "a", 1.00)
+    row(0.1, "b", 1.02)          # 2 % apart ...
+    row(0.1, "a", 1.03, 0.5)     # ... while halving the step moves a by 3 %: a tie
+    row(0.1, "b", 1.02, 0.5)
+    row(0.3, "a", 0.50)
+    row(0.3, "b", 1.00)          # 50 % less, far beyond the uncertainty: holds
+    row(0.5, "a", 0.01, status="failed")
+    row(0.5, "b", 1.00)
+    return pd.DataFrame(rows)
+
+
+def test_map_cells_ties_wins_and_failures():
+    spec = {"claim": "X", "kind": "ratio", "metric": "cost", "a": "a", "b": "b",
+            "holds_below": 0.8}
+    cells = map_cells(_cells_table(), spec, ["upqc.rating", "t_off", "load"])
+    v = dict(zip(cells["upqc.rating"], cells["verdict"]))
+    assert v == {0.1: "tie", 0.3: "holds", 0.5: "failed"}
+    val = dict(zip(cells["upqc.rating"], cells["value"]))
+    assert val[0.3] == pytest.approx(0.5) and math.isnan(val[0.5])
+    # without the dt check there is no uncertainty: 0.98 is then "not" (above 0.8)
+    t = _cells_table()
+    cells2 = map_cells(t[t["dt_factor"] == 1.0], spec, ["upqc.rating", "t_off", "load"])
+    assert dict(zip(cells2["upqc.rating"], cells2["verdict"]))[0.1] == "not"
+
+
+def test_report_is_one_self_contained_file(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1])
+    png = tmp_path / "figs" / "f.png"
+    png.parent.mkdir()
+    fig.savefig(png)
+    plt.close(fig)
+    claims = [{"id": "C", "case": "c", "paper": "p", "rule": "r", "verdict": "partly",
+               "measured": "m", "map_setting": "high: 1.04 (not)",
+               "map_region": "holds at 0.3, 0.6"}]
+    maps = [{"study": "s", "claim": "C", "title": "t", "at_setting": "1.04", "region": "r",
+             "n_holds": 1, "n_cells": 2, "path": png}]
+    report = write_html(tmp_path / "out" / "report.html", claims=claims,
+                        metrics=[{"id": "r1", "control_cost": 0.1}], figures=[png],
+                        designs=[], meta={"title": "t"}, maps=maps, protocol=["a change"])
+    html = report.read_text()
+    moved = tmp_path / "elsewhere.html"
+    report.rename(moved)
+    for p in png.parent.glob("*"):
+        p.unlink()
+    text = moved.read_text()
+    assert text == html
+    refs = re.findall(r"""(?:src|href)\s*=\s*['"]([^'"]*)['"]|url\(([^)]*)\)""", text)
+    refs = [a or b for a, b in refs]
+    assert len(refs) == 2 and all(r.startswith("data:image/png;base64,") for r in refs)
+    assert "holds at 0.3, 0.6" in text and "a change" in text
