@@ -24,6 +24,7 @@ def small_study(n=4, t_end=0.4):
                     "events": [{"kind": "fault", "bus": 3, "t_on": 0.1,
                                 "t_off": 0.15 + 0.01 * k, "rf": 0.0, "xf": 0.1}]})
     d.update(scenarios=scs, figures=[], claims=[])
+    d.pop("sweep", None)          # no maps: the short runs only
     return study_from_dict(d, st.source, st.base_dir)
 
 

@@ -66,7 +66,7 @@ def test_dotted_paths_and_defaults():
     assert st.get("scenarios.1.id") == "c2-high-f100"
     # defaults a user expects: bypass = the fault windows, controllers = the compared ones
     assert st.scenarios()[0]["bypass"] == [[3.0, 3.2]]
-    assert st.get("scenarios.c2-high-f200.controllers") == ["hji", "lqr", "pss-only"]
+    assert st.get("scenarios.c2-high-f200.controllers") == ["hji", "lqr", "pss-only", "hji-bounded"]
     with pytest.raises(ParameterError, match="upqc.ratin"):
         st.get("upqc.ratin")
     # a fault may be given by its duration

@@ -32,18 +32,19 @@ SMALL_SWEEP = """
 mode = "product"
 scenarios = ["c1-high-conv"]
 controllers = ["nonlinear-29"]
-t_end = 0.35
+t_end = T_END
 [sweep.axes]
 "upqc.rating" = RATINGS
 "scenarios.c1-high-conv.events.0.bus" = [3, 99]
 """
 
 
-def _small_study(tmp_path, ratings=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3)) -> Path:
+def _small_study(tmp_path, ratings=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3), t_end=0.35) -> Path:
     """Case 1 with a small sweep: ratings × {bus 3, a bus that does not exist (fails)}."""
     src = resources.files("weakgrid") / "data" / "studies" / "case1-weak-grid.toml"
     text = src.read_text(encoding="utf-8")
-    text = text[: text.index(MARKER)] + SMALL_SWEEP.replace("RATINGS", str(list(ratings)))
+    text = text[: text.index(MARKER)] + SMALL_SWEEP.replace("RATINGS", str(list(ratings))).replace(
+        "T_END", str(t_end))
     p = tmp_path / "small.toml"
     p.write_text(text, encoding="utf-8")
     return p
@@ -129,7 +130,9 @@ def test_sweep_against_a_scheduler_address_gives_the_default_table(tmp_path):
 @pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_weakgrid_sweep_interrupted_and_restarted_completes_the_same_table(tmp_path, sig):
-    study = _small_study(tmp_path)
+    # runs long enough (1.5 s simulated each) that the signal lands while some still run,
+    # however loaded the machine is; the 6 failing runs (bus 99) finish first
+    study = _small_study(tmp_path, t_end=1.5)
     out = tmp_path / "out"
     cache = out / "cache"
     cmd = [sys.executable, "-m", "weakgrid.cli.main", "sweep", str(study), "-o", str(out),
