@@ -77,6 +77,28 @@ def positive_int(text) -> int:
     return v
 
 
+def nonnegative_int(text) -> int:
+    """An integer ≥ 0."""
+    try:
+        v = int(text)
+    except (TypeError, ValueError):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number (give an integer "
+                                         "≥ 0)") from None
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} must be ≥ 0")
+    return v
+
+
+def add_cluster_arguments(p):
+    """``--workers`` and ``--scheduler``: where the simulations of a command run (Dask)."""
+    p.add_argument("--workers", type=nonnegative_int, default=None,
+                   help="worker processes of the local Dask cluster that runs the simulations "
+                        "(default: one per core; 0 = serially in this process)")
+    p.add_argument("--scheduler", default=None,
+                   help="address of an existing Dask scheduler (tcp://host:port); default: a "
+                        "local cluster")
+
+
 def output_file(*suffixes):
     """A path to write, whose suffix must be one of ``suffixes`` (checked before any work)."""
     def parse(text) -> Path:

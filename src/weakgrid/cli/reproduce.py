@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._common import output_folder
+from ._common import add_cluster_arguments, output_folder
 
 NAME = "reproduce"
 
@@ -23,11 +23,7 @@ def add_parser(sub):
                    help="output folder")
     p.add_argument("--quick", action="store_true",
                    help="shorter runs and the essential subset of scenarios")
-    p.add_argument("--workers", type=int, default=None,
-                   help="worker processes of the local Dask cluster that runs the simulations "
-                        "(default: one per core; 0 = serially in this process)")
-    p.add_argument("--scheduler", default=None,
-                   help="address of an existing Dask scheduler (tcp://host:port)")
+    add_cluster_arguments(p)
     p.set_defaults(func=run)
     return p
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ._common import add_cluster_arguments
+
 NAME = "run"
 
 
@@ -23,11 +25,7 @@ def add_parser(sub):
     p.add_argument("--quick", action="store_true",
                    help="each scenario's quick settings (shorter runs, fewer controllers)")
     p.add_argument("--list", action="store_true", help="list the shipped studies")
-    p.add_argument("--workers", type=int, default=None,
-                   help="worker processes of the local Dask cluster that runs the simulations "
-                        "(default: one per core; 0 = serially in this process)")
-    p.add_argument("--scheduler", default=None,
-                   help="address of an existing Dask scheduler (tcp://host:port)")
+    add_cluster_arguments(p)
     p.set_defaults(func=run)
     return p
 

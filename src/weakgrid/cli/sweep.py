@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ._common import add_cluster_arguments
+
 NAME = "sweep"
 
 
@@ -23,12 +25,7 @@ def add_parser(sub):
     p.add_argument("study", help="a study file (TOML) or a shipped study's name")
     p.add_argument("--output", "-o", type=Path, default=None,
                    help="output folder (default: <study>-sweep)")
-    p.add_argument("--scheduler", default=None,
-                   help="address of an existing Dask scheduler (tcp://host:port); default: a "
-                        "local cluster")
-    p.add_argument("--workers", type=int, default=None,
-                   help="worker processes of the local cluster (default: one per core; 0 = "
-                        "serial, in this process)")
+    add_cluster_arguments(p)
     p.add_argument("--quick", action="store_true", help="the sweep's [sweep.quick] axes")
     p.add_argument("--signals", action="store_true",
                    help="keep every run's signals (Parquet, in the cache folder)")
@@ -40,13 +37,10 @@ def add_parser(sub):
 
 def run(args) -> int:
     """Run ``weakgrid sweep`` with the parsed ``args``; return the exit status."""
-    from ..game.errors import ParameterError
     from ..study.studyfile import load_study
     from ..study.sweep import run_study_sweep
     from ..sweep import SweepInterrupted
 
-    if args.workers is not None and args.workers < 0:
-        raise ParameterError("--workers", args.workers, "give a whole number ≥ 0 (0 = serial)")
     st = load_study(args.study)
     if args.signals and "sweep" in st.data:
         st.data["sweep"]["signals"] = True
