@@ -14,6 +14,12 @@ import pytest
 
 import weakgrid
 
+
+def _sigint_default():
+    """In the child: Ctrl-C acts, even when this test runs in a background job (which starts
+    its children with SIGINT ignored, so that Python would install no KeyboardInterrupt)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
 pytestmark = pytest.mark.slow
 
 SCRIPT = Path(__file__).with_name("small_reproduce.py")
@@ -23,6 +29,7 @@ N_RUNS = 4
 def _start(out):
     env = dict(os.environ, PYTHONPATH=str(Path(weakgrid.__file__).parents[1]))
     return subprocess.Popen([sys.executable, str(SCRIPT), str(out), str(N_RUNS), "0.4"],
+                            preexec_fn=_sigint_default,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
 
 

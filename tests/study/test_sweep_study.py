@@ -25,6 +25,12 @@ from weakgrid.study.sweep import run_point, sweep_points
 from weakgrid.study.sweep_maps import map_cells
 from weakgrid.sweep import expand, run_sweep
 
+
+def _sigint_default():
+    """In the child: Ctrl-C acts, even when this test runs in a background job (which starts
+    its children with SIGINT ignored, so that Python would install no KeyboardInterrupt)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
 MARKER = "# ------------------------------------------------------------------ where the claims hold"
 
 SMALL_SWEEP = """
@@ -138,7 +144,8 @@ def test_weakgrid_sweep_interrupted_and_restarted_completes_the_same_table(tmp_p
     cmd = [sys.executable, "-m", "weakgrid.cli.main", "sweep", str(study), "-o", str(out),
            "--workers", "2", "--no-progress"]
     env = dict(os.environ, PYTHONUNBUFFERED="1")
-    p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    p = subprocess.Popen(cmd, preexec_fn=_sigint_default, env=env, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE,
                          text=True)
     t0 = time.time()
     while len(list(cache.glob("*.json"))) < 2 and time.time() - t0 < 180:

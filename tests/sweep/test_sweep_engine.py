@@ -18,6 +18,12 @@ import pytest
 from weakgrid.game.errors import ParameterError
 from weakgrid.sweep import Axis, expand, get_path, run_key, run_sweep, set_path
 
+
+def _sigint_default():
+    """In the child: Ctrl-C acts, even when this test runs in a background job (which starts
+    its children with SIGINT ignored, so that Python would install no KeyboardInterrupt)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
 cloudpickle.register_pickle_by_value(sys.modules[__name__])
 
 BASE = {"upqc": {"rating": 0.15, "structure": "conventional"},
@@ -142,7 +148,8 @@ def test_interrupted_sweep_resumes_without_rerunning(tmp_path, sig):
     script.write_text(SCRIPT)
     cache, log = tmp_path / "cache", tmp_path / "log.txt"
     env = dict(os.environ, PYTHONUNBUFFERED="1")
-    p = subprocess.Popen([sys.executable, str(script), str(cache), str(log)], env=env,
+    p = subprocess.Popen([sys.executable, str(script), str(cache), str(log)],
+                         preexec_fn=_sigint_default, env=env,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     t0 = time.time()
     while len(list(cache.glob("*.json"))) < 2 and time.time() - t0 < 120:
