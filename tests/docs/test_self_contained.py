@@ -17,7 +17,8 @@ def repository_files():
     for top in ("src", "tests", "docs", "benchmarks", ".ci"):
         for p in sorted((ROOT / top).rglob("*")):
             if p.is_file() and p.suffix in SUFFIXES and "_build" not in p.parts \
-                    and "generated" not in p.parts and p != Path(__file__).resolve():
+                    and "generated" not in p.parts and p != Path(__file__).resolve() \
+                    and not any(q.endswith(".egg-info") for q in p.parts):  # build output
                 yield p
     for name in ("README.md", "pyproject.toml"):
         yield ROOT / name

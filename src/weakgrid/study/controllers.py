@@ -115,10 +115,17 @@ def _hji(ctx):
         "train_seconds": ctl.train_seconds})
 
 
+_BOUNDED = {}   # (design settings, design model, bound) -> trained controller, per process
+
+
 def _hji_bounded(ctx):
+    from ..sweep.cache import canonical_json
+
     ubar = float(ctx.options.get("u_bound", ctx.study.data["upqc"]["rating"]))
-    problem = design_problem(ctx.study, ctx.design).with_rating(ubar)
-    ctl = problem.train()
+    key = canonical_json([ctx.study.data["design"], ctx.design.to_dict(), ubar])
+    ctl = _BOUNDED.get(key)
+    if ctl is None:   # every run of one operating point shares one training
+        ctl = _BOUNDED[key] = design_problem(ctx.study, ctx.design).with_rating(ubar).train()
     return ControllerChoice(ctx.name, ctl.control, info={
         "weights": ctl.weights.tolist(), "iterations": ctl.iterations,
         "train_seconds": ctl.train_seconds, "u_bound": ctl.cost.bound.to_dict()})

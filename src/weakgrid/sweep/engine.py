@@ -124,8 +124,6 @@ def open_client(scheduler=None, workers=None):
         cluster.close()
 
 
-_client = open_client
-
 
 def _progress(total, initial, enabled, desc):
     from tqdm.auto import tqdm
@@ -227,7 +225,7 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
                 from distributed import as_completed
 
                 ctx = contextlib.nullcontext(client) if client is not None else \
-                    _client(scheduler, workers)
+                    open_client(scheduler, workers)
                 with ctx as cl:
                     futs = [cl.submit(execute, run, p.inputs, k, key=f"weakgrid-run-{k}",
                                           pure=False) for p, k in todo_unique]
