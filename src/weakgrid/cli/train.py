@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 
 from ..game.hji import closed_loop_spectral_radius
+from ..game.checkpoint import (CheckpointError, StaleCheckpointError, load_checkpoint,
+                               save_checkpoint)
 from ..game.errors import ParameterError
 from ._common import (add_force_argument, add_problem_arguments, guard_training, output_file,
                       positive_float, problem_of)
@@ -35,6 +38,9 @@ def add_parser(sub):
     p.add_argument("--u-bound-shape", choices=("disk", "box"), default=None,
                    help="shape of --u-bound (default: the problem's, else disk)")
     p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
+    p.add_argument("--restart", action="store_true",
+                   help="start over, ignoring the checkpoint of an interrupted training "
+                        "(OUTPUT with the suffix .checkpoint.npz)")
     add_force_argument(p)
     p.set_defaults(func=run)
     return p
@@ -74,6 +80,13 @@ def run(args) -> int:
           f"{list(problem.mesh.step)}  ({mesh_n} points);  basis {problem.basis.size} terms")
     print(f"  solver  δu = {settings.tol_u:g}, δw = {settings.tol_w:g}")
     guard_training(problem, args.force)
+    out = args.output or Path(f"{problem.name}.controller.json")
+    ckpt = checkpoint_path(out)
+    key = training_key(problem, settings)
+    start = None if args.restart else _load_start(ckpt, key)
+    if start is not None:
+        print(f"  resuming from the checkpoint {ckpt}: {start.outer} finished outer "
+              f"iteration(s) kept, continuing at iteration {start.outer + 1}")
     if not args.quiet:
         print("\n  outer  inner    max|Δu|     max|Δw| (last)   residual    min J     "
               "max eig Yw  min eig Yu" + ("  bound binds" if c.bound is not None else ""))
@@ -81,7 +94,8 @@ def run(args) -> int:
     from tqdm.auto import tqdm
 
     # the bar (stderr, only on a terminal) counts outer iterations and shows max|Δu| vs δu
-    bar = tqdm(desc="  training", unit=" outer it", leave=False, disable=None)
+    bar = tqdm(desc="  training", unit=" outer it", leave=False, disable=None,
+               initial=start.outer if start is not None else 0)
 
     def progress(rec):
         bar.update(1)
@@ -92,9 +106,31 @@ def run(args) -> int:
                        f"{rec.max_eig_Yw:10.3g}  {rec.min_eig_Yu:10.3g}"
                        + (f"  {100 * rec.bound_active:9.1f} %" if rec.bound_active is not None
                           else ""), file=sys.stdout)
+            sys.stdout.flush()
+
+    # the finished outer iterations are saved at most every CHECKPOINT_SECONDS, and on an
+    # interruption (Ctrl-C, SIGTERM) before the error boundary reports it
+    kept = {"state": None, "saved": start.outer if start is not None else 0,
+            "at": time.monotonic()}
+
+    def keep(state):
+        kept["state"] = state
+        if time.monotonic() - kept["at"] >= CHECKPOINT_SECONDS:
+            save_checkpoint(ckpt, state, key)
+            kept["saved"], kept["at"] = state.outer, time.monotonic()
 
     try:
-        ctl = problem.train(settings, progress=progress)
+        ctl = problem.train(settings, progress=progress, start=start, checkpoint=keep)
+    except KeyboardInterrupt:
+        bar.close()
+        state = kept["state"]
+        if state is not None and state.outer > kept["saved"]:
+            save_checkpoint(ckpt, state, key)
+            kept["saved"] = state.outer
+        if kept["saved"]:
+            print(f"\n  kept {kept['saved']} finished outer iteration(s) in {ckpt}; re-run "
+                  "the same command to continue", flush=True)
+        raise
     finally:
         bar.close()
     it = ctl.iterations
@@ -138,7 +174,47 @@ def run(args) -> int:
     print(f"    closed loop under u* linearized at 0: spectral radius {rho:.6f} "
           f"({'stable' if rho < 1 else 'UNSTABLE'})")
     print(f"    relative residual of the last fit: {ctl.history[-1].residual:.3e}")
-    out = args.output or Path(f"{problem.name}.controller.json")
     ctl.save(out)
     print(f"\n  wrote {out}")
+    if ckpt.exists():
+        ckpt.unlink()
     return 0
+
+
+# ------------------------------------------------------------------ checkpoints
+CHECKPOINT_SECONDS = 1.0  # a training shorter than this writes no checkpoint unless stopped
+
+
+def checkpoint_path(out: Path) -> Path:
+    """The checkpoint of the training that writes ``out``: beside it, ``.checkpoint.npz``."""
+    return out.with_suffix(".checkpoint.npz")
+
+
+def training_key(problem, settings) -> str:
+    """A content hash of everything a training depends on: the problem file as read, the
+    model, cost (with any bound), mesh, basis and solver settings after the command-line
+    overrides, and the code (every source and data file of the package, with its version)."""
+    import hashlib
+
+    from ..sweep.cache import canonical_json, code_fingerprint
+
+    inputs = {"command": NAME, "problem": problem.raw, "name": problem.name,
+              "cost": problem.cost.to_dict(), "mesh": problem.mesh.to_dict(),
+              "basis": problem.basis.to_dict(), "settings": settings.to_dict()}
+    text = canonical_json({"inputs": inputs, "code": code_fingerprint()})
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+def _load_start(ckpt: Path, key: str):
+    """The state in the checkpoint ``ckpt`` if it is of these inputs, else None (said why)."""
+    if not ckpt.exists():
+        return None
+    try:
+        return load_checkpoint(ckpt, key)
+    except StaleCheckpointError:
+        print(f"  the checkpoint {ckpt} is of other inputs (the problem, the settings or the "
+              "code changed): starting over; it will be replaced")
+    except CheckpointError as exc:
+        print(f"weakgrid train: warning: {exc}: ignored, starting over (it will be replaced; "
+              "delete it to silence this warning)", file=sys.stderr, flush=True)
+    return None

@@ -390,6 +390,8 @@ def solve_hji(
     *,
     problem: dict | None = None,
     progress: Callable[[IterationRecord], None] | None = None,
+    start=None,
+    checkpoint: Callable | None = None,
 ) -> GameController:
     """Solve the approximate HJI equation by two-loop policy iteration.
 
@@ -408,6 +410,14 @@ def solve_hji(
         Extra description recorded in the controller (e.g. the preset name).
     progress : callable, optional
         Called with each :class:`IterationRecord` as it completes.
+    start : TrainingState, optional
+        Continue from these finished outer iterations (a checkpoint of the same
+        inputs, :mod:`weakgrid.game.checkpoint`): the result is the same, bit for
+        bit, as that of a run that was never interrupted.
+    checkpoint : callable, optional
+        Called with the :class:`~weakgrid.game.checkpoint.TrainingState` after each
+        finished outer iteration (before ``progress``); e.g. keep it to save on an
+        interruption.
 
     Returns
     -------
@@ -457,8 +467,14 @@ def solve_hji(
     history: list[IterationRecord] = []
     u = np.ascontiguousarray(u.T)  # (m, p): per-point quantities are kept as planes
     g2 = cost.gamma**2
-    cs = pr.set_column_scale(u)
-    for i in range(1, settings.max_outer + 1):
+    cs = pr.set_column_scale(u)  # from the initial policy, also when resuming
+    first, seconds_before, done = 1, 0.0, False
+    if start is not None:
+        u, history, first, seconds_before, done = _resume(start, p, system.n_controls,
+                                                          basis.size, settings)
+    for i in range(first, settings.max_outer + 1):
+        if done:  # the checkpoint already holds the converged iteration
+            break
         w = np.zeros((q, p))
         base_Y = pr.Qx + (_quad_planes(cost.R, u) if bound is None
                           else bound.penalty(u.T, cost.R))
@@ -560,9 +576,14 @@ def solve_hji(
             weights=W, min_J=float((pr.phi_s @ Ws).min()),
             max_eig_Yw=float(eYw.max()), min_eig_Yu=float(eYu.min()), bound_active=active)
         history.append(rec)
+        u = u_new
+        if checkpoint is not None:  # before progress: an iteration reported is one kept
+            from .checkpoint import TrainingState
+
+            checkpoint(TrainingState(i, u.T, list(history),
+                                     seconds_before + time.perf_counter() - t0))
         if progress is not None:
             progress(rec)
-        u = u_new
         if du <= settings.tol_u:
             break
         if (i >= 20 and du <= _ROUNDOFF * max(float(np.abs(u).max()), 1e-300)
@@ -573,11 +594,16 @@ def solve_hji(
                 f"{float(np.abs(u).max()):.2e}). Fix: use tol_u ≥ {10 * du:.0e} (e.g. 1e-7)",
                 history)
     else:
-        raise ConvergenceError(
-            f"the outer (control) loop did not converge in {settings.max_outer} iterations: "
-            f"last max|Δu| = {history[-1].max_du:.3e} > δu = {settings.tol_u:g} (changes of "
-            f"the last iterations: {[f'{r.max_du:.2e}' for r in history[-5:]]}). Raise "
-            "max_outer or loosen tol_u.", history)
+        if not done:
+            raise ConvergenceError(
+                f"the outer (control) loop did not converge in {settings.max_outer} "
+                f"iterations: last max|Δu| = {history[-1].max_du:.3e} > δu = "
+                f"{settings.tol_u:g} (changes of the last iterations: "
+                f"{[f'{r.max_du:.2e}' for r in history[-5:]]}). Raise max_outer or loosen "
+                "tol_u.", history)
+    if done:  # resumed after the last iteration: its weights are the result
+        W = history[-1].weights
+        Ws = W / cs
 
     J = pr.phi_s @ Ws
     if J.min() < -1e-9 * max(1.0, float(np.abs(J).max())):
@@ -587,7 +613,7 @@ def solve_hji(
             f"(minimum {J[k]:.3g} at x = {X[k].tolist()}): the basis cannot represent a "
             "nonnegative value on this region; use a richer basis or a smaller region",
             RuntimeWarning, stacklevel=2)
-    elapsed = time.perf_counter() - t0
+    elapsed = seconds_before + time.perf_counter() - t0
     record = {
         "model": _system_record(system),
         "cost": cost.to_dict(),
@@ -602,6 +628,25 @@ def solve_hji(
         record.update(problem)
     return GameController(system=system, basis=basis, weights=W, cost=cost, problem=record,
                           history=history, train_seconds=elapsed)
+
+
+def _resume(start, p, m, L, settings):
+    """The loop state from a :class:`~weakgrid.game.checkpoint.TrainingState`, checked
+    against this problem: ``(u (m, p), history, first outer index, seconds, converged)``."""
+    policy = np.asarray(start.policy, float)
+    if policy.shape != (p, m):
+        raise ShapeError("checkpoint policy", policy.shape, f"({p}, {m}) for this mesh "
+                         "and model: the checkpoint is of another problem")
+    if len(start.history) != start.outer or start.outer < 1:
+        raise ParameterError("checkpoint outer", start.outer,
+                             f"holds {len(start.history)} iteration records")
+    if any(np.shape(r.weights) != (L,) for r in start.history):
+        raise ShapeError("checkpoint weights", np.shape(start.history[-1].weights),
+                         f"({L},) for this basis")
+    history = list(start.history)
+    done = history[-1].max_du <= settings.tol_u
+    return (np.ascontiguousarray(policy.T), history, start.outer + 1, float(start.seconds),
+            done)
 
 
 def _system_record(system):

@@ -241,13 +241,16 @@ class TrainingProblem:
     raw: dict = field(default_factory=dict)
     source: str = ""
 
-    def train(self, settings: SolverSettings | None = None, progress=None) -> GameController:
-        """Run the two-loop policy iteration (docs/theory.md, (25)–(28))."""
+    def train(self, settings: SolverSettings | None = None, progress=None, *, start=None,
+              checkpoint=None) -> GameController:
+        """Run the two-loop policy iteration (docs/theory.md, (25)–(28)); ``start`` and
+        ``checkpoint`` resume and record it (see :func:`weakgrid.game.hji.solve_hji`)."""
         extra = {"name": self.name, "source": self.source}
         if self.published and self.cost.bound is None:
             extra["published"] = self.published
         return solve_hji(self.system, self.basis, self.cost, self.mesh, self.initial_policy,
-                         settings or self.settings, problem=extra, progress=progress)
+                         settings or self.settings, problem=extra, progress=progress,
+                         start=start, checkpoint=checkpoint)
 
     def with_gamma(self, gamma: float) -> "TrainingProblem":
         c = self.cost
