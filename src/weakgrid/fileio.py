@@ -60,7 +60,11 @@ def _target(path) -> Path:
 
 
 def _temp_beside(path: Path) -> str:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as exc:  # name the target, not the temporary, in the error
+        exc.filename = str(path)
+        raise
     os.close(fd)
     return tmp
 

@@ -94,9 +94,54 @@ def add_cluster_arguments(p):
     p.add_argument("--workers", type=nonnegative_int, default=None,
                    help="worker processes of the local Dask cluster that runs the simulations "
                         "(default: one per core; 0 = serially in this process)")
-    p.add_argument("--scheduler", default=None,
+    p.add_argument("--scheduler", type=scheduler_address, default=None,
                    help="address of an existing Dask scheduler (tcp://host:port); default: a "
                         "local cluster")
+
+
+_SCHEMES = ("tcp", "tls", "ucx", "ws", "wss")
+
+
+def scheduler_address(text) -> str:
+    """A Dask scheduler address ``[tcp://]host:port`` (the form is checked, not the host)."""
+    from urllib.parse import urlsplit
+
+    s = text.strip()
+    url = urlsplit(s if "://" in s else f"tcp://{s}")
+    try:
+        port = url.port
+    except ValueError:
+        port = None
+    if url.scheme not in _SCHEMES or not url.hostname or port is None or not 0 < port < 65536 \
+            or url.path not in ("", "/"):
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a scheduler address: give tcp://HOST:PORT (e.g. "
+            "tcp://10.0.0.5:8786), as `dask scheduler` prints it")
+    host = f"[{url.hostname}]" if ":" in url.hostname else url.hostname
+    return f"{url.scheme}://{host}:{port}"
+
+
+def check_cluster(args, timeout: float = 5.0):
+    """Before any work: the scheduler given by ``--scheduler`` answers on its port."""
+    import socket
+    from urllib.parse import urlsplit
+
+    from ..game.errors import ParameterError
+
+    address = getattr(args, "scheduler", None)
+    if not address:
+        return
+    url = urlsplit(address)
+    if url.scheme not in ("tcp", "tls"):
+        return  # other transports: Dask reports them itself
+    try:
+        socket.create_connection((url.hostname, url.port), timeout=timeout).close()
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise ParameterError("--scheduler", address,
+                             f"no Dask scheduler answers there ({reason}). Fix: start it "
+                             "(`dask scheduler`) and check the address, or leave out "
+                             "--scheduler to use a local cluster") from None
 
 
 def output_file(*suffixes):
@@ -126,6 +171,13 @@ def _check_writable_folder(folder: Path, text):
     if not q.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r}: {str(q)!r} is a file, not a folder")
     if not os.access(q, os.W_OK | os.X_OK):
+        try:
+            readonly = bool(os.statvfs(q).f_flag & os.ST_RDONLY)
+        except (OSError, AttributeError):  # pragma: no cover
+            readonly = False
+        if readonly:
+            raise argparse.ArgumentTypeError(f"{text!r}: {str(q)!r} is on a read-only file "
+                                             "system; write elsewhere")
         raise argparse.ArgumentTypeError(f"{text!r}: no permission to write in {str(q)!r}")
 
 

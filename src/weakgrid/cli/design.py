@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ._common import output_file
 from ._study import add_operating_point, add_study_argument, study_of
 
 NAME = "design"
@@ -22,7 +23,7 @@ def add_parser(sub):
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     add_study_argument(p)
     add_operating_point(p)
-    p.add_argument("--output", "-o", type=Path, default=None,
+    p.add_argument("--output", "-o", type=output_file(".json"), default=None,
                    help="controller file (default: <study>-<load>-<upqc>.controller.json)")
     p.add_argument("--no-train", action="store_true", help="derive and check only")
     p.set_defaults(func=run)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ._common import nonnegative_float, output_file
 from ._study import add_operating_point, add_study_argument, study_of
 
 NAME = "modes"
@@ -21,8 +22,10 @@ def add_parser(sub):
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     add_study_argument(p)
     add_operating_point(p)
-    p.add_argument("--min-hz", type=float, default=0.0, help="list modes above this frequency")
-    p.add_argument("--plot", type=Path, default=None, help="eigenvalue plot (.png or .svg)")
+    p.add_argument("--min-hz", type=nonnegative_float, default=0.0,
+                   help="list modes above this frequency (Hz, ≥ 0)")
+    p.add_argument("--plot", type=output_file(".png", ".svg", ".pdf"), default=None,
+                   help="eigenvalue plot (.png, .svg or .pdf)")
     p.set_defaults(func=run)
     return p
 
@@ -83,6 +86,9 @@ def run(args) -> int:
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
         fig.tight_layout()
-        fig.savefig(args.plot, dpi=110)
+        from ..fileio import savefig_atomic
+
+        savefig_atomic(fig, args.plot, dpi=110)
+        plt.close(fig)
         print(f"  wrote {args.plot}")
     return 0

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._common import add_cluster_arguments
+from ._common import add_cluster_arguments, check_cluster, output_folder
 
 NAME = "run"
 
@@ -20,7 +20,7 @@ def add_parser(sub):
                     "report.html.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     p.add_argument("study", nargs="?", help="a study file (TOML) or a shipped study's name")
-    p.add_argument("--output", "-o", type=Path, default=None,
+    p.add_argument("--output", "-o", type=output_folder, default=None,
                    help="output folder (default: <study>-output)")
     p.add_argument("--quick", action="store_true",
                    help="each scenario's quick settings (shorter runs, fewer controllers)")
@@ -34,14 +34,20 @@ def run(args) -> int:
     """Run ``weakgrid run`` with the parsed ``args``; return the exit status."""
     from ..study.studyfile import load_study, shipped_studies
 
-    if args.list or not args.study:
+    if args.list:
         for n in shipped_studies():
             st = load_study(n)
             print(f"  {n:<28} {st.data['study']['title']}")
-        return 0 if args.list else 2
+        return 0
+    if not args.study:
+        from ..game.errors import ParameterError
+
+        raise ParameterError("STUDY", None, f"give a study file (TOML) or a shipped study's "
+                             f"name: {shipped_studies()} (`weakgrid run --list`)")
     from ..study.engine import run_studies
 
     st = load_study(args.study)
+    check_cluster(args)
     out = args.output or Path(f"{st.name}-output")
     summary = run_studies([st], out, quick=args.quick, title=st.data["study"]["title"] or st.name,
                           scheduler=args.scheduler, workers=args.workers)

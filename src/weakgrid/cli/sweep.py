@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._common import add_cluster_arguments
+from ._common import add_cluster_arguments, check_cluster, output_folder
 
 NAME = "sweep"
 
@@ -23,7 +23,7 @@ def add_parser(sub):
                     "free.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     p.add_argument("study", help="a study file (TOML) or a shipped study's name")
-    p.add_argument("--output", "-o", type=Path, default=None,
+    p.add_argument("--output", "-o", type=output_folder, default=None,
                    help="output folder (default: <study>-sweep)")
     add_cluster_arguments(p)
     p.add_argument("--quick", action="store_true", help="the sweep's [sweep.quick] axes")
@@ -44,6 +44,7 @@ def run(args) -> int:
     st = load_study(args.study)
     if args.signals and "sweep" in st.data:
         st.data["sweep"]["signals"] = True
+    check_cluster(args)
     out = args.output or Path(f"{st.name}-sweep")
     try:
         table = run_study_sweep(st, out, quick=args.quick, scheduler=args.scheduler,

@@ -37,6 +37,7 @@ import numpy as np
 from ..design import derive_design
 from ..design.upqc_insert import insert_upqc_matpower, insert_upqc_pandapower
 from ..game.errors import ParameterError
+from ..sim.errors import DataError
 from ..sim.controllers import gti_design_states, sg_design_states
 from ..sim.gti import GTI
 from ..sim.network import BR_R, BR_X, F_BUS, GEN_BUS, T_BUS, Network
@@ -365,7 +366,15 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
             if part in gen:
                 p = dict(gen[part])
                 parts[part] = (p.pop("model"), p)
-        s.add_generator(gen["name"], gen_row(gen["bus"], f"dynamics.generator.{i}.bus"), **parts)
+        try:
+            s.add_generator(gen["name"], gen_row(gen["bus"], f"dynamics.generator.{i}.bus"),
+                            **parts)
+        except DataError as exc:  # an unknown model: name the study field
+            bad = [k for k, (m, _) in parts.items() if m == exc.value]
+            if exc.element != "model" or not bad:
+                raise
+            raise ParameterError(f"dynamics.generator.{i}.{bad[0]}.model", exc.value,
+                                 exc.fix) from None
     gti_names = [gt["name"] for gt in dyn["gti"]]
     if variant == "pq" and ctl_name not in gti_names:
         raise ParameterError("controller", "pq", "the PQ baseline replaces the UPQC by the "

@@ -262,10 +262,13 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         _num(g, "Sb_mva", "grid", 100.0, positive=True)
         g.setdefault("Sb_mva", 100.0)
         g.setdefault("f_hz", 60.0)
+        _inline_grid(g)
     elif g["kind"] == "pandapower":
         _need(g, "network", "grid", str)
     else:
         _need(g, "file", "grid", str)
+    if "f_hz" in g:
+        _num(g, "f_hz", "grid", positive=True)
     dyn = d.setdefault("dynamics", {})
     _keys(dyn, {"generator", "gti"}, "dynamics")
     names = []
@@ -414,3 +417,56 @@ def _event(ev, w, t_end):
         _num(ev, "t", w, nonneg=True)
         ev["dP"] = _num(ev, "dP", w, 0.0)
         ev["dQ"] = _num(ev, "dQ", w, 0.0)
+
+
+def _inline_grid(g):
+    """Types and ranges of an inline grid's tables (the simulator checks the physics)."""
+    def whole(d, key, w, lo=None):
+        v = _need(d, key, w)
+        if isinstance(v, bool) or not isinstance(v, int) or (lo is not None and v < lo):
+            raise ParameterError(f"{w}.{key}", v, "must be a whole number"
+                                 + (f" ≥ {lo}" if lo is not None else ""))
+        return v
+
+    def ref(d, key, w):
+        v = _need(d, key, w)
+        if isinstance(v, bool) or not isinstance(v, (int, str)):
+            raise ParameterError(f"{w}.{key}", v, "give a bus number or a bus name")
+
+    for i, b in enumerate(g["bus"]):
+        w = f"grid.bus.{i}"
+        if not isinstance(b, dict):
+            raise ParameterError(w, b, "must be a table [[grid.bus]] with id, type, base_kv")
+        whole(b, "id", w, lo=0)
+        if b.get("type", 1) not in (1, 2, 3):
+            raise ParameterError(f"{w}.type", b.get("type"), "1 (PQ), 2 (PV) or 3 (slack)")
+        _num(b, "base_kv", w, 1.0, positive=True)
+    for level, table in (g.get("loads") or {}).items():
+        if not isinstance(table, dict):
+            raise ParameterError(f"grid.loads.{level}", table, "must be a table: "
+                                 "BUS = [P_MW, Q_Mvar]")
+        for bus, pq in table.items():
+            w = f"grid.loads.{level}.{bus}"
+            if not (isinstance(pq, list) and len(pq) == 2):
+                raise ParameterError(w, pq, "give [P_MW, Q_Mvar]")
+            for k, v in enumerate(pq):
+                _num({"PQ"[k]: v}, "PQ"[k], w)
+    for i, gg in enumerate(g["gen"]):
+        w = f"grid.gen.{i}"
+        if not isinstance(gg, dict):
+            raise ParameterError(w, gg, "must be a table [[grid.gen]]")
+        ref(gg, "bus", w)
+        for k in ("P_mw", "Q_mvar"):
+            _num(gg, k, w, 0.0)
+        _num(gg, "V_set", w, 1.0, positive=True)
+        _num(gg, "Mbase", w, 100.0, positive=True)
+    for i, br in enumerate(g["branch"]):
+        w = f"grid.branch.{i}"
+        if not isinstance(br, dict):
+            raise ParameterError(w, br, "must be a table [[grid.branch]]")
+        for k in ("from", "to"):
+            whole(br, k, w, lo=0)
+        for k in ("r", "x"):
+            _num(br, k, w)
+        for k in ("b", "tap", "shift"):
+            _num(br, k, w, 0.0)

@@ -82,13 +82,37 @@ def validate_sweep(d: dict, study) -> None:
         if not isinstance(axes, dict) or not axes:
             raise ParameterError(where, axes, "give a table of dotted path = list of values")
         for path, vals in axes.items():
-            get_path(d, path)   # the field exists (error names it)
+            try:
+                get_path(d, path)   # the field exists
+            except ParameterError as exc:
+                raise ParameterError(f"{where}.\"{path}\"", path, f"no such study field: "
+                                     f"{exc.field}: {exc.fix}") from None
             if not isinstance(vals, list) or not vals:
                 raise ParameterError(f"{where}.\"{path}\"", vals, "give a non-empty list")
+            for v in vals:
+                _check_axis_value(d, where, path, v)
+    for where, t in (("sweep.t_end", sw.get("t_end")),
+                     ("sweep.quick.t_end", (sw.get("quick") or {}).get("t_end"))):
+        if t is not None and (isinstance(t, bool) or not isinstance(t, (int, float))
+                              or not 0 < t < float("inf")):
+            raise ParameterError(where, t, "give the simulated time of every run, a number "
+                                 "> 0 (s)")
     for path, vals in (sw.get("dt_check") or {}).items():
         if path not in sw.get("axes", {}) or not isinstance(vals, list):
             raise ParameterError(f"sweep.dt_check.\"{path}\"", vals, "give a list of values of "
                                  "a swept field (a path of [sweep.axes])")
+
+
+def _check_axis_value(d, where, path, value):
+    """A value of an axis must be valid for its field: the study with it is validated."""
+    trial = {k: copy.deepcopy(v) for k, v in d.items() if k != "sweep"}
+    try:
+        set_path(trial, path, copy.deepcopy(value))
+        study_from_dict(trial)
+    except ParameterError as exc:
+        fix = exc.fix if exc.field == path else str(exc)
+        raise ParameterError(f"{where}.\"{path}\"", value,
+                             f"not a valid value of {path}: {fix}") from None
 
 
 def _axes(sw: dict, quick: bool) -> dict:
