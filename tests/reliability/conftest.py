@@ -18,6 +18,7 @@ import pytest
 from weakgrid.cli.main import main
 
 PRESET = Path(str(resources.files("weakgrid") / "data" / "presets" / "case1-paper.toml"))
+STUDY = Path(str(resources.files("weakgrid") / "data" / "studies" / "case1-weak-grid.toml"))
 
 
 @pytest.fixture(scope="session")
@@ -48,6 +49,22 @@ class Workspace:
         text = edit(PRESET.read_text())
         assert text != PRESET.read_text(), "the edit changed nothing"
         p.write_text(text)
+        return p
+
+    @property
+    def study(self) -> Path:
+        """A copy of the shipped study case1-weak-grid (made on first use)."""
+        p = self.root / "study.toml"
+        if not p.exists():
+            p.write_text(STUDY.read_text())
+        return p
+
+    def study_with(self, old: str, new: str) -> Path:
+        """A copy of the study with the first ``old`` replaced by ``new``."""
+        text = STUDY.read_text()
+        assert old in text, f"{old!r} is not in the study"
+        p = self.root / "edited-study.toml"
+        p.write_text(text.replace(old, new, 1))
         return p
 
     def controller_with(self, edit) -> Path:
