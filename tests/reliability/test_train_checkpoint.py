@@ -99,7 +99,7 @@ def test_restart_ignores_a_checkpoint(ws, cli, states):
     problem = load_preset("case1-paper")
     out = ws.root / "c.controller.json"
     save_checkpoint(checkpoint_path(out), kept[9], training_key(problem, problem.settings))
-    code, stdout, err = cli(["train", "--preset", "case1-paper", "-o", out, "--restart"])
+    code, stdout, _ = cli(["train", "--preset", "case1-paper", "-o", out, "--restart"])
     assert code == 0 and "resuming" not in stdout and _rows(stdout)[0] == 1
 
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from ._common import nonnegative_float, output_file
 from ._study import add_operating_point, add_study_argument, study_of
