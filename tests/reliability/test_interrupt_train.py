@@ -90,3 +90,29 @@ def test_interrupted_training_resumes_and_gives_the_same_weights(tmp_path, refer
     assert [h["max_du"] for h in rec["history"]] == [r.max_du for r in reference.history]
     assert rec["iterations"]["outer"] == len(reference.history)
     assert not ckpt.exists()  # a finished training removes its checkpoint
+
+
+def test_a_killed_training_resumes_from_its_last_periodic_checkpoint(tmp_path, reference):
+    """SIGKILL (or a power cut): no handler runs, yet the iterations saved by the periodic
+    checkpoint (every second) are not redone, and the result is the same."""
+    out = tmp_path / "c.controller.json"
+    ckpt = tmp_path / "c.controller.checkpoint.npz"
+    proc = _start(out)
+    deadline = time.monotonic() + 300
+    while not ckpt.exists():
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, "no checkpoint in 5 minutes"
+        time.sleep(0.02)
+    proc.kill()
+    proc.communicate(timeout=60)
+    assert proc.returncode == -signal.SIGKILL
+    n_saved = len(np.load(ckpt, allow_pickle=False)["weights"])  # a complete file
+    assert 1 <= n_saved < len(reference.history)
+    assert not out.exists()
+
+    proc = _start(out)
+    stdout, stderr = proc.communicate(timeout=300)
+    assert proc.returncode == 0, stderr
+    assert f"{n_saved} finished outer iteration(s) kept" in stdout
+    assert _rows(stdout) == list(range(n_saved + 1, len(reference.history) + 1))
+    np.testing.assert_array_equal(json.loads(out.read_text())["weights"], reference.weights)

@@ -113,3 +113,20 @@ def test_a_checkpoint_of_another_mesh_is_refused_by_the_solver(states):
     state = replace(kept[3], policy=kept[3].policy[:-1])  # one mesh point fewer
     with pytest.raises(ShapeError, match="checkpoint policy"):
         p.train(start=state)
+
+
+def test_the_key_changes_with_every_input_and_with_the_code(monkeypatch):
+    from dataclasses import replace
+
+    import weakgrid.sweep.cache as cache
+
+    p = load_preset("case1-paper")
+    key = training_key(p, p.settings)
+    assert training_key(load_preset("case1-paper"), p.settings) == key  # reproducible
+    others = [training_key(p.with_input_bound(0.5), p.settings),       # --u-bound
+              training_key(p.with_gamma(25.0), p.settings),            # the cost
+              training_key(p, replace(p.settings, max_inner=100)),     # the solver
+              training_key(load_preset("case2-paper"), p.settings)]    # another problem
+    monkeypatch.setattr(cache, "code_fingerprint", lambda: "another version of the code")
+    others.append(training_key(p, p.settings))
+    assert len({key, *others}) == len(others) + 1
