@@ -67,6 +67,15 @@ class Workspace:
         p.write_text(text.replace(old, new, 1))
         return p
 
+    @staticmethod
+    def closed_port() -> int:
+        """A local TCP port with nobody listening (bound, then released)."""
+        import socket
+
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            return s.getsockname()[1]
+
     def controller_with(self, edit) -> Path:
         """A controller file whose record (a deep copy) is changed by ``edit(d)``."""
         d = json.loads(json.dumps(self.record))

@@ -105,6 +105,8 @@ CATALOGUE = [
     ("simulate-unknown-controller", "arguments", lambda ws: ["simulate", "case1-weak-grid", "-c", "mpc"], 2, ["--controller", "mpc"]),
     ("reproduce-output-is-file", "arguments", lambda ws: ["reproduce", "-o", ws.precious], 2, ["--output", "precious.json", "not a folder"]),
     ("reproduce-output-under-file", "arguments", lambda ws: ["reproduce", "-o", ws.precious / "sub"], 2, ["--output", "precious.json"]),
+    ("reproduce-scheduler-unreachable", "arguments", lambda ws: ["reproduce", "--quick", "-o", ws.root / "rep", "--scheduler", f"tcp://127.0.0.1:{ws.closed_port()}"], 2, ["--scheduler", "127.0.0.1", "no Dask scheduler"]),
+    ("reproduce-workers-too-many", "arguments", lambda ws: ["reproduce", "--workers", "99999"], 2, ["--workers", "99999", "at most"]),
     ("unknown-command", "arguments", lambda ws: ["bake"], 2, ["bake"]),
     # ---------------------------------------------------------------- problem files
     ("problem-Q-text", "problem file", problem("Q = 0.01", 'Q = "abc"'), 2, ["cost.Q", "abc", "edited.toml"]),

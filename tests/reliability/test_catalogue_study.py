@@ -8,7 +8,6 @@ training starts; the checks are those of ``test_catalogue_cli.py``.
 
 from __future__ import annotations
 
-import socket
 import subprocess
 
 import pytest
@@ -16,13 +15,6 @@ import pytest
 RATING = "rating = 0.15"
 AXIS = '"upqc.rating" = [0.1, 0.15, 0.3, 0.6, 1.0]'
 FAULT = "events = [{ kind = \"fault\", bus = 3, t_on = 0.2, t_off = 0.25, rf = 0.0, xf = 0.1 }]"
-
-
-def closed_port() -> int:
-    """A local TCP port with nobody listening (bound, then released)."""
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def design(old, new):
@@ -91,10 +83,11 @@ CATALOGUE = [
     ("run-missing-study", "study arguments", lambda ws: ["run", "nope.toml"], 2, ["study", "nope.toml"]),
     ("run-workers-negative", "study arguments", lambda ws: ["run", ws.study, "--workers", "-1"], 2, ["--workers", "-1"]),
     ("run-workers-text", "study arguments", lambda ws: ["run", ws.study, "--workers", "two"], 2, ["--workers", "two"]),
+    ("run-workers-too-many", "study arguments", lambda ws: ["run", ws.study, "--workers", "100000"], 2, ["--workers", "100000", "at most"]),
     ("run-workers-fraction", "study arguments", lambda ws: ["run", ws.study, "--workers", "1.5"], 2, ["--workers", "1.5"]),
     ("run-scheduler-malformed", "study arguments", lambda ws: ["run", ws.study, "--scheduler", "nonsense"], 2, ["--scheduler", "nonsense", "tcp://"]),
     ("run-scheduler-no-port", "study arguments", lambda ws: ["run", ws.study, "--scheduler", "tcp://localhost"], 2, ["--scheduler", "tcp://localhost"]),
-    ("run-scheduler-unreachable", "study arguments", lambda ws: ["run", ws.study, "--scheduler", f"tcp://127.0.0.1:{closed_port()}"], 2, ["--scheduler", "tcp://127.0.0.1:", "no Dask scheduler"]),
+    ("run-scheduler-unreachable", "study arguments", lambda ws: ["run", ws.study, "--scheduler", f"tcp://127.0.0.1:{ws.closed_port()}"], 2, ["--scheduler", "tcp://127.0.0.1:", "no Dask scheduler"]),
     ("run-output-is-file", "study arguments", lambda ws: ["run", ws.study, "-o", ws.precious], 2, ["--output", "precious.json", "not a folder"]),
     ("run-output-under-file", "study arguments", lambda ws: ["run", ws.study, "-o", ws.precious / "out"], 2, ["--output", "precious.json", "not a folder"]),
     ("run-controller-unknown", "study file", run('compare = ["hji", "nonlinear-29"', 'compare = ["mpc", "nonlinear-29"'), 2, ["controllers.compare", "mpc"]),
@@ -126,8 +119,9 @@ CATALOGUE = [
     ("sweep-dt-check-not-swept", "sweep", sweep('"upqc.rating" = [0.15]      #', '"upqc.x" = [0.15]      #'), 2, ['sweep.dt_check."upqc.x"', "[0.15]"]),
     ("sweep-no-sweep-table", "sweep", lambda ws: ["sweep", ws.study_with("[sweep]\n", "[sweeps]\n"), "-o", ws.root / "sw"], 2, ["sweeps", "unknown field"]),
     ("sweep-workers-negative", "study arguments", lambda ws: ["sweep", ws.study, "--workers", "-1"], 2, ["--workers", "-1"]),
+    ("sweep-workers-too-many", "study arguments", lambda ws: ["sweep", ws.study, "--workers", "5000"], 2, ["--workers", "5000", "at most"]),
     ("sweep-scheduler-malformed", "study arguments", lambda ws: ["sweep", ws.study, "--scheduler", "http://x:80"], 2, ["--scheduler", "http://x:80"]),
-    ("sweep-scheduler-unreachable", "study arguments", lambda ws: ["sweep", ws.study, "--scheduler", f"127.0.0.1:{closed_port()}"], 2, ["--scheduler", "127.0.0.1:", "no Dask scheduler"]),
+    ("sweep-scheduler-unreachable", "study arguments", lambda ws: ["sweep", ws.study, "--scheduler", f"127.0.0.1:{ws.closed_port()}"], 2, ["--scheduler", "127.0.0.1:", "no Dask scheduler"]),
     ("sweep-output-is-file", "study arguments", lambda ws: ["sweep", ws.study, "-o", ws.precious], 2, ["--output", "precious.json", "not a folder"]),
     # ---------------------------------------------------------------- simulate STUDY
     ("simulate-study-rating-negative", "study file", simulate(RATING, "rating = -0.15"), 2, ["upqc.rating", "-0.15"]),

@@ -89,9 +89,20 @@ def nonnegative_int(text) -> int:
     return v
 
 
+def worker_count(text) -> int:
+    """A number of local worker processes: 0 (serial) up to 4 per core."""
+    v = nonnegative_int(text)
+    cap = 4 * (os.cpu_count() or 1)
+    if v > cap:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} worker processes on {os.cpu_count()} core(s): give at most {cap} (one "
+            "per core is usually fastest; more only adds memory and start-up time)")
+    return v
+
+
 def add_cluster_arguments(p):
     """``--workers`` and ``--scheduler``: where the simulations of a command run (Dask)."""
-    p.add_argument("--workers", type=nonnegative_int, default=None,
+    p.add_argument("--workers", type=worker_count, default=None,
                    help="worker processes of the local Dask cluster that runs the simulations "
                         "(default: one per core; 0 = serially in this process)")
     p.add_argument("--scheduler", type=scheduler_address, default=None,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._common import add_cluster_arguments, output_folder
+from ._common import add_cluster_arguments, check_cluster, output_folder
 
 NAME = "reproduce"
 
@@ -32,6 +32,7 @@ def run(args) -> int:
     """Run ``weakgrid reproduce`` with the parsed ``args``; return the exit status."""
     from ..study.reproduce import reproduce
 
+    check_cluster(args)
     summary = reproduce(args.output, quick=args.quick, scheduler=args.scheduler,
                         workers=args.workers)
     width = max((len(c["id"]) for c in summary["claims"]), default=0)
