@@ -189,3 +189,14 @@ def test_readonly_output_folder(case, ws, cli, readonly_dir):
     assert len(body) == 1 and "read-only file system" in body[0] and str(readonly_dir) in body[0]
     assert sorted(p.name for p in readonly_dir.iterdir()) == before
     ws.check_untouched()
+
+
+def test_a_missing_output_folder_is_created(ws, cli):
+    """Not an error: the folders of an output path are made (only where the user said)."""
+    ws.snapshot()
+    plot = ws.root / "new" / "sub" / "modes.svg"
+    code, out, err = cli(["modes", ws.study, "--plot", plot])
+    assert code == 0, err
+    assert plot.read_text().lstrip().startswith(("<?xml", "<svg"))
+    assert sorted(p.name for p in (ws.root / "new").rglob("*")) == ["modes.svg", "sub"]
+    ws.check_untouched()
