@@ -147,7 +147,8 @@ class Network:
             return self._pos[int(bus_id)]
         except (KeyError, TypeError, ValueError):
             raise DataError(element, field, bus_id,
-                            f"no such bus; known buses are {sorted(int(b) for b in self._pos)}") from None
+                            "no such bus; known buses are "
+                            f"{sorted(int(b) for b in self._pos)}") from None
 
     # ------------------------------------------------------------- admittances
     def branch_admittances(self):
