@@ -45,7 +45,7 @@ import numpy as np
 CASES = ["kundur_full", "case39", "case118", "case300", "case1354pegase", "case2869pegase"]
 TF, H, T_ON, T_OFF = 10.0, 1 / 120, 1.0, 1.05
 TEMPLATE = dict(H=4.0, xd1=0.3, D=0.0)
-PEER = {"kundur_full": ("kundur/kundur_full.xlsx", 8)}
+PEER = {"kundur_full": ("kundur/kundur_full.xlsx", 8), "ieee39": ("ieee39/ieee39_full.xlsx", 16)}
 
 
 def _rss_mb():
