@@ -22,6 +22,9 @@ deviation is the largest difference of any machine speed between the two tools [
 run (linear interpolation on a common grid).
 
 Tolerances: ANDES's default TDS tolerance (1e-4); weakgrid's default Newton tolerance (1e-7).
+Where the deviation exceeds 2e-5 pu, both tools run the case again (untimed) at h/2 and h/4,
+ANDES with its tolerance tightened to 1e-8: a deviation that shrinks with the step is the two
+tools' step (discretization) error, not a model difference.
 
 Run:  PYTHONPATH=src python benchmarks/bench_scale.py [--repeat 3] [--cases kundur_full,case118]
       [--solver auto|dense|sparse] [--lu klu|superlu] [--tools weakgrid,andes]
@@ -45,7 +48,8 @@ import numpy as np
 CASES = ["kundur_full", "case39", "case118", "case300", "case1354pegase", "case2869pegase"]
 TF, H, T_ON, T_OFF = 10.0, 1 / 120, 1.0, 1.05
 TEMPLATE = dict(H=4.0, xd1=0.3, D=0.0)
-PEER = {"kundur_full": ("kundur/kundur_full.xlsx", 8)}
+DEV_GOAL = 2e-5   # [pu] largest speed deviation accepted between the tools at the same step
+PEER = {"kundur_full": ("kundur/kundur_full.xlsx", 8), "ieee39": ("ieee39/ieee39_full.xlsx", 16)}
 
 
 def _rss_mb():
@@ -61,7 +65,7 @@ def fault_bus(mpc):
 
 
 # ------------------------------------------------------------------ children
-def child_weakgrid(case, repeat, solver, lu, out):
+def child_weakgrid(case, repeat, solver, lu, out, h=H):
     import pandapower.networks  # noqa: F401  (imports before the baseline memory)
 
     from weakgrid.sim.events import Fault
@@ -84,7 +88,7 @@ def child_weakgrid(case, repeat, solver, lu, out):
             s = classical_system(mpc, **TEMPLATE)
             events = [Fault(fault_bus(mpc), T_ON, T_OFF)]
             names = s.machine_names
-        sim = Simulator(s, dt=H, linear_solver=solver, sparse_lu=lu,
+        sim = Simulator(s, dt=h, linear_solver=solver, sparse_lu=lu,
                         record=[f"{n}.omega" for n in names])
         t0 = time.perf_counter()
         res = sim.run(TF, events=events, on_failure="return")
@@ -96,7 +100,7 @@ def child_weakgrid(case, repeat, solver, lu, out):
                 stats=res.stats, rss=_rss_mb(), rss_base=base)
 
 
-def child_andes(case, repeat, out):
+def child_andes(case, repeat, out, h=H, tol=None):
     import andes
     import pandapower.networks  # noqa: F401
     from andes.io.matpower import mpc2system
@@ -125,7 +129,9 @@ def child_andes(case, repeat, out):
         ss.PFlow.config.tol = 1e-11
         ss.PFlow.run()
         ss.TDS.config.tf = TF
-        ss.TDS.config.tstep = H
+        ss.TDS.config.tstep = h
+        if tol is not None:
+            ss.TDS.config.tol = tol
         ss.TDS.config.fixt = 1
         ss.TDS.config.shrinkt = 0
         ss.TDS.config.no_tqdm = 1
@@ -139,10 +145,12 @@ def child_andes(case, repeat, out):
                 failure=None, rss=_rss_mb(), rss_base=base)
 
 
-def run_child(tool, case, repeat, solver, lu, tmp):
-    out = str(Path(tmp) / f"{tool}_{case}.npz")
+def run_child(tool, case, repeat, solver, lu, tmp, h=H, tol=None):
+    out = str(Path(tmp) / f"{tool}_{case}_{h:.6g}.npz")
     cmd = [sys.executable, __file__, "--child", tool, "--cases", case, "--repeat", str(repeat),
-           "--solver", solver, "--lu", lu, "--out", out]
+           "--solver", solver, "--lu", lu, "--out", out, "--h", repr(h)]
+    if tol is not None:
+        cmd += ["--andes-tol", repr(tol)]
     p = subprocess.run(cmd, capture_output=True, text=True, env=os.environ.copy())
     lines = [ln for ln in p.stdout.splitlines() if ln.startswith("{")]
     if p.returncode != 0 or not lines:
@@ -168,6 +176,8 @@ def main():
     ap.add_argument("--tools", default="weakgrid,andes")
     ap.add_argument("--child")
     ap.add_argument("--out")
+    ap.add_argument("--h", type=float, default=H, help=argparse.SUPPRESS)
+    ap.add_argument("--andes-tol", type=float, default=None, help=argparse.SUPPRESS)
     a = ap.parse_args()
     cases = a.cases.split(",")
     if a.child:
@@ -177,9 +187,9 @@ def main():
         warnings.simplefilter("ignore")
         logging.disable(logging.WARNING)
         if a.child == "weakgrid":
-            info = child_weakgrid(cases[0], a.repeat, a.solver, a.lu, a.out)
+            info = child_weakgrid(cases[0], a.repeat, a.solver, a.lu, a.out, a.h)
         else:
-            info = child_andes(cases[0], a.repeat, a.out)
+            info = child_andes(cases[0], a.repeat, a.out, a.h, a.andes_tol)
         print(json.dumps(info))
         return
     tools = a.tools.split(",")
@@ -188,6 +198,7 @@ def main():
            " max speed deviation [pu] | peak memory weakgrid / ANDES [MB] |")
     print(hdr)
     print("|" + "---|" * 8)
+    halved = []
     with tempfile.TemporaryDirectory() as tmp:
         for case in cases:
             r = {}
@@ -211,11 +222,25 @@ def main():
                 tw, ta = statistics.median(w[0]["wall"]), statistics.median(an[0]["wall"])
                 ratio, speed = f"{tw / ta:.3f}", f"{ta / tw:.1f}x"
                 if w[0]["ok"] and an[0]["ok"]:
-                    dev = f"{speed_deviation(w[1], an[1]):.1e}"
+                    d = speed_deviation(w[1], an[1])
+                    dev = f"{d:.1e}"
+                    if d > DEV_GOAL:
+                        halved.append((case, d))
             solver = f" [{w[0]['solver']}]" if w[0] and "solver" in w[0] else ""
             print(f"| {case}{solver} | {cell(w[0], 'N')} / {cell(an[0], 'N')} | {cell(w[0], 'wall')} | "
                   f"{cell(an[0], 'wall')} | {ratio} | {speed} | {dev} | {cell(w[0], 'mem')} / "
                   f"{cell(an[0], 'mem')} |", flush=True)
+        # where the tools differ by more than DEV_GOAL: is it step error? both again (untimed)
+        # at h/2 and h/4, ANDES with its Newton tolerance tightened to 1e-8
+        for case, d in halved:
+            devs = [f"h: {d:.2e}"]
+            for k in (2, 4):
+                wk = run_child("weakgrid", case, 1, a.solver, a.lu, tmp, H / k)
+                ak = run_child("andes", case, 1, a.solver, a.lu, tmp, H / k, 1e-8)
+                ok = wk[1] is not None and ak[1] is not None
+                devs.append(f"h/{k}: " + (f"{speed_deviation(wk[1], ak[1]):.2e}" if ok else "failed"))
+            print(f"\n{case}: speed deviation over {DEV_GOAL:g} pu at h; with the step halved in both "
+                  f"tools: " + ", ".join(devs), flush=True)
 
 
 if __name__ == "__main__":

@@ -61,18 +61,32 @@ class GENCLS(SyncMachine):
         system.set_machine_initial(self.m, vf0=vf0, tm0=tm0, XadIfd=vf0, Pe=S.real, Qe=S.imag,
                                    delta=delta, V=V)
 
+    def setup(self, system):
+        super().setup(system)
+        ra, xq = self.p["ra"], self.p["xd1"]
+        det = xq * xq + ra * ra
+        # folded constants of the stator solution (solve_stator with xd2 = xq2 = xd1, psi2q = 0)
+        self._cIa, self._cIb = xq / det, ra / det
+
     def compute(self, ctx):
         x = ctx.x
         delta, omega = x[..., self._sls[0]], x[..., self._sls[1]]
-        V = ctx.V[..., self.bus]
-        vd, vq = self.dq_voltage(V, delta)
-        ra, xq = self.p["ra"], self.p["xd1"]
-        vf = ctx.sig["vf"][..., self.m]
-        Id, Iq = solve_stator(vf, 0.0, vd, vq, ra, xq, xq)
-        self.inject(ctx, self.network_current(Id, Iq, delta))
+        V = ctx.V[..., self._bi]
+        sd, cd = np.sin(delta), np.cos(delta)
+        Vre, Vim = V.real, V.imag
+        vd = Vre * sd - Vim * cd               # dq_voltage
+        vq = Vre * cd + Vim * sd
+        vf = ctx.sig["vf"][..., self._mi]
+        a, b = vf - vq, vd                     # solve_stator(vf, 0, vd, vq, ra, xd1, xd1)
+        cIa, cIb = self._cIa, self._cIb
+        Id = cIa * a - cIb * b
+        Iq = cIa * b + cIb * a
+        # injected current (Id + j Iq) exp(j(delta - pi/2)), as network_current
+        self.inject(ctx, (Id * sd + Iq * cd) + 1j * (Iq * sd - Id * cd))
         Pe = vd * Id + vq * Iq
         Qe = vq * Id - vd * Iq
-        self._te = (vq + ra * Iq) * Iq + (vd + ra * Id) * Id
+        ra = self.p["ra"]
+        self._te = Pe + ra * (Iq * Iq + Id * Id)   # (vq + ra Iq) Iq + (vd + ra Id) Id
         self.publish(ctx, omega, delta, Pe, Qe, V, vf)
         o = ctx.out
         o["GENCLS.Pe"], o["GENCLS.Qe"], o["GENCLS.te"] = Pe, Qe, self._te
