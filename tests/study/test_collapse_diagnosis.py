@@ -97,7 +97,7 @@ def test_series_voltage_step_past_a_fold_is_a_voltage_collapse(monkeypatch):
 
 def test_states_into_an_impasse_is_a_voltage_collapse_at_a_step_independent_time(monkeypatch):
     """HJI, 0.15 pu, 100-ms fault, low load: Newton failed between samples at t ≈ 0.3144 s."""
-    rec, system, err = _run(monkeypatch, 0.15, "low", "hji", t_end=0.33)
+    _, system, err = _run(monkeypatch, 0.15, "low", "hji", t_end=0.33)
     assert err is not None and err.cause == "voltage collapse"   # was "newton" before
     assert "the states' motion" in str(err)
     nx = system.nx
@@ -107,6 +107,6 @@ def test_states_into_an_impasse_is_a_voltage_collapse_at_a_step_independent_time
     sf = _net(system, err.t, zf)[1](zf[nx:])
     assert sf < 0.05 * s0
     # physical, not numerical: halving the step moves the collapse by < 0.1 ms
-    rec2, _, err2 = _run(monkeypatch, 0.15, "low", "hji", t_end=0.33, dt_factor=0.5)
+    _, _, err2 = _run(monkeypatch, 0.15, "low", "hji", t_end=0.33, dt_factor=0.5)
     assert err2 is not None and err2.cause == "voltage collapse"
     assert abs(err2.t - err.t) < 1e-4

@@ -321,7 +321,6 @@ class Simulator:
         as a saddle-node is approached (``|dy/ds| ~ (s* - s)^(-1/2)``) — or ``info = None``
         when the continuation stalled for another reason.
         """
-        nx = self.nx
         z0 = path(0.0, z.copy())
         s, ds, out = 0.0, 0.25, None
         zs = z0

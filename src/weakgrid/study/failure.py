@@ -14,7 +14,34 @@ import math
 
 import numpy as np
 
-__all__ = ["failure_text"]
+__all__ = ["FAILED_CELLS_NOTE", "failure_kind", "failure_text"]
+
+#: What a failed cell ("!") of a sweep map means (the report prints it beside the maps).
+FAILED_CELLS_NOTE = (
+    "A cell marked ! is a run that did not finish; its cause is in the sweep table's 'failure' "
+    "column and in the summary. 'voltage collapse' is a real loss of the operating point of the "
+    "simulated grid, not a numerical failure: the network equations have no solution beyond a "
+    "fold (saddle-node), found by following the network's solution along the controller's "
+    "series-voltage step (at a sample) or along the states' motion (between samples), and "
+    "the failure says at which "
+    "series voltage, series power, shunt-bus voltage and machine angle. 'loss of synchronism' "
+    "is a rotor-angle spread beyond the simulator's limit (180°). Either way the controlled "
+    "grid lost its operating point in that cell; the study's notes say where and why.")
+
+
+def failure_kind(text) -> str:
+    """The kind of a failure cause (``""`` if none): "voltage collapse", "loss of
+    synchronism", "Newton failure", "divergence", "controller error" or "failed"."""
+    text = str(text or "")
+    if not text:
+        return ""
+    for key, kind in (("voltage collapse", "voltage collapse"),
+                      ("loss of synchronism", "loss of synchronism"),
+                      ("newton", "Newton failure"), ("divergence", "divergence"),
+                      ("controller", "controller error")):
+        if key in text:
+            return kind
+    return "failed"
 
 
 def _at(out, key, i):
@@ -63,9 +90,11 @@ def failure_text(failure, setup, demanded=None) -> str:
     name = getattr(setup, "source", None)      # the controlled machine's name
     if gti is not None and name in gti.names:
         j = gti.names.index(name)
-        parts.append(f"GTI '{name}' angle ϕs = {_at(out, 'GTI.phi_s', j):.3g} rad "
-                     f"(rate υ = {_at(out, 'GTI.upsilon', j):.3g} rad/s), power "
-                     f"{_at(out, 'GTI.P_ac', j) * setup_sb(setup):.3g} MW")
+        phi, ups = _at(out, "GTI.phi_s", j), _at(out, "GTI.upsilon", j)
+        parts.append(f"GTI '{name}' angle ϕs = {phi:.3g} rad w.r.t. bus r (rate υ = {ups:.3g} "
+                     f"rad/s), power {_at(out, 'GTI.P_ac', j) * setup_sb(setup):.3g} MW"
+                     + (" — past 90° and still rising: the GTI is slipping out of step"
+                        if phi > math.pi / 2 and ups > 0 else ""))
     if not parts:
         return text
     return (f"voltage collapse at t = {failure.t:.6g} s: the network cannot carry the "
