@@ -313,18 +313,21 @@ class Simulator:
     def _alg_path(self, t, z, path, max_iter):
         """Natural continuation of the network solution along the physical ``path`` of a jump.
 
-        Steps ``s`` from 0 (``z`` solves the network there) to 1, each step by
-        :meth:`_alg_newton` from the previous solution, halving on failure. Returns
+        Steps ``s`` from 0 (the network solved there first, from ``z``: another jump at the
+        same instant, e.g. an event, may have moved it) to 1, each step by
+        :meth:`_alg_newton` from the previous solution, the step cut by 4 on failure. Returns
         ``(out, 1.0, None)`` on success, else ``(None, s, info)``: ``s`` the last point
         solved and ``info`` (its ``(z, ctx)``, the growth of the tangent ``|dy/ds|`` from
         ``s = 0``) when the branch ends there at a fold — the tangent grows without bound
         as a saddle-node is approached (``|dy/ds| ~ (s* - s)^(-1/2)``) — or ``info = None``
         when the continuation stalled for another reason.
         """
-        z0 = path(0.0, z.copy())
         s, ds, out = 0.0, 0.25, None
-        zs = z0
         try:
+            o = self._alg_newton(t, path(0.0, z.copy()), max_iter)
+            if o is None:
+                return None, 0.0, None
+            zs = z0 = o[0]
             tan0 = self._alg_tangent(t, z0, path, 0.0)
             while s < 1.0:
                 s1 = min(1.0, s + ds)
