@@ -49,8 +49,10 @@ class SimulationError(SimError):
     cause : str
         One of ``"newton"`` (Newton iteration failed even at the minimum step),
         ``"divergence"`` (non-finite or runaway state), ``"loss of synchronism"``
-        (rotor-angle spread beyond the limit) or ``"controller"`` (a digital
-        controller returned invalid output).
+        (rotor-angle spread beyond the limit), ``"voltage collapse"`` (the network's
+        operating point ends at a fold: after a jump of the controllers' outputs, or as the
+        states move on; the attribute ``fold`` then holds the last network solution before
+        it) or ``"controller"`` (a digital controller returned invalid output).
     """
 
     def __init__(self, t: float, cause: str, detail: str = ""):

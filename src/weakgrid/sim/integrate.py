@@ -168,7 +168,7 @@ class Simulator:
         return self._alg_lu
 
     # ------------------------------------------------------------------ solves
-    def solve_algebraic(self, t, z, max_iter=30, return_eval=False, y_guess=None):
+    def solve_algebraic(self, t, z, max_iter=30, return_eval=False, y_guess=None, path=None):
         """Re-solve the network (algebraic) variables with the states fixed.
 
         First a chord iteration with the current factorization (cheap; enough after
@@ -184,6 +184,13 @@ class Simulator:
         the solution is that update, i.e. < ``tol``), so that with
         ``return_eval=True`` the residual ``F`` and context evaluated there are
         returned too (``(z, F, ctx)``) and need not be recomputed.
+
+        ``path(s, z)``, if given, moves the system along the jump itself (``s = 0``: before
+        it, ``s = 1``: after it; e.g. the controllers' outputs from their held to their new
+        values) and returns the point with the states at ``s``. When Newton fails, the
+        network is then followed along that path (:meth:`_alg_path`); if its solution branch
+        ends at a fold, the jump has no network solution: ``SimulationError`` with cause
+        ``"voltage collapse"``.
         """
         nx = self.nx
         z_start = z.copy()
@@ -193,6 +200,10 @@ class Simulator:
         out = self._alg_chord(t, z, max_iter)
         if out is None:
             out = self._alg_newton(t, z_start, max_iter)
+        if out is None and path is not None:
+            out, s_fold, info = self._alg_path(t, z_start, path, max_iter)
+            if out is None and info is not None:
+                raise self._collapse(t, s_fold, info, "the step of the controllers' outputs")
         if out is None:
             out, s_reached = self._alg_continuation(t, z_start, max_iter)
             if out is None:
@@ -289,6 +300,94 @@ class Simulator:
             ds = min(2 * ds, 1.0)
         return out, 1.0
 
+    def _alg_tangent(self, t, z, path, s, ds=1e-6):
+        """``|dy/ds|`` of the network solution ``z`` at ``s`` of ``path`` (one solve)."""
+        nx = self.nx
+        z1 = path(s + ds, z)
+        g1 = self.sys.residual(t, z1)[0][nx:]
+        path(s, z)
+        g0 = self.sys.residual(t, z)[0][nx:]
+        self._refresh_jacobian(t, z)
+        return float(np.linalg.norm(lu_solve(self._alg_lu_get(), (g1 - g0) / ds)))
+
+    def _alg_path(self, t, z, path, max_iter):
+        """Natural continuation of the network solution along the physical ``path`` of a jump.
+
+        Steps ``s`` from 0 (the network solved there first, from ``z``: another jump at the
+        same instant, e.g. an event, may have moved it) to 1, each step by
+        :meth:`_alg_newton` from the previous solution, the step cut by 4 on failure. Returns
+        ``(out, 1.0, None)`` on success, else ``(None, s, info)``: ``s`` the last point
+        solved and ``info`` (its ``(z, ctx)``, the growth of the tangent ``|dy/ds|`` from
+        ``s = 0``) when the branch ends there at a fold — the tangent grows without bound
+        as a saddle-node is approached (``|dy/ds| ~ (s* - s)^(-1/2)``) — or ``info = None``
+        when the continuation stalled for another reason.
+        """
+        s, ds, out = 0.0, 0.25, None
+        try:
+            o = self._alg_newton(t, path(0.0, z.copy()), max_iter)
+            if o is None:
+                return None, 0.0, None
+            zs = z0 = o[0]
+            tan0 = self._alg_tangent(t, z0, path, 0.0)
+            while s < 1.0:
+                s1 = min(1.0, s + ds)
+                zt = path(s1, zs.copy())
+                o = self._alg_newton(t, zt, max_iter)
+                if o is None:
+                    ds /= 4
+                    if ds < 1e-6:
+                        break
+                    continue
+                out, zs, s = o, o[0], s1
+                ds = min(2 * ds, 0.25)
+            if s >= 1.0:
+                return out, 1.0, None
+            tan = self._alg_tangent(t, zs, path, s, ds=min(1e-6, 1e-3 * max(ds, 1e-9)))
+            growth = tan / max(tan0, 1e-12)
+            if not growth > 10.0:      # not a fold: let the caller try another homotopy
+                return None, s, None
+            ctx = self.sys.residual(t, zs)[1]
+            return None, s, {"z": zs, "z0": z0, "ctx": ctx, "growth": growth}
+        finally:
+            path(1.0, z)
+
+    def _collapse(self, t, s, info, what):
+        """The :class:`SimulationError` of a fold of the network equations (voltage collapse)."""
+        ctx = info["ctx"]
+        vm = np.abs(np.asarray(ctx.V))
+        b = int(np.argmin(vm))
+        err = SimulationError(
+            t, "voltage collapse",
+            f"no network solution: following {what}, the network's operating point ends at a fold "
+            f"(saddle-node) at {s:.4g} of it (|dy/ds| grew {info['growth']:.3g}x), lowest voltage "
+            f"{vm[b]:.3g} pu at bus {self.sys.network.bus_ids[b]}")
+        err.fold = {"s": float(s), "z": info["z"], "z0": info["z0"], "V": np.asarray(ctx.V).copy(),
+                    "outputs": {k: np.array(v, copy=True) for k, v in ctx.out.items()}}
+        return err
+
+    def _impasse(self, t, z_n, f_n):
+        """At a step failure: does the network lose its solution as the states move on?
+
+        Follows the network solution along the states' explicit prediction
+        ``x_n + s dt f_n`` for ``s`` in [0, 1] (:meth:`_alg_path`). A fold before ``s = 1``
+        is an impasse: the states carry the grid to a point where the network equations have
+        no solution (voltage collapse); returns the error to raise, else None.
+        """
+        nx, dt = self.nx, self.dt
+        x_n = z_n[:nx].copy()
+
+        def path(s, z):
+            z[:nx] = x_n + s * dt * f_n
+            return z
+
+        try:
+            out, s, info = self._alg_path(t, z_n.copy(), path, 30)
+        except Exception:      # the diagnosis must never hide the failure
+            return None
+        if out is not None or info is None:
+            return None
+        return self._collapse(t + s * dt, s, info, f"the states' motion from t = {t:.6g} s")
+
     def _predict(self, lu, h, z_n, f_n, fi, limval):
         """Linearly implicit trapezoidal step from ``z_n`` with the chord matrix ``lu``."""
         R = np.zeros(len(z_n))
@@ -384,6 +483,9 @@ class Simulator:
                     guess = corr = None
                     continue
                 if h / 2 < self.min_step:
+                    collapse = self._impasse(t, z_n, f_n)
+                    if collapse is not None:
+                        raise collapse
                     raise SimulationError(t, "newton",
                                           f"no convergence with step {h:.3g} s even with a fresh "
                                           f"Jacobian{self._step_diagnosis(t, z_n)}")
@@ -518,6 +620,7 @@ class Simulator:
                         events[ev_i].apply(self)
                         ev_i += 1
                         discont = new_jac = True
+                    u_held = [_held(c) for c in controllers]
                     for c in controllers:
                         if c.due(self.t):
                             discont |= c.sample(self, self.t, self.z)
@@ -533,7 +636,8 @@ class Simulator:
                             # is close to the previous one; start the re-solve from there
                             guess = y_before + self._jump
                         self.z, F, self._ctx = self.solve_algebraic(self.t, self.z, return_eval=True,
-                                                                    y_guess=guess)
+                                                                    y_guess=guess,
+                                                                    path=_output_path(controllers, u_held))
                         if not new_jac:
                             self._jump = self.z[self.nx:] - y_before
                             self._jump_t = self.t
@@ -546,6 +650,33 @@ class Simulator:
                 raise
             failure = exc
         return rec.finish(failure=failure, stats=dict(self.stats))
+
+
+def _held(c):
+    """The output a controller's target holds (None if it cannot tell)."""
+    get = getattr(getattr(c, "target", None), "get", None)
+    return None if get is None else np.array(get(), dtype=float)
+
+
+def _output_path(controllers, held):
+    """``path(s, z)`` moving every controller's target from its held output (``s = 0``) to
+    its new one (``s = 1``); None if no output changed (e.g. the jump is an event)."""
+    moves = []
+    for c, u0 in zip(controllers, held):
+        if u0 is not None:
+            u1 = _held(c)
+            if not np.array_equal(u0, u1):
+                moves.append((c.target, u0, u1))
+    if not moves:
+        return None
+
+    def path(s, z):
+        s = min(max(float(s), 0.0), 1.0)
+        for tg, u0, u1 in moves:
+            tg.apply(u1 if s == 1.0 else u0 + s * (u1 - u0))
+        return z
+
+    return path
 
 
 def simulate(system, t_end, dt=1 / 120, events=(), controllers=(), on_failure="raise", **kw) -> Results:

@@ -9,6 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from ..fileio import write_text_atomic
+from .failure import FAILED_CELLS_NOTE
 
 __all__ = ["metrics_frame", "write_tables", "write_html"]
 
@@ -124,6 +125,7 @@ def write_html(path, *, claims, metrics, figures, designs, meta, notes=None, map
                          f"</td><td>{e(m['at_setting'])}</td><td>{e(m['region'])} "
                          f"({m['n_holds']} of {m['n_cells']} cells)</td></tr>")
         parts.append("</table>")
+        parts.append(f"<p>{e(FAILED_CELLS_NOTE)}</p>")
         for m in maps:
             if m.get("path"):
                 parts.append(f"<figure><img src='{data_uri(m['path'])}' alt='"

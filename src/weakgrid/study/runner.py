@@ -14,6 +14,7 @@ from ..sim.integrate import simulate
 from ..sim.network import F_BUS, T_BUS
 from .build import build_setup
 from .controllers import controller_variant, make_controller
+from .failure import failure_text
 from .metrics import backswing, control_cost, itae, running_cost, settling_time, stability_verdict
 
 __all__ = ["Run", "RunRecord", "run_scenario", "enable_windows", "make_events"]
@@ -195,7 +196,7 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     metrics = {"id": run.id, "case": run.case, "load": run.load, "upqc": run.upqc,
                "controller": run.controller, "design_load": dload, "fault": run.fault_text,
                "failed": res.failure is not None,
-               "failure": str(res.failure) if res.failure is not None else "",
+               "failure": failure_text(res.failure, setup, dc.log_u[-1] if dc.log_u else None),
                "wall_s": wall}
     # metrics are taken after the last disturbance (fault clearing, bypass end, step, trip)
     after = max([b[1] for b in run.bypass] + [e["t_off"] for e in run.events if "t_off" in e]

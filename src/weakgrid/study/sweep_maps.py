@@ -17,7 +17,8 @@ uncertainty is a tie, not a win. The uncertainty of a metric is measured by runn
 ``[sweep.dt_check]`` points again at half the integration step: ``|m(T) − m(T/2)|`` relative
 to ``|m(T)|``, per load level and fault severity (the row of the map), applied to every cell
 of that row (a row without a check takes the largest measured at its load level). A cell where
-a run failed is marked failed.
+a run failed is marked failed, its detail naming the cause (voltage collapse, loss of
+synchronism, …; :mod:`weakgrid.study.failure`).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import math
 import pandas as pd
 
 from ..game.errors import ParameterError
+from .failure import failure_kind
 from .maps import plot_map
 
 __all__ = ["map_cells", "draw_maps", "map_summaries", "MAP_KINDS"]
@@ -158,6 +160,8 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
             verdict = "holds" if sa == "stable" and sb in ("unstable", "undamped") else "not"
         if verdict == "failed":     # a failed run's metrics stop at the failure: no value
             val = math.nan
+            detail = "; ".join(f"{c} {failure_kind(r.get('failure'))}" for c, r, f in
+                               ((a, ra, fa), (b, rb, fb)) if f)
         rec.update(value=val, verdict=verdict, uncertainty=u, detail=detail)
         rows.append(rec)
     return pd.DataFrame(rows)
@@ -248,7 +252,10 @@ def map_summaries(maps) -> list[dict]:
                 if ties:
                     txt += "; tie at " + ", ".join(f"{v:g}" for v in ties)
                 if fails:
-                    txt += "; a run failed at " + ", ".join(f"{v:g}" for v in fails)
+                    fr = row[row["verdict"] == "failed"]
+                    txt += "; a run failed at " + ", ".join(
+                        f"{v:g}" + (f" ({d})" if d else "") for v, d in
+                        zip(fr[x], fr["detail"] if "detail" in fr else [""] * len(fr)))
                 parts.append(txt)
             region.append(pre + "; ".join(parts))
         nh = int((cells["verdict"] == "holds").sum())
