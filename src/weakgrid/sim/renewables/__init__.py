@@ -1,6 +1,7 @@
 """WECC generic renewable-plant models (converter interface)."""
 
 from .pvd1 import PVD1
+from .reeca1 import REECA1
 from .regca1 import REGCA1
 
-__all__ = ["PVD1", "REGCA1"]
+__all__ = ["PVD1", "REECA1", "REGCA1"]
