@@ -37,7 +37,7 @@ Conventions (those of ANDES 2.0, checked against it in ``tests/sim/test_reeca1_p
   ``Iqinj`` for ``|Thld|`` s after a dip; ``p0 = 0`` with ``PFFLAG = 1`` holds the Q
   reference at its initial value (the power-factor angle is undefined).
 * In a dip the PI outputs are held at their last value before the dip (their states frozen),
-  as ANDES does.
+  as ANDES does; so are the outputs of ``s4`` and ``s5`` when their time constant is 0.
 * The flag combinations follow ANDES's diagram, including its initial references:
   ``Qref0 = q0`` with ``QFLAG = 0``, ``Vref1 - v0`` with ``QFLAG = 1``.
 * ANDES adds ``Ipcmd0/LVG0 - Ipcmd0`` to the active current command so that the converter
@@ -131,7 +131,7 @@ class REECA1(Component):
     )
     states = ("s0", "S1", "PIQ", "s4", "pfilt", "s5", "PIV")
     outputs = ("Ipcmd", "Iqcmd", "Ipmax", "Iqmax", "Iqinj", "Pord", "Volt_dip", "Qsel", "PIQ_y", "PIV_y",
-               "fThld2")
+               "fThld2", "s4_y")
 
     # ------------------------------------------------------------------ import
     @classmethod
@@ -277,6 +277,8 @@ class REECA1(Component):
         self._piq_hold = np.zeros(self.n)
         self._piv_hold = x[self.sl(6)].copy()
         self._ipmax_hold = ipmax.copy()
+        self._s4_hold = pfsel / vp
+        self._pord_hold = self.Pref0.copy()
         self._fthld2_prev = np.zeros(self.n, bool)
         self._dip_start_t = np.full(self.n, -np.inf)
 
@@ -308,6 +310,7 @@ class REECA1(Component):
         piq = np.where(dip, self._piq_hold, self.PIQb.output(xq, uq, p["VMIN"], p["VMAX"]))
         vsel = np.clip(np.where(vflag, piq, p["Vref1"] + pfsel), p["VMIN"], p["VMAX"])
         s4y = self.s4b.output(s4, pfsel / vp)
+        s4y = np.where(dip & (p["Tiq"] <= 0), self._s4_hold, s4y)     # a frozen pass-through holds
         # voltage-dip reactive current injection
         iqv = p["Kqv"] * deadband(self.Vref0r - s0y, p["dbd1"], p["dbd2"])
         ext = run & (((self._dip_prev & (self.Thld_abs > 0)) | (t < self._t_thld)))
@@ -317,7 +320,8 @@ class REECA1(Component):
         # active power
         pref = self.Pref0 + pext
         pfy = pfl                      # LagRate: output = state (tpfilt > 0)
-        pord = np.where(p["Tpord"] > 0, s5, np.clip(pfy, p["PMIN"], p["PMAX"]))   # Tpord = 0: limiter only
+        # Tpord = 0: the limiter only (held in a dip, as a frozen state)
+        pord = np.where(p["Tpord"] > 0, s5, np.where(dip, self._pord_hold, np.clip(pfy, p["PMIN"], p["PMAX"])))
         # current limiter
         iq1, ip1 = self._vdl(s0y)
         fthld2 = run & (((self._dip_prev & (p["Thld2"] > 0)) | (t < self._t_thld2)))
@@ -362,6 +366,7 @@ class REECA1(Component):
         o[f"{tn}.Volt_dip"] = dip.astype(float)
         o[f"{tn}.Qsel"], o[f"{tn}.PIQ_y"], o[f"{tn}.PIV_y"] = qsel, piq, piv
         o[f"{tn}.fThld2"] = fthld2.astype(float)
+        o[f"{tn}.s4_y"] = s4y
 
     def accept(self, t, ctx):
         """Update the discrete memory at an accepted point: dip end times, held values."""
@@ -375,5 +380,7 @@ class REECA1(Component):
         run = ~dip
         self._piq_hold = np.where(run, o[f"{tn}.PIQ_y"], self._piq_hold)
         self._piv_hold = np.where(run, o[f"{tn}.PIV_y"], self._piv_hold)
+        self._s4_hold = np.where(run, o[f"{tn}.s4_y"], self._s4_hold)
+        self._pord_hold = np.where(run, o[f"{tn}.Pord"], self._pord_hold)
         f2 = o[f"{tn}.fThld2"] > 0.5
         self._ipmax_hold = np.where(f2, self._ipmax_hold, o[f"{tn}.Ipmax"])
