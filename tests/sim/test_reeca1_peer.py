@@ -85,14 +85,14 @@ def _pq(a, w):
     return out
 
 
-def test_imports_with_reeca1_and_refuses_repca1():
-    from weakgrid.sim.errors import DataError
+def test_imports_the_renewable_chain():
     from weakgrid.sim.io.andes import from_andes
 
     system, _ = from_andes(load_case(CASE, modify=no_plant))
-    assert "REECA1" in system.components and system.components["REECA1"].n == 1
-    with pytest.raises(DataError, match="REPCA1"):
-        from_andes(load_case(CASE))
+    assert system.components["REECA1"].n == 1 and "REPCA1" not in system.components
+    system, _ = from_andes(load_case(CASE))
+    assert system.components["REPCA1"].n == 1
+    assert system.components["REPCA1"].links[0]["ree"] == "REECA1_1"
 
 
 def test_speeds_angles_and_converter_outputs_match_andes(runs):

@@ -87,7 +87,7 @@ def _registry():
     from .machines import GENCLS, GENROU
     from .pss import IEEEST
     from .loads import ZIP
-    from .renewables import PVD1, REECA1, REGCA1, REPCA1
+    from .renewables import PVD1, REECA1, REECB1, REGCA1, REPCA1
 
     from .exciters import ESDC2A, ESST3A, EXAC1, EXST1, IEEET1, IEEEX1
     from .governors import IEEEG1, IEESGO, TG2, TGOV1N
@@ -96,7 +96,7 @@ def _registry():
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
                                     IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT)
-            + (REGCA1, REECA1, REPCA1, PVD1, ZIP)}
+            + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ZIP)}
 
 
 class System:

@@ -154,7 +154,8 @@ class REECA1(Component):
         for f in ("tpfilt", "kqs", "kvs"):
             if f in [p.name for p in cls.params] and hasattr(m.config, f):
                 values[f] = float(getattr(m.config, f))
-        values["vdl_np"] = 0.0      # ANDES 2.0's current limiter (see the module docstring)
+        if "vdl_np" in [p.name for p in cls.params]:
+            values["vdl_np"] = 0.0      # ANDES 2.0's current limiter (see the module docstring)
         return values
 
     def add_reeca1(self, name, reg, **params):
@@ -165,6 +166,9 @@ class REECA1(Component):
     # ------------------------------------------------------------------- setup
     def setup(self, system):
         super().setup(system)
+        self._setup_links(system)
+
+    def _setup_links(self, system):
         p = self.p
         regc = system.components.get(self.controlled)
         self.reg = np.zeros(self.n, int)
@@ -223,6 +227,28 @@ class REECA1(Component):
         ip1 = np.where(self.zVDL2, np.minimum(vdl2, self.Imaxr), BIG)
         return iq1, ip1
 
+    # ------------------------------------------------- variant hooks (REECB1)
+    def _qref0(self, v, vp):
+        """Initial Q reference (ANDES: ``q0`` with QFLAG = 0, ``Vref1 - v0`` with QFLAG = 1)."""
+        p = self.p
+        return -np.where(p["QFLAG"] > 0, v - p["Vref1"], self.Iqcmd0 * vp)
+
+    def _vsel(self, piq, pfsel):
+        p = self.p
+        return np.clip(np.where(p["VFLAG"] > 0, piq, p["Vref1"] + pfsel), p["VMIN"], p["VMAX"])
+
+    def _piv_input(self, vsel, s0y):
+        p = self.p
+        return np.where(p["QFLAG"] > 0, vsel - np.where(p["VFLAG"] > 0, 0.0, s0y), 0.0)
+
+    def _iqinj(self, iqv, dip, t):
+        p = self.p
+        run = ~dip
+        ext = run & (((self._dip_prev & (self.Thld_abs > 0)) | (t < self._t_thld)))
+        iqinj = np.where(dip, iqv, np.where(ext, np.where(p["Thld"] < 0, iqv,
+                                                          np.where(p["Thld"] > 0, p["Iqfrz"], 0.0)), 0.0))
+        return np.clip(iqinj, p["Iql1"], p["Iqh1"])
+
     # -------------------------------------------------------------------- init
     def init(self, system, x, sig):
         p = self.p
@@ -238,7 +264,7 @@ class REECA1(Component):
         self.pfaref0 = np.arctan2(self.q0, self.p0)
         self.zp = self.p0 == 0
         qflag, vflag = p["QFLAG"] > 0, p["VFLAG"] > 0
-        self.Qref0 = -np.where(qflag, v - p["Vref1"], self.Iqcmd0 * vp)
+        self.Qref0 = self._qref0(v, vp)
         self.Vref0r = np.where(p["Vref0"] == 0, v, p["Vref0"])
         self.Pref0 = self.p0
         for i in np.nonzero((v < p["Vdip"]) | (v > p["Vup"]))[0]:
@@ -308,15 +334,12 @@ class REECA1(Component):
         vflag, qflag = p["VFLAG"] > 0, p["QFLAG"] > 0
         uq = np.where(vflag, qerr, 0.0)
         piq = np.where(dip, self._piq_hold, self.PIQb.output(xq, uq, p["VMIN"], p["VMAX"]))
-        vsel = np.clip(np.where(vflag, piq, p["Vref1"] + pfsel), p["VMIN"], p["VMAX"])
+        vsel = self._vsel(piq, pfsel)
         s4y = self.s4b.output(s4, pfsel / vp)
         s4y = np.where(dip & (p["Tiq"] <= 0), self._s4_hold, s4y)     # a frozen pass-through holds
         # voltage-dip reactive current injection
         iqv = p["Kqv"] * deadband(self.Vref0r - s0y, p["dbd1"], p["dbd2"])
-        ext = run & (((self._dip_prev & (self.Thld_abs > 0)) | (t < self._t_thld)))
-        iqinj = np.where(dip, iqv, np.where(ext, np.where(p["Thld"] < 0, iqv,
-                                                          np.where(p["Thld"] > 0, p["Iqfrz"], 0.0)), 0.0))
-        iqinj = np.clip(iqinj, p["Iql1"], p["Iqh1"])
+        iqinj = self._iqinj(iqv, dip, t)
         # active power
         pref = self.Pref0 + pext
         pfy = pfl                      # LagRate: output = state (tpfilt > 0)
@@ -327,7 +350,7 @@ class REECA1(Component):
         fthld2 = run & (((self._dip_prev & (p["Thld2"] > 0)) | (t < self._t_thld2)))
         pri = p["PQFLAG"] > 0
         I2 = self.Imaxr ** 2
-        uv = np.where(qflag, vsel - np.where(vflag, 0.0, s0y), 0.0)
+        uv = self._piv_input(vsel, s0y)
         # Q priority: Iq first
         iqmax_q = iq1
         piv_q = np.where(dip, self._piv_hold, self.PIVb.output(xv, uv, -iqmax_q, iqmax_q))

@@ -35,15 +35,18 @@ from ..errors import DataError
 from ..params import Param
 
 
+_EC = ("REECA1", "REECB1")     # electrical controls a plant control may drive
+
+
 def _flag(name, info, default=None):
     return Param(name, default, "-", info, "nonneg")
 
 
 class REPCA1(Component):
-    """Renewable plant control model A (WECC); drives one REECA1."""
+    """Renewable plant control model A (WECC); drives one REECA1 or REECB1."""
 
     kind = "device"
-    order = 1            # before REECA1, which reads Pext and Qext
+    order = 1            # before REECA1/REECB1, which read Pext and Qext
     params = (
         _flag("VCFlag", "1 line drop compensation, 0 droop (Kc Qline)"),
         _flag("RefFlag", "1 voltage control, 0 Q control"),
@@ -89,12 +92,13 @@ class REPCA1(Component):
     @classmethod
     def andes_link(cls, m, k, dev_name, ss, **_):
         """Link of ANDES device ``k``: its REECA1 and the 0-based row of its monitored line."""
-        name = dev_name.get(("REECA1", m.ree.v[k]))
+        name = dev_name.get(("REECA1", m.ree.v[k])) or dev_name.get(("REECB1", m.ree.v[k]))
         dev = f"ANDES REPCA1 {m.idx.v[k]}"
         if name is None:
-            if "REECA1" in ss.models and m.ree.v[k] in list(ss.REECA1.idx.v):
+            if any(e in ss.models and m.ree.v[k] in list(ss.models[e].idx.v) for e in _EC):
                 return None
-            raise DataError(dev, "ree", m.ree.v[k], "no REECA1 with this idx; only REECA1 is supported")
+            raise DataError(dev, "ree", m.ree.v[k], "no REECA1 or REECB1 with this idx (the only "
+                            "electrical controls supported)")
         if m.busr.v[k] not in (None, ""):
             raise DataError(dev, "busr", m.busr.v[k], "remote measurement is not supported; leave it empty")
         line = m.line.v[k]
@@ -119,7 +123,8 @@ class REPCA1(Component):
             ids = list(bfm.idx.v)
             j = ids.index(bf) if bf in ids else None
             if j is None:   # ANDES finds the BusFreq at the converter's bus (DeviceFinder)
-                reg = ss.REECA1.reg.v[list(ss.REECA1.idx.v).index(m.ree.v[k])]
+                ec = next(ss.models[e] for e in _EC if m.ree.v[k] in list(ss.models[e].idx.v))
+                reg = ec.reg.v[list(ec.idx.v).index(m.ree.v[k])]
                 bus = ss.REGCA1.bus.v[list(ss.REGCA1.idx.v).index(reg)]
                 on = [i for i, b in enumerate(bfm.bus.v) if b == bus]
                 j = on[0] if on else None
@@ -142,10 +147,11 @@ class REPCA1(Component):
         from ..network import GEN_BUS  # noqa: F401  (bus layout documented there)
 
         p = self.p
-        ree = system.components.get("REECA1")
         regc = system.components.get("REGCA1")
+        ecs = [system.components[e] for e in _EC if e in system.components]
         net = system.network
         self.ree = np.zeros(self.n, int)
+        self.ree_comps = [None] * self.n
         self.bus = np.zeros(self.n, int)
         self.b1 = np.zeros(self.n, int)
         self.b2 = np.zeros(self.n, int)
@@ -153,10 +159,13 @@ class REPCA1(Component):
         self.zl = np.ones(self.n, complex)
         Sn = np.zeros(self.n)
         for i, lk in enumerate(self.links):
-            if ree is None or lk.get("ree") not in ree.names:
-                raise DataError(self.element(i), "ree", lk.get("ree"), "give the name of a REECA1 of the system")
+            ree = next((c for c in ecs if lk.get("ree") in c.names), None)
+            if ree is None:
+                raise DataError(self.element(i), "ree", lk.get("ree"),
+                                "give the name of a REECA1 or REECB1 of the system")
             j = ree.names.index(lk["ree"])
             self.ree[i] = j
+            self.ree_comps[i] = ree
             r = regc.names.index(ree.links[j]["reg"])
             self.bus[i] = regc.bus[r]
             Sn[i] = regc.p["Sn"][r]
@@ -179,7 +188,13 @@ class REPCA1(Component):
         for prm in self.params:
             if prm.base == "power":
                 p[prm.name] = p[prm.name] * c
-        self.ree_comp, self.regc = ree, regc
+        self.regc = regc
+        # per electrical-control type: (rows of this model, their indices in that type)
+        self._targets = {}
+        for c in ecs:
+            rows = np.array([i for i in range(self.n) if self.ree_comps[i] is c], int)
+            if len(rows):
+                self._targets[c.type_name] = (c.n, rows, self.ree[rows])
         self.s0b = Lag(1.0, p["Tfltr"])
         self.s1b = Lag(1.0, p["Tfltr"])
         self.s2b = PITrackAW(p["Kp"], p["Ki"], p["kqs"])
@@ -191,10 +206,10 @@ class REPCA1(Component):
         self.WOb = Washout(self.iwn, p["Tw"])
 
     def pattern(self, system):
-        ree, rc = self.ree_comp, self.regc
+        rc = self.regc
         out = []
         for i in range(self.n):
-            j = self.ree[i]
+            j, ree = self.ree[i], self.ree_comps[i]
             r = rc.names.index(ree.links[j]["reg"])
             v = (self.instance_states(i) + ree.instance_states(j) + rc.instance_states(r)
                  + system.bus_vars(self.bus[i]) + system.bus_vars(self.b1[i]) + system.bus_vars(self.b2[i]))
@@ -254,11 +269,11 @@ class REPCA1(Component):
         s5y = self.s5b.output(s5, fe, p["Pmin"], p["Pmax"])
         s6y = self.s6b.output(s6, s5y)
         pext = np.where(p["Fflag"] > 0, s6y, 0.0)
-        shape = x.shape[:-1] + (self.ree_comp.n,)
-        for key, val in (("REECA1.Pext", pext), ("REECA1.Qext", qext)):
-            arr = np.zeros(shape)
-            arr[..., self.ree] = val
-            ctx.sig[key] = arr
+        for tn, (n, rows, idx) in self._targets.items():
+            for key, val in (("Pext", pext), ("Qext", qext)):
+                arr = np.zeros(x.shape[:-1] + (n,))
+                arr[..., idx] = val[..., rows]
+                ctx.sig[f"{tn}.{key}"] = arr
         fd = ctx.f
         fd[..., sl[0]] = self.s0b.deriv(s0, vcsel)
         fd[..., sl[1]] = self.s1b.deriv(s1, Q)

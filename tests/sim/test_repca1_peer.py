@@ -1,0 +1,82 @@
+"""REGCA1 + REECA1 + REPCA1 against ANDES 2.0 on ``kundur/kundur_reg.xlsx`` as shipped.
+
+The plant control monitors Line_14 at the converter's bus (line drop compensation VCFlag = 1,
+voltage control RefFlag = 1, line power control PLflag = 1) with frequency control off
+(Fflag = 0, as shipped); the limit case switches it on (Fflag = 1) and lowers ``Qmax`` and
+``Pmax``/``Pmin``, so that the power-error limits femax/femin, the Q PI limit and the P PI
+limit are reached, and the voltage-freeze hold (Vfrz) acts in the fault. Three-phase fault at
+bus 8 from 1.0 to 1.1 s, 5 s.
+
+As for REECA1 alone (see ``test_reeca1_peer.py``), ANDES's step after an event restarts at
+1e-4 s, so weakgrid runs at h/8 against ANDES at h = 1/120 s. Measured: 2.0e-5 pu and 0.10 deg
+as shipped, 2.1e-5 pu and 0.11 deg in the limit case; the converter's P and Q within 0.06 pu
+(100-MVA base; the plant exports 700 MW).
+"""
+
+import numpy as np
+import pytest
+
+andes = pytest.importorskip("andes")
+
+from weakgrid.sim.peer.andes_case import compare_named, load_case, run_andes_ss, run_weakgrid_ss  # noqa: E402
+from weakgrid.sim.peer.andes_runs import interp_to  # noqa: E402
+
+pytestmark = [pytest.mark.andes, pytest.mark.slow]
+
+CASE = "kundur/kundur_reg.xlsx"
+FAULT = (8, 1.0, 1.1)
+H = 1 / 120
+TF = 5.0
+LIMITS = dict(Fflag=1, Qmax=0.3, Pmax=0.03, Pmin=-0.03)
+
+
+def _pair(modify):
+    a = run_andes_ss(load_case(CASE, fault=FAULT, modify=modify), TF, H)
+    w = run_weakgrid_ss(load_case(CASE, fault=FAULT, modify=modify), TF, H / 8)
+    assert a["ok"] and w["ok"]
+    return a, w
+
+
+def _pq(a, w):
+    ss, r = a["ss"], w["res"]
+    tg = np.linspace(0.0, TF, 2001)
+    keep = (np.abs(tg - 1.0) > 0.03) & (np.abs(tg - 1.1) > 0.03)
+    out = []
+    for v, k in ((ss.REGCA1.Pe, "REGCA1_1.Pe"), (ss.REGCA1.Qe, "REGCA1_1.Qe")):
+        ya = interp_to(tg, a["t"], ss.dae.ts.y[:, [v.a[0]]])[:, 0]
+        yw = interp_to(tg, r.t, np.asarray(r[k])[:, None])[:, 0]
+        out.append(float(np.max(np.abs(ya - yw)[keep])))
+    return out
+
+
+def test_as_shipped_matches_andes():
+    a, w = _pair(None)
+    dw, dd = compare_named(a, w)
+    assert dw < 2.5e-5 and dd < 0.5, (dw, dd)
+    eP, eQ = _pq(a, w)
+    assert eP < 0.1 and eQ < 0.1, (eP, eQ)
+    r = w["res"]
+    assert np.ptp(np.asarray(r["REPCA1_1.Qext"])) > 0.1           # the plant control acted
+    assert np.all(np.asarray(r["REPCA1_1.Pext"]) == 0)             # Fflag = 0
+
+
+def test_limits_case():
+    def modify(ss):
+        for f, v in LIMITS.items():
+            getattr(ss.REPCA1, f).v[0] = v
+
+    a, w = _pair(modify)
+    dw, dd = compare_named(a, w)
+    assert dw < 2.5e-5 and dd < 0.5, (dw, dd)
+    eP, eQ = _pq(a, w)
+    assert eP < 0.1 and eQ < 0.1, (eP, eQ)
+    r = w["res"]
+    t = r.t
+    fe = np.asarray(r["REPCA1_1.fe"])
+    assert fe.max() == pytest.approx(0.05) and fe.min() == pytest.approx(-0.05)   # femax, femin
+    assert np.asarray(r["REPCA1_1.Qext"]).max() == pytest.approx(0.3, abs=1e-3)   # Qmax (s2) reached
+    s5 = np.asarray(r["REPCA1_1.s5_y"])
+    assert np.isclose(s5, 0.03).any() or np.isclose(s5, -0.03).any()              # Pmax/Pmin reached
+    assert np.ptp(np.asarray(r["REPCA1_1.Pext"])) > 0.01                          # frequency control on
+    held = (t > 1.01) & (t < 1.09)
+    assert np.ptp(np.asarray(r["REPCA1_1.eHld"])[held]) == 0                      # e held below Vfrz
