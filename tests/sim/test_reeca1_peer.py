@@ -29,9 +29,13 @@ The limit case (``test_limits_case``) switches to P priority, so that VDL2 bound
 current and the reactive current reaches sqrt(Imax^2 - Ip^2): 3.4e-5 pu, 0.10 deg.
 
 Known gap, not in the tests: with the voltage PI on (QFLAG = 1, Vref1 = v0, Kvp = 5, Kvi = 20)
-ANDES keeps the PI's integrator and output frozen after the dip has ended (PIV_xi stays at its
-initial 1.061 and PIV_y at 8.949 for the rest of the run), while weakgrid releases them when
-the voltage recovers above Vdip, as the diagram says: 1.4e-2 pu of speed apart. Not resolved.
+the two tools part (1.4e-2 pu of speed). At clearing the voltage jumps from 0.45 pu (under Vdip)
+to 1.15 pu (over Vup = 1.1): the dip logic stays on, and the PI should stay frozen at its
+pre-fault output (1.061 pu; weakgrid). In ANDES a Newton iterate of the clearing step passes
+through the normal band, the PI output is recomputed for that iterate (8.949 pu, its upper
+limit) and then frozen there; that large reactive current keeps the voltage above Vup
+(1.25-1.30 pu), so the dip never ends and the PI stays frozen at 8.949 pu for the rest of the
+run. weakgrid holds the value of the last *accepted* point outside a dip. Not reconciled.
 """
 
 import numpy as np

@@ -37,7 +37,12 @@ Conventions (those of ANDES 2.0, checked against it in ``tests/sim/test_reeca1_p
   ``Iqinj`` for ``|Thld|`` s after a dip; ``p0 = 0`` with ``PFFLAG = 1`` holds the Q
   reference at its initial value (the power-factor angle is undefined).
 * In a dip the PI outputs are held at their last value before the dip (their states frozen),
-  as ANDES does; so are the outputs of ``s4`` and ``s5`` when their time constant is 0.
+  as ANDES does; so are the outputs of ``s4`` and ``s5`` when their time constant is 0. The
+  held value is the one of the last *accepted* point outside a dip (ANDES holds the value of
+  the Newton iterate at which its flag switched, which can differ when the voltage jumps from
+  below Vdip to above Vup in one step; see ``tests/sim/test_reeca1_peer.py``).
+* ``Ipmax`` is held for Thld2 at its value at the end of the dip (WECC); ANDES 2.0 holds an
+  older value (its pre-dip one in the peer case). It binds in neither peer case.
 * The flag combinations follow ANDES's diagram, including its initial references:
   ``Qref0 = q0`` with ``QFLAG = 0``, ``Vref1 - v0`` with ``QFLAG = 1``.
 * ANDES adds ``Ipcmd0/LVG0 - Ipcmd0`` to the active current command so that the converter
