@@ -107,3 +107,25 @@ def test_reecb1_under_the_plant_control():
     r = w["res"]
     assert np.asarray(r["REECB1_B1.Iqinj"]).max() == pytest.approx(4.0)   # Iqh1 reached
     assert np.asarray(r["REECB1_B1.Volt_dip"]).max() == 1
+
+
+def test_zero_parameters_as_andes():
+    """Zero-parameter conventions against ANDES: REECA1 Vref0 = 0 (the initial voltage) and
+    Trv = Tp = Tiq = 0, REPCA1 Tfltr = Tfv = Tp = Tg = 0 (pass-throughs). Measured: 2.0e-5 pu,
+    0.10 deg; P within 0.05 pu, Q within 1e-3 pu. (Imax = 0 is not compared: ANDES's "no
+    limit" replacement is not used in its sqrt(Imax^2 - I^2), which then cuts the current to 0,
+    and its run stops at the fault; weakgrid applies "no limit" on both axes, see REECA1.)"""
+    def modify(ss):
+        for f in ("Trv", "Tp", "Tiq", "Vref0"):
+            getattr(ss.REECA1, f).v[0] = 0.0
+        for f in ("Tfltr", "Tfv", "Tp", "Tg"):
+            getattr(ss.REPCA1, f).v[0] = 0.0
+
+    a, w = _pair(modify)
+    dw, dd = compare_named(a, w)
+    assert dw < 2.5e-5 and dd < 0.5, (dw, dd)
+    eP, eQ = _pq(a, w)
+    assert eP < 0.1 and eQ < 0.1, (eP, eQ)
+    r = w["res"]
+    for st in ("REECA1_1.s0", "REECA1_1.S1", "REECA1_1.s4", "REPCA1_1.s0", "REPCA1_1.s3", "REPCA1_1.s6"):
+        assert np.ptp(np.asarray(r[st])) == 0, st                 # bypassed lags
