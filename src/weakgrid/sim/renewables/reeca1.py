@@ -56,8 +56,8 @@ peer cases, whose data keep them out of reach; each is documented, not hidden):
   table of that axis; the WECC model takes the minimum of both. ``vdl_np = 1`` (the default)
   follows WECC, ``vdl_np = 0`` ANDES; the ANDES importer sets 0 so that an ANDES case gives
   ANDES's answer (ANDES's shipped cases reach the VDL tables in a fault).
-* ANDES's Q-priority ``Ipmax`` uses ``Imax`` even when it is ``<= 0`` (no active current);
-  here the "no limit" replacement is used on both axes.
+* ANDES's non-priority limit ``sqrt(Imax^2 - I^2)`` uses ``Imax`` even when it is ``<= 0``
+  (which cuts that current to 0); here the "no limit" replacement is used on both axes.
 
 Per-unit bases as ANDES: ``QMax``, ``QMin``, ``dPmax``, ``dPmin``, ``PMAX``, ``PMIN`` are
 powers and ``Imax``, ``Iq1..Iq4``, ``Ip1..Ip4`` currents on the converter's rating ``Sn``.
@@ -249,7 +249,7 @@ class REECA1(Component):
     def _iqinj(self, iqv, dip, t):
         p = self.p
         run = ~dip
-        ext = run & (((self._dip_prev & (self.Thld_abs > 0)) | (t < self._t_thld)))
+        ext = run & ((self._dip_prev & (self.Thld_abs > 0)) | (t < self._t_thld))
         iqinj = np.where(dip, iqv, np.where(ext, np.where(p["Thld"] < 0, iqv,
                                                           np.where(p["Thld"] > 0, p["Iqfrz"], 0.0)), 0.0))
         return np.clip(iqinj, p["Iql1"], p["Iqh1"])
@@ -268,7 +268,7 @@ class REECA1(Component):
         self.Ip_offset = rc.Ipcmd0[r] - self.Ipcmd0      # 0 unless LVG(v0) < 1 (see module doc)
         self.pfaref0 = np.arctan2(self.q0, self.p0)
         self.zp = self.p0 == 0
-        qflag, vflag = p["QFLAG"] > 0, p["VFLAG"] > 0
+        qflag = p["QFLAG"] > 0
         self.Qref0 = self._qref0(v, vp)
         self.Vref0r = np.where(p["Vref0"] == 0, v, p["Vref0"])
         self.Pref0 = self.p0
@@ -352,7 +352,7 @@ class REECA1(Component):
         pord = np.where(p["Tpord"] > 0, s5, np.where(dip, self._pord_hold, np.clip(pfy, p["PMIN"], p["PMAX"])))
         # current limiter
         iq1, ip1 = self._vdl(s0y)
-        fthld2 = run & (((self._dip_prev & (p["Thld2"] > 0)) | (t < self._t_thld2)))
+        fthld2 = run & ((self._dip_prev & (p["Thld2"] > 0)) | (t < self._t_thld2))
         pri = p["PQFLAG"] > 0
         I2 = self.Imaxr ** 2
         uv = self._piv_input(vsel, s0y)

@@ -34,7 +34,6 @@ from ..component import Component
 from ..errors import DataError
 from ..params import Param
 
-
 _EC = ("REECA1", "REECB1")     # electrical controls a plant control may drive
 
 
@@ -108,7 +107,7 @@ class REPCA1(Component):
             if line not in lines:
                 raise DataError(dev, "line", line, "no Line with this idx")
             row = lines.index(line)
-        rc, xc = getattr(m, "Rc").v[k], getattr(m, "Xc").v[k]
+        rc, xc = m.Rc.v[k], m.Xc.v[k]
         return {"ree": name, "line": row, "zline": rc is None or xc is None}
 
     @classmethod
@@ -144,8 +143,6 @@ class REPCA1(Component):
     # ------------------------------------------------------------------- setup
     def setup(self, system):
         super().setup(system)
-        from ..network import GEN_BUS  # noqa: F401  (bus layout documented there)
-
         p = self.p
         regc = system.components.get("REGCA1")
         ecs = [system.components[e] for e in _EC if e in system.components]
