@@ -22,8 +22,9 @@ weakgrid h/8 vs ANDES h        1.9e-5       0.10
 "fixed" step (``fixt = 1``) is only an upper bound. After a step that needs more than 6 Newton
 iterations ANDES shortens the next one by 5 % (by half above 15) and lets it regrow by 10 % per
 step; the converter's limiter and dip flags switch between its Newton iterations in the fault
-and the recovery, so its steps from 1.0 to ~1.25 s fall to 1-4 ms (h/8 to h/2), exactly where
-the converter's 20-ms controls recover (it also puts points 1e-4 s around each event). weakgrid
+and the recovery, so its steps shrink through the fault and are 1-4 ms (h/8 to h/2) in the
+0.1-0.15 s after clearing, exactly where the converter's 20-ms controls recover (it also puts
+points 1e-4 s around each event). weakgrid
 at h/8 matches ANDES at h within ANDES's own step change. (Forcing an ANDES-like shortened
 schedule on weakgrid is no fix: a threshold crossing -- LVPL release at Brkpt, the end of the
 dip -- then lands one step apart in one tool or the other: with a schedule starting at 1e-4 s

@@ -8,7 +8,7 @@ reached, and the voltage-freeze hold (Vfrz) acts in the fault. Three-phase fault
 bus 8 from 1.0 to 1.1 s, 5 s.
 
 As for REECA1 alone (see ``test_reeca1_peer.py``), ANDES shortens its "fixed" step to 1-4 ms
-while its Newton iterations are many (fault and recovery), so weakgrid runs at h/8 against
+while its Newton iterations are many (the recovery after clearing), so weakgrid runs at h/8 against
 ANDES at h = 1/120 s. Measured: 2.0e-5 pu and 0.10 deg
 as shipped, 2.1e-5 pu and 0.11 deg in the limit case; the converter's P and Q within 0.06 pu
 (100-MVA base; the plant exports 700 MW).
