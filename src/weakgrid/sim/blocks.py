@@ -385,3 +385,42 @@ def rectifier_fex(IN):
     IN = np.asarray(IN, dtype=float)
     return np.select([IN <= 0, IN <= 0.433, IN <= 0.75, IN <= 1.0],
                      [np.ones_like(IN), 1 - 0.577 * IN, np.sqrt(np.abs(0.75 - IN * IN)), 1.732 * (1 - IN)], 0.0)
+
+
+class PITrackAW:
+    r"""PI controller :math:`K_p + K_i/s` with a tracking anti-windup (back-calculation).
+
+    The unlimited output :math:`y_s = K_p u + x` is clipped to ``[lower, upper]``; the
+    integrator is driven back by the part of the output the limiter cut:
+    :math:`\dot x = K_i\,(u - K_s (y_s - y))` (WECC REEC/REPC convention; ANDES ``PITrackAW``).
+    Limits may be arrays that move with the solution (given at each call).
+
+    Parameters
+    ----------
+    Kp, Ki : array_like
+        Proportional gain [pu/pu] and integral gain [1/s].
+    Ks : float or array_like
+        Tracking gain [pu/pu] (2 in ANDES's default configuration).
+    """
+
+    nx = 1
+
+    def __init__(self, Kp, Ki, Ks=2.0):
+        self.Kp = np.asarray(Kp, dtype=float)
+        self.Ki = np.asarray(Ki, dtype=float)
+        self.Ks = np.asarray(Ks, dtype=float)
+
+    def unlimited(self, x, u):
+        return self.Kp * u + x
+
+    def output(self, x, u, lower, upper):
+        return np.clip(self.Kp * u + x, lower, upper)
+
+    def deriv(self, x, u, lower, upper):
+        ys = self.Kp * u + x
+        return self.Ki * (u - self.Ks * (ys - np.clip(ys, lower, upper)))
+
+
+def deadband(u, lower, upper):
+    """Dead band without offset: 0 inside ``[lower, upper]``, ``u - upper`` above, ``u - lower`` below."""
+    return np.where(u > upper, u - upper, np.where(u < lower, u - lower, 0.0))

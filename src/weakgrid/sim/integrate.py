@@ -445,6 +445,11 @@ class Simulator:
             if var_lim:   # held at a limit that moves with the solution (VRMAX*Vt): implicit in the limit
                 self.sys.update_limits(ctx)
                 limval = np.where(self.frozen > 0, self.sys.lim_hi, self.sys.lim_lo)[fz]
+                if not np.all(np.isfinite(limval)):
+                    # the limit switched off (e.g. REGCA1's LVPL above Brkpt): release the held
+                    # states and redo the step; they resume from the value they were held at
+                    self.frozen[np.nonzero(fz)[0][~np.isfinite(limval)]] = 0
+                    return None, it + 1, "release"
             f = F[:nx].copy()
             R = F
             R[:nx] = z[:nx] - c - 0.5 * h * f
@@ -476,6 +481,9 @@ class Simulator:
         corr = self._corr if (self._corr is not None and abs(self._corr_h - h) <= 1e-9 * h) else None
         while True:
             z, nit, last = self._newton(t + h, h, z_n, f_n, guess, corr)
+            if z is None and last == "release":
+                guess = corr = None
+                continue
             if z is None:
                 if not refreshed:
                     self._refresh_jacobian(t, z_n)
@@ -516,6 +524,8 @@ class Simulator:
                 self._refresh_next = True   # at the next step's predicted point
             self.z, self._f, self._ctx = z, f1, ctx
             self.t = t + h
+            if self.sys._accepting:
+                self.sys.accept(self.t, ctx)
             self.stats["steps"] += 1
             return h
 
@@ -588,6 +598,8 @@ class Simulator:
             self.z = self.solve_algebraic(self.t, self.z)
         F, self._ctx = sys.residual(self.t, self.z)
         self._f = F[:self.nx].copy()
+        if sys._accepting:
+            sys.accept(self.t, self._ctx)
         rec.add(self.t, self.z, self._ctx)
         ev_i = 0
         eps = 1e-12
@@ -642,6 +654,8 @@ class Simulator:
                             self._jump = self.z[self.nx:] - y_before
                             self._jump_t = self.t
                         self._f = F[:self.nx].copy()
+                        if sys._accepting:
+                            sys.accept(self.t, self._ctx)
                         rec.add(self.t, self.z, self._ctx)
                 elif nstep % self.save_every == 0:
                     rec.add(self.t, self.z, self._ctx)

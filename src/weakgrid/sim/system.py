@@ -87,7 +87,7 @@ def _registry():
     from .machines import GENCLS, GENROU
     from .pss import IEEEST
     from .loads import ZIP
-    from .renewables import PVD1, REGCA1
+    from .renewables import PVD1, REECA1, REECB1, REGCA1, REPCA1
 
     from .exciters import ESDC2A, ESST3A, EXAC1, EXST1, IEEET1, IEEEX1
     from .governors import IEEEG1, IEESGO, TG2, TGOV1N
@@ -96,7 +96,7 @@ def _registry():
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
                                     IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT)
-            + (REGCA1, PVD1, ZIP)}
+            + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ZIP)}
 
 
 class System:
@@ -309,6 +309,8 @@ class System:
         self.lim_idx = np.concatenate(li) if li else np.zeros(0, int)
         self.lim_lo = np.concatenate(lo) if lo else np.zeros(0)
         self.lim_hi = np.concatenate(hi) if hi else np.zeros(0)
+        # components with discrete memory (dip timers, held values) updated at accepted points
+        self._accepting = [c for c in self.comps if hasattr(c, "accept")]
         self.update_network()
         self._build_pattern()
         self.check_initial_point(limits=limits, tol=init_tol)
@@ -384,6 +386,12 @@ class System:
             raise DataError(f"initial point: bus {self.network.bus_ids[b]}", "current mismatch", worst_g,
                             f"the devices' currents do not balance the network at this bus "
                             f"({worst_g:.3g} pu > {tol:g}); check the machines/devices connected to it")
+
+    def accept(self, t, ctx):
+        """Tell components with discrete memory (e.g. REECA1's voltage-dip timers) that the point
+        evaluated in ``ctx`` at time ``t`` was accepted by the integrator."""
+        for c in self._accepting:
+            c.accept(t, ctx)
 
     def update_limits(self, ctx):
         """Refresh the non-windup limits that depend on the solution (e.g. ``VRMAX * Vt``) from ``ctx``."""

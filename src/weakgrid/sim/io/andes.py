@@ -3,7 +3,8 @@
 Supported ANDES models: the network (``Bus``, ``Line``, ``PQ``, ``Shunt``,
 ``PV``, ``Slack``), every dynamic model registered in
 :func:`weakgrid.sim.system._registry` (machines, exciters, governors, PSS,
-renewables, ZIP loads; parameters are read by their ANDES names), and the
+renewables — REGCA1 with its controls REECA1/REECB1 and REPCA1, PVD1 —, ZIP loads;
+parameters are read by their ANDES names), and the
 events ``Toggle`` (of a ``Line``: each toggle flips the line's status, so
 a second toggle recloses it) and ``Fault``. Measurement-only models
 (``BusFreq``, ``COI``, ``PMU``, ``ACEc``) and bookkeeping (``Area``,

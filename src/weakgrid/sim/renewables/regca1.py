@@ -18,10 +18,13 @@ Without an electrical control (REECA1) the commands are held at their initial va
 conventions are ANDES's: ``Iolim``, ``Iqrmax``, ``Iqrmin`` are currents on the device
 base ``Sn`` (converted by ``Sn/Sb``).
 
-Limits follow ANDES: the rate limits bound ``T dx/dt``; the non-windup upper limit LVPL
-of ``S0`` holds the state while it is at or above the limit and its input pushes up, and
-the output is the limit meanwhile (ANDES also resets the state to the limit; here the state
-is held, so after the limit releases the output resumes from the held state).
+Limits follow ANDES: the rate limits bound ``T dx/dt``; the upper limit LVPL of ``S0`` is
+an anti-windup limit that moves with ``S2``: a state that crosses it is *reset* to it and held
+there while its input pushes up (the integrator's non-windup limits, refreshed at every Newton
+iterate through :meth:`limit_values`), as ANDES's ``AntiWindup`` resets the state. The output
+is the state. (Holding the state where it was when the limit first bound, and clipping only
+the output, leaves the state far above a limit that fell in a fault; when LVPL switches off
+at ``Brkpt`` the output then jumps back to the state, and the step cannot converge.)
 """
 
 from __future__ import annotations
@@ -107,6 +110,20 @@ class REGCA1(Component):
         lim = np.where(s2 <= p["Zerox"], 0.0, np.where(s2 <= p["Brkpt"], seg, 9999.0))
         return np.where(on, lim, 9999.0)
 
+    limit_fields = {"S0": ("lower limit", "LVPL (Brkpt, Zerox, Lvpl1)")}
+
+    def limits(self):
+        """``S0`` below LVPL(S2) (anti-windup, reset to the limit when it crosses it)."""
+        return [(self.idx("S0"), np.full(self.n, -np.inf), self._lvpl_limit(self._v0))]
+
+    def _lvpl_limit(self, s2):
+        lim = self._lvpl(s2)
+        return np.where(lim >= 9999.0, np.inf, lim)     # off: no limit (releases a held state)
+
+    def limit_values(self, ctx):
+        """Current LVPL limit of ``S0`` from the filtered voltage ``S2`` in ``ctx``."""
+        return np.full(self.n, -np.inf), self._lvpl_limit(ctx.x[self.sl(2)])
+
     def init(self, system, x, sig):
         pf = system.network.pf
         p = self.p
@@ -114,6 +131,7 @@ class REGCA1(Component):
         v = np.abs(V)
         self.p0 = pf.Pg[self.gen] * p["gammap"]
         self.q0 = pf.Qg[self.gen] * p["gammaq"]
+        self._v0 = v.copy()
         lvg = self._lvg(v)
         for i in np.nonzero(lvg <= 0)[0]:
             raise DataError(self.element(i), "Lvpnt0", p["Lvpnt0"][i],
@@ -152,7 +170,7 @@ class REGCA1(Component):
         v = np.abs(V)
         lvpl = self._lvpl(s2)
         self._lvpl_v = lvpl
-        ip = np.minimum(s0, lvpl)
+        ip = s0                       # held at/below LVPL by the integrator (anti-windup reset)
         lvg = self._lvg(v)
         ipout = ip * lvg
         hvg = np.maximum(p["Khv"] * (v - p["Volim"]), 0.0)
@@ -175,9 +193,7 @@ class REGCA1(Component):
         s0, s1, s2 = x[..., sl[0]], x[..., sl[1]], x[..., sl[2]]
         ipcmd, iqcmd = ctx.sig["REGCA1.Ipcmd"], ctx.sig["REGCA1.Iqcmd"]
         ipout, iqout, lvg, lvpl, v = self._o
-        d0 = self.S0.deriv(s0, ipcmd)
-        at_upper = (s0 >= lvpl) & (d0 >= 0)            # non-windup upper limit LVPL
-        ctx.f[..., sl[0]] = np.where(at_upper, 0.0, d0)
+        ctx.f[..., sl[0]] = self.S0.deriv(s0, ipcmd)   # upper limit LVPL: see limits()
         ctx.f[..., sl[1]] = self.S1.deriv(s1, iqcmd)
         ctx.f[..., sl[2]] = self.S2.deriv(s2, v)
         o = ctx.out

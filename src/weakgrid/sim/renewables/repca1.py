@@ -1,0 +1,294 @@
+"""REPCA1: WECC generic renewable plant control model A (PSS/E REPCA1, PSLF REPC_A).
+
+Adds a plant-level reactive and active power correction (``Qext``, ``Pext``) to the references
+of one electrical control (:class:`~.reeca1.REECA1`). Block diagram (system per unit, times in
+s; ``V`` is the voltage of the converter's bus, the line is the monitored branch)::
+
+    Iline = Isign (V1 - V2) / (r + jx),  Pline + jQline = Isign V1 conj(Iline)/Isign^2
+            (Isign = +1 when the converter is at the line's bus1, -1 at bus2; 0 without a line)
+    VCsel = |V - (Rc + jXc) Iline|  (VCFlag = 1)   or   Kc Qline + |V|  (VCFlag = 0)
+    VCsel --[Lag 1/(1+sTfltr)]--> s0,       Qline --[Lag 1/(1+sTfltr)]--> s1
+    Refsel = Vref0 - s0 (RefFlag = 1)   or   Qline0 - s1 (RefFlag = 0)
+    e = clip(deadband(Refsel; dbd1, dbd2), emin, emax), held while |V| < Vfrz
+    e --[PI Kp, Ki (tracking anti-windup), Qmin..Qmax]--> s2 --[LeadLag (1+sTft)/(1+sTfv)]--> Qext
+    Pline --[Lag 1/(1+sTp)]--> s4
+    ferr = 1 - f;   droop = Ddn * fdb if fdb < 0 else Dup * fdb,   fdb = deadband(ferr; fdbd1, fdbd2)
+    Perr = droop + PLflag (Pline0 - s4),   fe = clip(Perr, femin, femax)
+    fe --[PI Kpg, Kig (tracking anti-windup), Pmin..Pmax]--> s5 --[Lag 1/(1+sTg)]--> s6
+    Pext = Fflag * s6
+
+The frequency ``f`` [pu] is measured at the converter's bus as ANDES's ``BusFreq`` does
+(angle lag ``Tf``, washout ``Tw``; the constants of the BusFreq named in ``busf`` or found at
+the bus, ANDES's defaults 0.02 s and 0.1 s otherwise). ``Rc``, ``Xc`` default to the monitored
+line's ``r``, ``x`` (system base) on import, as ANDES. The PI tracking gains are ANDES's
+configuration ``kqs = ksg = 2``, and the hold of ``e`` its ``freeze = 1``. ``Pmax``, ``Pmin`` are
+powers on the converter's rating ``Sn``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..blocks import Lag, LeadLag, PITrackAW, Washout, deadband
+from ..component import Component
+from ..errors import DataError
+from ..params import Param
+
+_EC = ("REECA1", "REECB1")     # electrical controls a plant control may drive
+
+
+def _flag(name, info, default=None):
+    return Param(name, default, "-", info, "nonneg")
+
+
+class REPCA1(Component):
+    """Renewable plant control model A (WECC); drives one REECA1 or REECB1."""
+
+    kind = "device"
+    order = 1            # before REECA1/REECB1, which read Pext and Qext
+    params = (
+        _flag("VCFlag", "1 line drop compensation, 0 droop (Kc Qline)"),
+        _flag("RefFlag", "1 voltage control, 0 Q control"),
+        _flag("Fflag", "frequency control on (1) or off (0)"),
+        _flag("PLflag", "line power control on (1) or off (0)", 1.0),
+        Param("Tfltr", 0.02, "s", "voltage and Q filter time constant (0: none)", "nonneg"),
+        Param("Kp", 1.0, "pu/pu", "Q PI proportional gain"),
+        Param("Ki", 0.1, "1/s", "Q PI integral gain"),
+        Param("Tft", 1.0, "s", "lead time constant", "nonneg"),
+        Param("Tfv", 1.0, "s", "lag time constant (0: none)", "nonneg"),
+        Param("Vfrz", 0.8, "pu", "voltage below which e is held"),
+        Param("Rc", 0.0, "pu", "line drop compensation resistance (system base)"),
+        Param("Xc", 0.0, "pu", "line drop compensation reactance (system base)"),
+        Param("Kc", 0.0, "pu/pu", "reactive droop gain"),
+        Param("emax", 999.0, "pu", "upper limit of the deadband output"),
+        Param("emin", -999.0, "pu", "lower limit of the deadband output"),
+        Param("dbd1", -0.1, "pu", "lower edge of the voltage/Q dead band"),
+        Param("dbd2", 0.1, "pu", "upper edge of the voltage/Q dead band"),
+        Param("Qmax", 999.0, "pu", "upper limit of the Q PI output"),
+        Param("Qmin", -999.0, "pu", "lower limit of the Q PI output"),
+        Param("Kpg", 1.0, "pu/pu", "P PI proportional gain"),
+        Param("Kig", 0.1, "1/s", "P PI integral gain"),
+        Param("Tp", 0.02, "s", "line power filter time constant (0: none)", "nonneg"),
+        Param("fdbd1", -0.0002833, "pu", "lower edge of the frequency dead band"),
+        Param("fdbd2", 0.0002833, "pu", "upper edge of the frequency dead band"),
+        Param("femax", 0.05, "pu", "upper limit of the power error"),
+        Param("femin", -0.05, "pu", "lower limit of the power error"),
+        Param("Pmax", 999.0, "pu (Sn)", "upper limit of the P PI output", "", "power"),
+        Param("Pmin", -999.0, "pu (Sn)", "lower limit of the P PI output", "", "power"),
+        Param("Tg", 0.02, "s", "Pext lag time constant (0: none)", "nonneg"),
+        Param("Ddn", 10.0, "pu/pu", "down-regulation droop gain (over-frequency)"),
+        Param("Dup", 10.0, "pu/pu", "up-regulation droop gain (under-frequency)"),
+        Param("fn", 60.0, "Hz", "nominal frequency", "pos"),
+        Param("Tf", 0.02, "s", "frequency measurement: angle filter", "pos"),
+        Param("Tw", 0.1, "s", "frequency measurement: washout", "pos"),
+        Param("kqs", 2.0, "pu/pu", "Q PI tracking gain (ANDES config)", "nonneg"),
+        Param("ksg", 2.0, "pu/pu", "P PI tracking gain (ANDES config)", "nonneg"),
+    )
+    states = ("s0", "s1", "s2", "s3", "s4", "s5", "s6", "L", "WO")
+    outputs = ("Pext", "Qext", "f", "Pline", "Qline", "eHld", "fe", "s5_y")
+
+    # ------------------------------------------------------------------ import
+    @classmethod
+    def andes_link(cls, m, k, dev_name, ss, **_):
+        """Link of ANDES device ``k``: its REECA1 and the 0-based row of its monitored line."""
+        name = dev_name.get(("REECA1", m.ree.v[k])) or dev_name.get(("REECB1", m.ree.v[k]))
+        dev = f"ANDES REPCA1 {m.idx.v[k]}"
+        if name is None:
+            if any(e in ss.models and m.ree.v[k] in list(ss.models[e].idx.v) for e in _EC):
+                return None
+            raise DataError(dev, "ree", m.ree.v[k], "no REECA1 or REECB1 with this idx (the only "
+                            "electrical controls supported)")
+        if m.busr.v[k] not in (None, ""):
+            raise DataError(dev, "busr", m.busr.v[k], "remote measurement is not supported; leave it empty")
+        line = m.line.v[k]
+        row = None
+        if line not in (None, ""):
+            lines = list(ss.Line.idx.v)
+            if line not in lines:
+                raise DataError(dev, "line", line, "no Line with this idx")
+            row = lines.index(line)
+        rc, xc = m.Rc.v[k], m.Xc.v[k]
+        return {"ree": name, "line": row, "zline": rc is None or xc is None}
+
+    @classmethod
+    def andes_params(cls, m, k, ss, values):
+        """Rc, Xc from the line when missing; BusFreq constants; ANDES configuration."""
+        for f in ("Rc", "Xc"):
+            if not np.isfinite(values.get(f, 0.0)):
+                values.pop(f, None)
+        bf = m.busf.v[k]
+        bfm = ss.models.get("BusFreq")
+        if bfm is not None and bfm.n:
+            ids = list(bfm.idx.v)
+            j = ids.index(bf) if bf in ids else None
+            if j is None:   # ANDES finds the BusFreq at the converter's bus (DeviceFinder)
+                ec = next(ss.models[e] for e in _EC if m.ree.v[k] in list(ss.models[e].idx.v))
+                reg = ec.reg.v[list(ec.idx.v).index(m.ree.v[k])]
+                bus = ss.REGCA1.bus.v[list(ss.REGCA1.idx.v).index(reg)]
+                on = [i for i, b in enumerate(bfm.bus.v) if b == bus]
+                j = on[0] if on else None
+            if j is not None:
+                values["Tf"], values["Tw"] = float(bfm.Tf.v[j]), float(bfm.Tw.v[j])
+                values["fn"] = float(bfm.fn.v[j])
+        for f in ("kqs", "ksg"):
+            if hasattr(m.config, f):
+                values[f] = float(getattr(m.config, f))
+        return values
+
+    def add_repca1(self, name, ree, line=None, **params):
+        """Add one plant control driving the REECA1 named ``ree``, monitoring branch row ``line``."""
+        self.add(name, {"ree": ree, "line": line}, params)
+        return name
+
+    # ------------------------------------------------------------------- setup
+    def setup(self, system):
+        super().setup(system)
+        p = self.p
+        regc = system.components.get("REGCA1")
+        ecs = [system.components[e] for e in _EC if e in system.components]
+        net = system.network
+        self.ree = np.zeros(self.n, int)
+        self.ree_comps = [None] * self.n
+        self.bus = np.zeros(self.n, int)
+        self.b1 = np.zeros(self.n, int)
+        self.b2 = np.zeros(self.n, int)
+        self.isign = np.zeros(self.n)
+        self.zl = np.ones(self.n, complex)
+        Sn = np.zeros(self.n)
+        for i, lk in enumerate(self.links):
+            ree = next((c for c in ecs if lk.get("ree") in c.names), None)
+            if ree is None:
+                raise DataError(self.element(i), "ree", lk.get("ree"),
+                                "give the name of a REECA1 or REECB1 of the system")
+            j = ree.names.index(lk["ree"])
+            self.ree[i] = j
+            self.ree_comps[i] = ree
+            r = regc.names.index(ree.links[j]["reg"])
+            self.bus[i] = regc.bus[r]
+            Sn[i] = regc.p["Sn"][r]
+            row = lk.get("line")
+            if row is None:
+                self.b1[i] = self.b2[i] = self.bus[i]
+                continue
+            if not (0 <= int(row) < net.branch.shape[0]):
+                raise DataError(self.element(i), "line", row, "give a 0-based row of the branch table")
+            br = net.branch[int(row)]
+            self.b1[i] = net.index_of(int(br[0]), self.element(i), "line bus1")
+            self.b2[i] = net.index_of(int(br[1]), self.element(i), "line bus2")
+            self.zl[i] = br[2] + 1j * br[3]
+            self.isign[i] = 1.0 if self.b1[i] == self.bus[i] else (-1.0 if self.b2[i] == self.bus[i] else 0.0)
+            if self.isign[i] == 0:
+                raise DataError(self.element(i), "line", row, "the monitored line must end at the converter's bus")
+            if lk.get("zline"):
+                p["Rc"][i], p["Xc"][i] = br[2], br[3]
+        c = Sn / system.Sb
+        for prm in self.params:
+            if prm.base == "power":
+                p[prm.name] = p[prm.name] * c
+        self.regc = regc
+        # per electrical-control type: (rows of this model, their indices in that type)
+        self._targets = {}
+        for c in ecs:
+            rows = np.array([i for i in range(self.n) if self.ree_comps[i] is c], int)
+            if len(rows):
+                self._targets[c.type_name] = (c.n, rows, self.ree[rows])
+        self.s0b = Lag(1.0, p["Tfltr"])
+        self.s1b = Lag(1.0, p["Tfltr"])
+        self.s2b = PITrackAW(p["Kp"], p["Ki"], p["kqs"])
+        self.s3b = LeadLag(p["Tft"], p["Tfv"])
+        self.s4b = Lag(1.0, p["Tp"])
+        self.s5b = PITrackAW(p["Kpg"], p["Kig"], p["ksg"])
+        self.s6b = Lag(1.0, p["Tg"])
+        self.iwn = 1.0 / (2 * np.pi * p["fn"])
+        self.WOb = Washout(self.iwn, p["Tw"])
+
+    def pattern(self, system):
+        rc = self.regc
+        out = []
+        for i in range(self.n):
+            j, ree = self.ree[i], self.ree_comps[i]
+            r = rc.names.index(ree.links[j]["reg"])
+            v = (self.instance_states(i) + ree.instance_states(j) + rc.instance_states(r)
+                 + system.bus_vars(self.bus[i]) + system.bus_vars(self.b1[i]) + system.bus_vars(self.b2[i]))
+            out.append((v, v))
+        return out
+
+    # ---------------------------------------------------------------- algebra
+    def _line(self, V):
+        V1, V2 = V[..., self.b1], V[..., self.b2]
+        Vb = V[..., self.bus]
+        I = self.isign * (V1 - V2) / self.zl
+        S = self.isign * V1 * np.conj((V1 - V2) / self.zl)
+        Vc = np.abs(Vb - (self.p["Rc"] + 1j * self.p["Xc"]) * I)
+        v = np.abs(Vb)
+        vcsel = np.where(self.p["VCFlag"] > 0, Vc, S.imag * self.p["Kc"] + v)
+        return S.real, S.imag, vcsel, v
+
+    def init(self, system, x, sig):
+        V = system.network.pf.V
+        self.V0 = V[self.bus].copy()
+        P, Q, vcsel, v = self._line(V)
+        self.Pline0, self.Qline0, self.Vref0 = P, Q, vcsel
+        for i in np.nonzero(v < self.p["Vfrz"])[0]:
+            raise DataError(self.element(i), "Vfrz", self.p["Vfrz"][i],
+                            f"the initial voltage {v[i]:.4g} pu is below Vfrz: the control would start held")
+        x[self.sl(0)] = vcsel
+        x[self.sl(1)] = Q
+        x[self.sl(4)] = P
+        for k in (2, 3, 5, 6, 7, 8):
+            x[self.sl(k)] = 0.0
+        self._ehold = np.zeros(self.n)
+
+    def compute(self, ctx):
+        p = self.p
+        x = ctx.x
+        sl = self._sls
+        s0, s1, s2, s3, s4, s5, s6, L, wo = (x[..., sl[k]] for k in range(9))
+        P, Q, vcsel, v = self._line(ctx.V)
+        # frequency at the bus (ANDES BusFreq): angle lag and washout
+        Vb = ctx.V[..., self.bus]
+        err = np.angle(Vb * np.conj(self.V0) * np.exp(-1j * L))
+        f = 1.0 + self.WOb.output(wo, L)
+        # reactive power / voltage
+        s0y, s1y = self.s0b.output(s0, vcsel), self.s1b.output(s1, Q)
+        refsel = np.where(p["RefFlag"] > 0, self.Vref0 - s0y, self.Qline0 - s1y)
+        enf = np.clip(deadband(refsel, p["dbd1"], p["dbd2"]), p["emin"], p["emax"])
+        held = v < p["Vfrz"]
+        ehld = np.where(held, self._ehold, enf)
+        s2y = self.s2b.output(s2, ehld, p["Qmin"], p["Qmax"])
+        qext = self.s3b.output(s3, s2y)
+        # active power / frequency
+        s4y = self.s4b.output(s4, P)
+        fdb = deadband(1.0 - f, p["fdbd1"], p["fdbd2"])
+        droop = np.where(fdb < 0, fdb * p["Ddn"], fdb * p["Dup"])
+        perr = droop + np.where(p["PLflag"] > 0, self.Pline0 - s4y, 0.0)
+        fe = np.clip(perr, p["femin"], p["femax"])
+        s5y = self.s5b.output(s5, fe, p["Pmin"], p["Pmax"])
+        s6y = self.s6b.output(s6, s5y)
+        pext = np.where(p["Fflag"] > 0, s6y, 0.0)
+        for tn, (n, rows, idx) in self._targets.items():
+            for key, val in (("Pext", pext), ("Qext", qext)):
+                arr = np.zeros(x.shape[:-1] + (n,))
+                arr[..., idx] = val[..., rows]
+                ctx.sig[f"{tn}.{key}"] = arr
+        fd = ctx.f
+        fd[..., sl[0]] = self.s0b.deriv(s0, vcsel)
+        fd[..., sl[1]] = self.s1b.deriv(s1, Q)
+        fd[..., sl[2]] = self.s2b.deriv(s2, ehld, p["Qmin"], p["Qmax"])
+        fd[..., sl[3]] = self.s3b.deriv(s3, s2y)
+        fd[..., sl[4]] = self.s4b.deriv(s4, P)
+        fd[..., sl[5]] = self.s5b.deriv(s5, fe, p["Pmin"], p["Pmax"])
+        fd[..., sl[6]] = self.s6b.deriv(s6, s5y)
+        fd[..., sl[7]] = err / p["Tf"]
+        fd[..., sl[8]] = self.WOb.deriv(wo, L)
+        o = ctx.out
+        o["REPCA1.Pext"], o["REPCA1.Qext"], o["REPCA1.f"] = pext, qext, f
+        o["REPCA1.Pline"], o["REPCA1.Qline"], o["REPCA1.eHld"] = P, Q, ehld
+        o["REPCA1.fe"], o["REPCA1.s5_y"] = fe, s5y
+        o["REPCA1.held"] = held.astype(float)
+        o["REPCA1.enf"] = enf
+
+    def accept(self, t, ctx):
+        """Hold memory of ``e``: its last value while the voltage was above Vfrz."""
+        held = ctx.out["REPCA1.held"] > 0.5
+        self._ehold = np.where(held, self._ehold, ctx.out["REPCA1.enf"])
