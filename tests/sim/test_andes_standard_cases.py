@@ -10,8 +10,9 @@ What these cases exercise: ieee14 — GENROU with ESST3A (``TA = 0``: no regulat
 TGOV1 (xlsx) / IEEEG1 + ST2CUT (dyr); ieee39 — ten GENROU (``xl > xd2``, accepted with a
 warning as in ANDES) with IEEEX1 and TGOV1N; wecc — 29 GENROU (``xq1 = xq`` on some) with
 ESDC2A, ESST3A, EXST1, IEEEG1, ST2CUT. Measured (2026-11-26, h = 1/120 s): ieee14 xlsx
-1.1e-5 pu / 0.023 deg, raw + dyr 1.1e-5 pu / 0.022 deg; ieee39 3.9e-6 pu / 0.012 deg;
-wecc xlsx 8.0e-6 pu / 0.033 deg.
+1.1e-5 pu / 0.023 deg, raw + dyr 1.2e-5 pu / 0.022 deg; ieee39 3.9e-6 pu / 0.012 deg;
+wecc xlsx 8.0e-6 pu / 0.033 deg, raw + dyr 5.1e-6 pu / 0.022 deg. The five cases took 112 s
+together on the shared 2-core machine at load ~5.
 
 The PSS/E variants run 5 s (the parser path is what they add; the first swing and its damping
 are inside), the others 10 s.
