@@ -13,6 +13,9 @@ Block diagram (pu, times in s; PSS/E ESST3A and ANDES conventions)::
     IN  = KC*XadIfd/VE,  VB = min(VE * FEX(IN), VBMAX)
     Efd = VB * VM
 
+``TA = 0`` (as in ANDES's ieee14 data) makes the regulator the limited gain
+``VR = clip(KA*VA, VRMIN, VRMAX)`` (the state ``VR`` is then unused).
+
 ``Vt``, ``It`` are the machine terminal voltage and current phasors on the
 system base (the magnitude does not depend on the reference frame, so the
 network frame is used). No under-excitation limiter (the UEL input is -inf,

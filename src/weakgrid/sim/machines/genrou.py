@@ -20,6 +20,10 @@ reactances must be equal, ``xd2 == xq2``)::
 Saturation coefficients ``A, B`` come from ``(1.0, S10)`` and ``(1.2, S12)``
 through :func:`weakgrid.sim.blocks.quad_saturation_coeffs` (``S10 = 0`` disables it).
 The steady-state initialization follows the OpenIPSL/ANDES procedure.
+
+Data checks: ``xd2 < xd1 <= xd`` and ``xq2 < xq1 <= xq`` (``xq1 = xq``, no q-axis
+transient effect, occurs in ANDES's wecc data), ``xl < xd1, xq1``; ``xl >= xd2`` (ANDES's
+ieee39 data) is unusual but well defined and is accepted with a warning, as ANDES does.
 """
 
 from __future__ import annotations
