@@ -86,3 +86,19 @@ def test_psse_raw_dyr_through_andes_parser_equals_xlsx():
             va, vb = {**va, "S12": 0.0}, {**vb, "S12": 0.0}
         assert va == pytest.approx(vb)
     assert sorted(xl.components) == sorted(rd.components)
+
+
+def test_zip_loads_of_a_case_not_set_up():
+    """ANDES's ieee14_zip.json, read with setup=False as the importer expects: the ZIP load
+    imports with the powers of the PQ load it replaces (before the fix: TypeError, the PQ
+    parameters have no input copy ``vin`` before ANDES's setup). Its shares of P sum to 90 %
+    (ANDES warns and starts off equilibrium): refused at setup, naming the field."""
+    ss = load_case("ieee14/ieee14_zip.json")
+    system, _ = from_andes(ss)
+    zip_ = system.components["ZIP"]
+    assert len(zip_.names) == ss.ZIP.n > 0
+    k = list(ss.PQ.idx.v).index(ss.ZIP.pq.v[0])
+    assert zip_.links[0]["P0"] == pytest.approx(ss.PQ.p0.v[k]) and zip_.links[0]["P0"] != 0
+    with pytest.raises(DataError, match="kpp.*sum to 100") as e:
+        system.setup()
+    assert "= 90 %" in str(e.value)

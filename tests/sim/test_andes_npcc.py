@@ -2,9 +2,13 @@
 against ANDES (issue 8, item 1).
 
 Before machine currents accumulated on shared buses, the network residual at t = 0 was
-2.7 and 5.4 pu at those buses and the speeds swung with no event. npcc's exciters are
-IEEEX1, not in the library yet, so both tools run the case without them (the .dyr
-records of IEEEX1 removed): GENROU + GENCLS + TGOV1.
+2.7 and 5.4 pu at those buses and the speeds swung with no event. Both tools run the
+case without its IEEEX1 exciters (the .dyr records of IEEEX1 removed): GENROU + GENCLS +
+TGOV1. With them, a fault at shared bus 23 drives nine IEEEX1 regulators to their
+ceiling VRMAX*Vt, which follows the collapsed terminal voltage in weakgrid (IEEE 421.5)
+and stays at its initial value in ANDES 2.0: 1.15e-4 pu and 0.78 deg apart at 1/120 s.
+The full case (IEEEX1 included) matches ANDES within 5.5e-6 pu with the census fault
+at a load bus (benchmarks/andes_case_census.json).
 """
 
 import numpy as np

@@ -72,3 +72,26 @@ def test_genrou_requires_equal_subtransient():
     s.add_machine("GENCLS", "G2", 1)
     with pytest.raises(DataError, match="xq2 == xd2"):
         s.setup()
+
+
+def test_genrou_accepts_data_that_andes_ships():
+    """ANDES's ieee39 has xl > xd2 and its wecc has xq1 = xq: both well defined, accepted (the first
+    with a warning, as ANDES does) and the initial point is steady; xl >= xd1 is still refused."""
+    import numpy as np
+
+    for kw, warns in ((dict(xl=0.2, xd2=0.1, xq2=0.1), True), (dict(xq=0.6, xq1=0.6), False)):
+        s = System(two_machine_case())
+        s.add_machine("GENROU", "G1", 0, **kw)
+        s.add_machine("GENCLS", "G2", 1)
+        if warns:
+            with pytest.warns(UserWarning, match="xl = 0.2 >= xd2"):
+                s.setup()
+        else:
+            s.setup()
+        F, _ = s.residual(0.0, s.z0)
+        assert np.max(np.abs(F)) < 1e-9
+    s = System(two_machine_case())
+    s.add_machine("GENROU", "G1", 0, xl=0.5, xd1=0.3)
+    s.add_machine("GENCLS", "G2", 1)
+    with pytest.raises(DataError, match="xl"):
+        s.setup()

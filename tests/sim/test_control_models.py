@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from sim_cases import two_machine_case
 
-from weakgrid.sim.blocks import WashoutOrLag, rectifier_fex
+from weakgrid.sim.blocks import LagNonWindup, WashoutOrLag, rectifier_fex
 from weakgrid.sim.errors import DataError
 from weakgrid.sim.system import System
 
@@ -66,6 +66,28 @@ def test_ieeeg1_cross_compound_split_warns_and_setup_refuses_the_drift():
 def test_st2cut_refuses_frequency_input():
     with pytest.raises(DataError, match="MODE"):
         _system(exciter=("EXST1", {}), pss=("ST2CUT", dict(MODE=2)))
+
+
+def test_lag_nonwindup_with_zero_time_constant_is_a_limited_gain():
+    """T = 0 (ANDES's ieee14 ESST3A data has TA = 0): the output is clip(K*u), not the frozen state."""
+    b = LagNonWindup(np.array([2.0, 2.0, 2.0]), np.array([0.0, 0.0, 1.0]), -1.0, 1.0)
+    x = np.array([0.3, 0.3, 0.3])
+    assert np.all(b.output(x, np.array([0.8, 0.2, 0.8])) == [1.0, 0.4, 0.3])
+    assert np.all(b.deriv(x, np.array([0.8, 0.2, 0.8]))[:2] == 0.0)
+
+
+def test_esst3a_without_regulator_lag_starts_in_steady_state():
+    """ESST3A with TA = 0 (as in ANDES's ieee14 cases) is accepted and starts steady; its
+    regulator output then follows KA*VA at once (no frozen state)."""
+    s = _system(exciter=("ESST3A", dict(EXCITERS["ESST3A"], TA=0.0)))
+    F, ctx = s.residual(0.0, s.z0)
+    assert np.max(np.abs(F)) < 1e-9
+    c = s.components["ESST3A"]
+    z = s.z0.copy()
+    z[c.idx("LL")] += 0.01                       # lead-lag state up: VA up by (1 - TC/TB)*0.01
+    F1, _ = s.residual(0.0, z)                   # -> VR up by KA times that, at once
+    dva = (1 - c.p["TC"][0] / c.p["TB"][0]) * 0.01
+    assert F1[c.idx("VM")] == pytest.approx(c.p["KM"][0] * 20 * dva / c.p["TM"][0], rel=1e-6)
 
 
 def test_washout_with_zero_gain_is_a_lag():

@@ -66,7 +66,8 @@ class LagNonWindup(Lag):
     Parameters
     ----------
     K, T : array_like
-        Gain [pu/pu] and time constant [s] (must be > 0).
+        Gain [pu/pu] and time constant [s]; ``T = 0`` makes the block the limited gain
+        ``clip(K*u, lower, upper)`` (its state is then unused), as in ANDES.
     lower, upper : array_like
         State (= output) limits [pu].
     """
@@ -77,7 +78,9 @@ class LagNonWindup(Lag):
         self.upper = np.asarray(upper, dtype=float)
 
     def output(self, x, u):
-        return x
+        if self._all:
+            return x
+        return np.where(self._on, x, np.clip(self.K * u, self.lower, self.upper))
 
 
 class LeadLag:

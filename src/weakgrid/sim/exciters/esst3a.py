@@ -13,6 +13,9 @@ Block diagram (pu, times in s; PSS/E ESST3A and ANDES conventions)::
     IN  = KC*XadIfd/VE,  VB = min(VE * FEX(IN), VBMAX)
     Efd = VB * VM
 
+``TA = 0`` (as in ANDES's ieee14 data) makes the regulator the limited gain
+``VR = clip(KA*VA, VRMIN, VRMAX)`` (the state ``VR`` is then unused).
+
 ``Vt``, ``It`` are the machine terminal voltage and current phasors on the
 system base (the magnitude does not depend on the reference frame, so the
 network frame is used). No under-excitation limiter (the UEL input is -inf,
@@ -51,7 +54,7 @@ class ESST3A(MachineControl):
         Param("TC", 3.0, "s", "lead time constant", "nonneg"),
         Param("TB", 15.0, "s", "lag time constant", "nonneg"),
         Param("KA", 50.0, "pu", "regulator gain", "pos"),
-        Param("TA", 0.1, "s", "regulator time constant", "pos"),
+        Param("TA", 0.1, "s", "regulator time constant (0: no lag)", "nonneg"),
         Param("VRMAX", 8.0, "pu", "maximum regulator output", ""),
         Param("VRMIN", 0.0, "pu", "minimum regulator output", ""),
         Param("KG", 1.0, "pu", "inner-loop feedback gain", "nonneg"),
@@ -118,11 +121,12 @@ class ESST3A(MachineControl):
         VB = self._vb(VE, s["XadIfd"][..., m])
         efd = VB * vm
         vg = np.minimum(p["KG"] * efd, p["VGMAX"])
+        vr_out = self.LA.output(vr, va)           # = vr unless TA = 0 (then clip(KA*va))
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LL.deriv(ll, vil)
         f[..., self._sls[2]] = self.LA.deriv(vr, va)
-        f[..., self._sls[3]] = self.LM.deriv(vm, vr - vg)
+        f[..., self._sls[3]] = self.LM.deriv(vm, vr_out - vg)
         s["vf"][..., m] = efd
         o = ctx.out
         o["ESST3A.vi"], o["ESST3A.VE"], o["ESST3A.VB"], o["ESST3A.vout"] = vi, VE, VB, efd

@@ -45,8 +45,9 @@ class ZIP(Component):
         j = list(pq.idx.v).index(m.pq.v[k])
         if pq.u.v[j] <= 0:
             return None
-        p0 = float(getattr(pq.p0, "vin", pq.p0.v)[j])
-        q0 = float(getattr(pq.q0, "vin", pq.q0.v)[j])
+        # ``vin`` (input values) exists only after ANDES's setup; before it, ``v`` holds them
+        p0 = float(pq.p0.v[j] if getattr(pq.p0, "vin", None) is None else pq.p0.vin[j])
+        q0 = float(pq.q0.v[j] if getattr(pq.q0, "vin", None) is None else pq.q0.vin[j])
         return {"bus": int(pos[pq.bus.v[j]]), "P0": p0, "Q0": q0}
 
     def add_zip(self, name, bus, P0, Q0, **params):

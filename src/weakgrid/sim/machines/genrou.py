@@ -20,9 +20,15 @@ reactances must be equal, ``xd2 == xq2``)::
 Saturation coefficients ``A, B`` come from ``(1.0, S10)`` and ``(1.2, S12)``
 through :func:`weakgrid.sim.blocks.quad_saturation_coeffs` (``S10 = 0`` disables it).
 The steady-state initialization follows the OpenIPSL/ANDES procedure.
+
+Data checks: ``xd2 < xd1 <= xd`` and ``xq2 < xq1 <= xq`` (``xq1 = xq``, no q-axis
+transient effect, occurs in ANDES's wecc data), ``xl < xd1, xq1``; ``xl >= xd2`` (ANDES's
+ieee39 data) is unusual but well defined and is accepted with a warning, as ANDES does.
 """
 
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 
@@ -67,11 +73,17 @@ class GENROU(SyncMachine):
             if abs(p["xd2"][i] - p["xq2"][i]) > 1e-12 * max(1.0, abs(p["xd2"][i])):
                 raise DataError(self.element(i), "xq2", self._values[i]["xq2"],
                                 "GENROU needs xq2 == xd2 (round rotor, as in PSS/E and ANDES); set xq2 = xd2")
-            if not p["xl"][i] < p["xd2"][i]:
-                raise DataError(self.element(i), "xl", self._values[i]["xl"], "leakage reactance must be < xd2")
-            if not (p["xd2"][i] < p["xd1"][i] < p["xd"][i]) or not (p["xq2"][i] < p["xq1"][i] < p["xq"][i]):
+            if not p["xl"][i] < min(p["xd1"][i], p["xq1"][i]):
+                raise DataError(self.element(i), "xl", self._values[i]["xl"],
+                                "leakage reactance must be < xd1 and < xq1")
+            if not p["xl"][i] < p["xd2"][i]:   # unusual but well defined (ANDES's ieee39 data): warn, as ANDES
+                warnings.warn(f"{self.element(i)}: leakage reactance xl = {p['xl'][i]:g} >= xd2 = "
+                              f"{p['xd2'][i]:g} (normally xl < xd2); accepted, as in ANDES", UserWarning,
+                              stacklevel=2)
+            # xq1 = xq (no q-axis transient effect, ANDES's wecc data) is well defined
+            if not (p["xd2"][i] < p["xd1"][i] <= p["xd"][i]) or not (p["xq2"][i] < p["xq1"][i] <= p["xq"][i]):
                 raise DataError(self.element(i), "xd1", self._values[i]["xd1"],
-                                "need xd2 < xd1 < xd and xq2 < xq1 < xq")
+                                "need xd2 < xd1 <= xd and xq2 < xq1 <= xq")
         xl = p["xl"]
         self.gd1 = (p["xd2"] - xl) / (p["xd1"] - xl)
         self.gq1 = (p["xq2"] - xl) / (p["xq1"] - xl)
