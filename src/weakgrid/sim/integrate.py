@@ -474,12 +474,12 @@ class Simulator:
         """Advance one step of size ``h`` (may be shortened on failure). Returns the step taken."""
         t, z_n, f_n = self.t, self.z, self._f
         li = self.sys.lim_idx
-        if self.sys._var_lim:   # limits that move with the solution, taken at t_n
-            self.sys.update_limits(self._ctx)
         guess = None            # linearly implicit predictor (see _newton)
         refreshed = False
         corr = self._corr if (self._corr is not None and abs(self._corr_h - h) <= 1e-9 * h) else None
         while True:
+            if self.sys._var_lim:   # limits that move with the solution (VRMAX*Vt), taken at t_n at
+                self.sys.update_limits(self._ctx)   # every attempt: a failed one leaves its iterate's
             z, nit, last = self._newton(t + h, h, z_n, f_n, guess, corr)
             if z is None and last == "release":
                 guess = corr = None
