@@ -477,14 +477,16 @@ class Simulator:
         guess = None            # linearly implicit predictor (see _newton)
         refreshed = False
         corr = self._corr if (self._corr is not None and abs(self._corr_h - h) <= 1e-9 * h) else None
+        if self.sys._var_lim:   # limits that move with the solution, taken at t_n
+            self.sys.update_limits(self._ctx)
         while True:
-            if self.sys._var_lim:   # limits that move with the solution (VRMAX*Vt), taken at t_n at
-                self.sys.update_limits(self._ctx)   # every attempt: a failed one leaves its iterate's
             z, nit, last = self._newton(t + h, h, z_n, f_n, guess, corr)
             if z is None and last == "release":
                 guess = corr = None
                 continue
             if z is None:
+                if self.sys._var_lim:   # a failed attempt leaves its (diverged) iterate's limits
+                    self.sys.update_limits(self._ctx)   # (VRMAX*Vt): every retry starts from t_n's
                 if not refreshed:
                     self._refresh_jacobian(t, z_n)
                     refreshed = True
