@@ -6,6 +6,8 @@ Cases (each tool gets the same data):
 
 * ``kundur_full`` — the ANDES stock case (GENROU + EXDC2 + TGOV1), imported into weakgrid
   through ``weakgrid.sim.io.andes``; its line trip disabled.
+* ``ieee39`` — the ANDES stock case ``ieee39_full`` (ten GENROU with IEEEX1, TGOV1N, IEEEST),
+  imported the same way; fault at bus 16 (the bus with the most branches).
 * ``case39``, ``case118``, ``case300``, ``case1354pegase``, ``case2869pegase`` — the MATPOWER
   cases pandapower ships, with a classical machine (GENCLS) at every in-service generator from
   ``weakgrid.sim.templates.classical_system`` (H = 4 s, x'd = 0.3 pu, D = 0 on each machine's
@@ -13,7 +15,7 @@ Cases (each tool gets the same data):
   same GENCLS parameters through ``System.add``.
 
 Scenario: 10 s at a fixed step of 1/120 s, one three-phase fault (xf = 1e-4 pu) from 1.0 to
-1.05 s at the bus with the most branch ends (kundur_full: bus 8). Timed: the integration only
+1.05 s at the bus with the most branch ends (kundur_full: bus 8; ieee39: bus 16). Timed: the integration only
 (ANDES ``TDS.run``; weakgrid ``Simulator.run``), median of ``--repeat`` runs. Each tool and case
 runs in its own subprocess, whose peak resident memory (``ru_maxrss``, whole process including
 imports) is reported, with the resident memory after the imports (numpy, SciPy, pandapower,
@@ -45,7 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
-CASES = ["kundur_full", "case39", "case118", "case300", "case1354pegase", "case2869pegase"]
+CASES = ["kundur_full", "ieee39", "case39", "case118", "case300", "case1354pegase", "case2869pegase"]
 TF, H, T_ON, T_OFF = 10.0, 1 / 120, 1.0, 1.05
 TEMPLATE = dict(H=4.0, xd1=0.3, D=0.0)
 DEV_GOAL = 2e-5   # [pu] largest speed deviation accepted between the tools at the same step

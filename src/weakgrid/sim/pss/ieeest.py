@@ -64,11 +64,14 @@ class IEEEST(MachineControl):
         self.LL2 = LeadLag(p["T3"], p["T4"])
         self.WO = Washout(p["T5"], p["T6"])
         self._wo_lag = p["T5"] <= 0          # T5 = 0: the washout degenerates into a lag 1/(1+sT6)
+        self._any_wo_lag = bool(self._wo_lag.any())
         # VCU = 0 / VCL = 0: no cut-off on that side
         self.VCU = np.where(p["VCU"] == 0, 999.0, p["VCU"])
         self.VCL = np.where(p["VCL"] == 0, -999.0, p["VCL"])
         # constant structure flags (fast paths of compute)
-        self._mode1 = bool(np.all(p["MODE"] == 1))
+        # one input mode for all instances (the usual case): that signal alone, no select
+        self._mode = int(p["MODE"][0]) if np.all(p["MODE"] == p["MODE"][0]) else None
+        self._pe_scale = system.Sb / self.Sn   # Pe on the machine base (MODE 3)
         self._filt1 = bool(np.any((p["A1"] > 0) | (p["A2"] > 0)))
         self._filt2 = bool(np.any((p["A3"] > 0) | (p["A4"] > 0)))
         self._no_cut = bool(np.all(self.VCL <= -999.0) and np.all(self.VCU >= 999.0))
@@ -77,11 +80,18 @@ class IEEEST(MachineControl):
         p = self.p
         m = self.mach
         s = ctx.sig
-        if self._mode1:                          # all speed input (the usual case)
-            return s["omega"][..., m] - 1.0
+        if self._mode is not None:               # one input mode for all (the usual case)
+            mi = self._mi
+            if self._mode == 1:
+                return s["omega"][..., mi] - 1.0
+            if self._mode == 3:
+                return s["Pe"][..., mi] * self._pe_scale
+            if self._mode == 4:
+                return s["tm"][..., mi] - s["tm0"][..., mi]
+            return s["Vt"][..., mi]
         mode = p["MODE"]
         return np.select([mode == 1, mode == 3, mode == 4, mode == 5],
-                         [s["omega"][..., m] - 1.0, s["Pe"][..., m] * ctx.system.Sb / self.Sn,
+                         [s["omega"][..., m] - 1.0, s["Pe"][..., m] * self._pe_scale,
                           s["tm"][..., m] - s["tm0"][..., m], s["Vt"][..., m]])
 
     def init(self, system, x, sig):
@@ -136,12 +146,12 @@ class IEEEST(MachineControl):
         f[..., sl[5]] = self.LL2.deriv(x5, y3)
         vks = p["KS"] * y4
         vss = self.WO.output(x6, vks)
-        if self._wo_lag.any():
+        if self._any_wo_lag:
             vss = np.where(self._wo_lag, x6, vss)
         f[..., sl[6]] = self.WO.deriv(x6, vks)
         vs = np.minimum(np.maximum(vss, p["LSMIN"]), p["LSMAX"])
         if not self._no_cut:
-            vt = ctx.sig["Vt"][..., self.mach]
+            vt = ctx.sig["Vt"][..., self._mi]
             vs = np.where((vt > self.VCL) & (vt < self.VCU), vs, 0.0)
-        ctx.sig["vs"][..., self.mach] = vs
+        ctx.sig["vs"][..., self._mi] = vs
         ctx.out["IEEEST.sig"], ctx.out["IEEEST.vss"] = u, vss
