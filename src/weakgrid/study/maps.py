@@ -110,7 +110,8 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
                 if N[i][j] and not np.isfinite(Z[i, j]):   # why there is no value
                     import textwrap
 
-                    txt += "\n" + "\n".join(textwrap.wrap(N[i][j], 11)[:3])
+                    txt += "\n" + "\n".join(textwrap.wrap(N[i][j], 13,
+                                                           break_on_hyphens=False)[:3])
                 dark = False
                 if np.isfinite(Z[i, j]):
                     r, g, b, _ = im.cmap(im.norm(Z[i, j]))
