@@ -277,10 +277,10 @@ def map_summaries(maps) -> list[dict]:
                     txt += "; a run failed at " + ", ".join(f"{v:g}" for v in fails)
                 if "note" in row:
                     none = row[row["verdict"].isna() & (row["note"].fillna("") != "")]
-                    if not none.empty:
+                    for n, grp in none.groupby("note", sort=False):
                         txt += "; no value at " + ", ".join(
-                            f"{v:g} ({n})" if isinstance(v, float) else f"{v} ({n})"
-                            for v, n in zip(none[x], none["note"]))
+                            f"{v:g}" if isinstance(v, float) else str(v) for v in grp[x]) \
+                            + f" ({n})"
                 parts.append(txt)
             region.append(pre + "; ".join(parts))
         nh = int((cells["verdict"] == "holds").sum())
