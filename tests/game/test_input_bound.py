@@ -98,6 +98,28 @@ def test_bounded_minimizer_is_inside_and_optimal(shape, seed, log_b, ubar):
     assert vals.min() >= F(u) - 1e-12 * (1 + abs(F(u)))
 
 
+@pytest.mark.parametrize("shape", ["box", "disk"])
+@pytest.mark.parametrize("m", [1, 2])
+def test_one_point_path_equals_the_vectorized_iteration(shape, m):
+    """A single point (a controller sample) takes the Python-float path; a batch the
+    vectorized one: the same iteration, so the same u (to rounding) and the same count."""
+    rng = np.random.default_rng(7 + m)
+    bd = InputBound.for_inputs(m, 0.15, shape) if m == 2 or shape == "box" else \
+        InputBound.for_inputs(1, 0.15, "disk")
+    R = np.eye(m) * 0.8
+    n = 200
+    G = rng.normal(size=(n, m, m))
+    M = G @ np.swapaxes(G, -1, -2) * rng.uniform(0, 5, (n, 1, 1)) - 1.5 * R
+    b = rng.normal(size=(n, m)) * 10.0 ** rng.uniform(-4, 2, (n, 1))
+    U, info = bd.minimize(M, b, R, return_info=True)      # vectorized (a batch)
+    for k in range(n):
+        u, inf1 = bd.minimize(M[k], b[k], R, return_info=True)   # one point
+        assert u.shape == (m,)
+        np.testing.assert_allclose(u, U[k], rtol=1e-12, atol=1e-15 * 0.15)
+        assert inf1["n_unconverged"] == 0 and inf1["max_residual"] < 1e-12
+    assert info["n_unconverged"] == 0
+
+
 def test_bound_settings_are_checked():
     s = LinearSystem(np.eye(2), np.eye(2), np.ones((2, 1)))
     for kw, field in (({"bound": -1.0}, "u_bound"),

@@ -96,3 +96,37 @@ def test_cli_refuses_a_malformed_file_naming_the_field(tmp_path, capsys):
     assert main(["design", str(text), "--no-train"]) == 2
     err = capsys.readouterr().err
     assert "upqc.rating" in err and "high" in err
+
+
+def test_simulation_settings_of_a_study_reach_the_simulator(monkeypatch):
+    """[simulation] tol is the tolerance of the study's runs; the half-step reference of the
+    sweeps' uncertainty check keeps the simulator's (tighter) default."""
+    import weakgrid.study.runner as runner
+    from weakgrid.study.runner import Run, run_scenario, sim_settings
+
+    d = paper1()
+    T = d["design"]["T"]
+    st = study_from_dict(copy.deepcopy(d))
+    assert sim_settings(st) == (T, d["simulation"]["tol"])
+    assert sim_settings(st, 0.5) == (T / 2, None)
+    d2 = copy.deepcopy(d)
+    d2["simulation"] = {"dt": T / 4, "tol": 3e-9}
+    assert sim_settings(study_from_dict(d2)) == (T / 4, 3e-9)
+    del d2["simulation"]
+    assert sim_settings(study_from_dict(d2)) == (T, None)
+    for bad in ({"tol": -1.0}, {"tol": 1.0}, {"dt": 0.0}, {"step": 1e-3}):
+        d3 = copy.deepcopy(d)
+        d3["simulation"] = bad
+        with pytest.raises(ParameterError, match=f"simulation.{next(iter(bad))}"):
+            study_from_dict(d3)
+    seen = {}
+    real = runner.simulate
+
+    def spy(*a, **kw):
+        seen.update(dt=kw["dt"], tol=kw["tol"])
+        return real(*a, **kw)
+
+    monkeypatch.setattr(runner, "simulate", spy)
+    sc = dict(st.scenarios()[0], t_end=0.05, events=[])
+    run_scenario(st, Run.of(st, sc, "nonlinear-29"))
+    assert seen == {"dt": T, "tol": d["simulation"]["tol"]}

@@ -200,6 +200,29 @@ def test_map_cells_ties_wins_and_failures():
     assert dict(zip(cells2["upqc.rating"], cells2["verdict"]))[0.1] == "not"
 
 
+def test_map_cell_without_value_has_a_reason_not_a_verdict():
+    """A settling-time ratio where a finished run never settles: no value, no ✗, the reason."""
+    t = _cells_table()
+    t = t[(t["dt_factor"] == 1.0) & (t["upqc.rating"] == 0.3)].copy()
+    t.loc[t["controller"] == "a", "cost"] = np.nan       # a finished but has no value
+    spec = {"claim": "X", "kind": "ratio", "metric": "speed_settling_s", "a": "a", "b": "b"}
+    t = t.rename(columns={"cost": "speed_settling_s"})
+    cells = map_cells(t, spec, ["upqc.rating", "t_off", "load"])
+    assert cells["verdict"].tolist() == [None]
+    assert cells["note"].tolist() == ["a: no settling"]
+    for kind in ("value", "stable"):
+        c = map_cells(t, dict(spec, kind=kind, holds_within=[0, 1]),
+                      ["upqc.rating", "t_off", "load"])
+        assert c["note"].tolist() == ["a: no settling"]
+        if kind == "value":
+            assert c["verdict"].tolist() == [None]
+    # a failed run: the note names it
+    t2 = _cells_table()
+    cells = map_cells(t2[t2["dt_factor"] == 1.0], dict(spec, metric="cost"),
+                      ["upqc.rating", "t_off", "load"])
+    assert dict(zip(cells["upqc.rating"], cells["note"]))[0.5] == "a failed"
+
+
 def test_report_is_one_self_contained_file(tmp_path):
     import matplotlib
 

@@ -61,6 +61,10 @@ PROTOCOL = [
     "running the [sweep.dt_check] points again at half the integration step (per load and "
     "fault severity, applied to every rating of that row); a difference smaller than it is "
     "a tie (=), not a win. Not measured in --quick (no ties there).",
+    "Numerics: every run integrates with the study's [simulation] step and Newton tolerance "
+    "(default: the controller's sampling period T and the simulator's tolerance scaled with "
+    "it); the half-step runs that measure the uncertainty use the simulator's default "
+    "(tighter) tolerance, so the uncertainty includes the tolerance chosen.",
     "PQ baseline: the GTI's dc link is regulated by an outer dc-voltage PI loop setting P_ref "
     "(kp_v, ki_v in the case-1 study file), as a real PQ-controlled GTI does; without it the "
     "dc link settled at 1.11 pu and every dc-link comparison against PQ was an artifact.",
@@ -168,6 +172,11 @@ def run_studies(studies, output, quick=False, log=print, title=None, progress=Tr
     for st, runs, keys in plan:
         trained = {}
         case_notes = list(st.data["study"]["notes"]) + list(st.data["report"]["notes"])
+        sim = st.data.get("simulation") or {}
+        if sim:
+            case_notes.append("numerics: " + ", ".join(
+                f"{k} = {sim[k]:g}" for k in ("dt", "tol") if k in sim) + " ([simulation]); "
+                + "; ".join(sim.get("notes", [])))
         pre = load_preset(st.data["design"]["settings"]).system
         for load, upqc in keys:
             bar.set_postfix_str(f"design + train {st.name} {load} {upqc}")

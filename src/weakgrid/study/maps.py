@@ -5,8 +5,9 @@ one panel per value of a facet field (e.g. the load level), the two swept fields
 on the axes as evenly spaced categories (their values as tick labels), each
 cell coloured by the quantity and labelled with its value, and with the claim's
 verdict in that cell as a mark: ``✓`` holds, ``✗`` does not, ``=`` tie within the
-numerical uncertainty, ``!`` a run failed. The setting the paper (or the shipped
-study) uses is outlined.
+numerical uncertainty, ``!`` a run failed. A cell without a value shows ``–`` and, instead
+of a verdict, why (a ``note``: a run failed, no settling, …). The setting the paper (or the
+shipped study) uses is outlined.
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ def _fmt(v):
 
 
 def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
-             facet: str | None = None, mark=None, title: str = "", value_label: str = "",
+             note: str | None = None, facet: str | None = None, mark=None, title: str = "", value_label: str = "",
              x_label: str = "", y_label: str = "", cmap: str = "RdBu_r", center=None,
              mark_label: str = "the paper's setting", path=None):
     """Draw (and optionally save) a map of ``value`` over fields ``x`` and ``y``.
@@ -46,6 +47,9 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
         Column of the measured quantity (e.g. the HJI/(29) cost ratio).
     verdict : str, optional
         Column holding ``"holds"``, ``"not"``, ``"tie"`` or ``"failed"`` per cell.
+    note : str, optional
+        Column of short texts written in the cell under its value (why a cell has no
+        value: a failed run, no settling, …).
     facet : str, optional
         Column whose values get one panel each (e.g. ``"load"``).
     mark : tuple, optional
@@ -86,12 +90,16 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
         sub = table if fv is None else table[table[facet] == fv]
         Z = np.full((len(ys), len(xs)), np.nan)
         V = [["" for _ in xs] for _ in ys]
+        N = [["" for _ in xs] for _ in ys]
         for (xv, yv), grp in sub.groupby([x, y], sort=False):
             i, j = ys.index(yv), xs.index(xv)
             Z[i, j] = float(np.nanmean(grp[value].astype(float))) if \
                 np.isfinite(grp[value].astype(float)).any() else np.nan
             if verdict is not None:
-                V[i][j] = VERDICT_MARKS.get(grp[verdict].iloc[0], "?")
+                v0 = grp[verdict].iloc[0]
+                V[i][j] = VERDICT_MARKS.get(None if v0 is None or v0 != v0 else v0, "?")
+            if note is not None and note in grp and isinstance(grp[note].iloc[0], str):
+                N[i][j] = grp[note].iloc[0]
         im = ax.pcolormesh(np.arange(len(xs) + 1) - 0.5, np.arange(len(ys) + 1) - 0.5,
                            np.ma.masked_invalid(Z), cmap=cmap, norm=norm,
                            vmin=None if norm else vmin, vmax=None if norm else vmax,
@@ -99,11 +107,17 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
         for i in range(len(ys)):
             for j in range(len(xs)):
                 txt = _fmt(Z[i, j]) + (f"\n{V[i][j]}" if V[i][j] else "")
+                if N[i][j] and not np.isfinite(Z[i, j]):   # why there is no value
+                    import textwrap
+
+                    txt += "\n" + "\n".join(textwrap.wrap(N[i][j], 13,
+                                                           break_on_hyphens=False)[:3])
                 dark = False
                 if np.isfinite(Z[i, j]):
                     r, g, b, _ = im.cmap(im.norm(Z[i, j]))
                     dark = 0.299 * r + 0.587 * g + 0.114 * b < 0.5
-                ax.text(j, i, txt, ha="center", va="center", fontsize=8,
+                ax.text(j, i, txt, ha="center", va="center",
+                        fontsize=8 if txt.count("\n") < 2 else 6,
                         color="white" if dark else "black")
         if mark is not None and mark[0] in xs and mark[1] in ys:
             j, i = xs.index(mark[0]), ys.index(mark[1])
@@ -116,13 +130,19 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
         if fv is not None:
             ax.set_title(f"{facet} = {fv}", fontsize=10)
     cb = fig.colorbar(im, ax=axes[0].tolist(), shrink=0.9)
-    cb.set_label(value_label or value)
+    # the label runs along the bar: wrap it to the bar's length (else it is clipped)
+    import textwrap
+
+    bar_in = 0.9 * (fig.get_figheight() - 1.0)            # the bar's length, roughly [in]
+    per_line = max(12, int(bar_in * 72 / (0.6 * 9)))      # characters of 9-pt text in it
+    cb.set_label("\n".join(textwrap.wrap(value_label or value, per_line)), fontsize=9)
     legend = ""
     if mark is not None:
         legend += f"outlined: {mark_label}"
     if verdict is not None:
         legend += ("; " if legend else "") + ("✓ holds  ✗ does not  = tie (within the "
-                                              "numerical uncertainty)  ! a run failed")
+                                              "numerical uncertainty)  ! a run failed  "
+                                              "– no value (why, in the cell)")
     if title or legend:
         import textwrap
 

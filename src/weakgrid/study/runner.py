@@ -17,7 +17,7 @@ from .controllers import controller_variant, make_controller
 from .failure import failure_text
 from .metrics import backswing, control_cost, itae, running_cost, settling_time, stability_verdict
 
-__all__ = ["Run", "RunRecord", "run_scenario", "enable_windows", "make_events"]
+__all__ = ["Run", "RunRecord", "run_scenario", "enable_windows", "make_events", "sim_settings"]
 
 Q_DESIGN = 0.01 * np.eye(2)  # the paper's state weight of (18), for the running cost metric
 R_DESIGN = np.eye(2)
@@ -136,8 +136,26 @@ def make_events(setup, run: Run):
     return out
 
 
+def sim_settings(study, dt_factor: float = 1.0) -> tuple[float, float | None]:
+    """``(dt, tol)``: integration step [s] and Newton tolerance [pu] of a run of ``study``.
+
+    The step is the study's ``simulation.dt`` (default: the controller's sampling period
+    ``design.T``; the integrator steps onto every sample anyway) times ``dt_factor``. The
+    tolerance is ``simulation.tol`` for the study's own step and ``None`` (the simulator's
+    default, scaled with the step like its local error:
+    :func:`weakgrid.sim.integrate.default_tol`) otherwise. A reference run at half the step
+    (``dt_factor = 0.5``, the sweeps' numerical-uncertainty check) is thus finer in both the
+    step and the tolerance, and ``|m(T) − m(T/2)|`` measures the error of the study's
+    setting, tolerance included.
+    """
+    sim = study.data.get("simulation") or {}
+    base = float(sim.get("dt") or study.data["design"]["T"])
+    tol = sim.get("tol") if float(dt_factor) == 1.0 else None
+    return base * float(dt_factor), (None if tol is None else float(tol))
+
+
 def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
-                 design=None) -> RunRecord:
+                 design=None, tol=None) -> RunRecord:
     """Simulate ``run`` of ``study`` and compute its metrics.
 
     Parameters
@@ -145,8 +163,10 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     trained : dict, optional
         ``(load, upqc) -> GameController`` cache of trained HJI controllers (keyed by the
         load the controller is designed at).
-    dt : float, optional
-        Integration step (default: the controller's sampling period T).
+    dt, tol : float, optional
+        Integration step [s] and Newton tolerance [pu]; default: the study's
+        (:func:`sim_settings`: ``[simulation]``, else the controller's sampling period T and
+        the simulator's default tolerance for it).
     design_load : str, optional
         Load level the controllers are designed at (default: the run's own load). The
         paper's low-load protocol applies the HIGH-load controllers at low load; the
@@ -178,7 +198,9 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
                            enable=enable_windows(run.bypass, run.t_end), name=run.controller)
     events = make_events(setup, run)
     t0 = time.perf_counter()
-    res = simulate(setup.system, run.t_end, dt=dt or T, events=events, controllers=[dc],
+    if dt is None:
+        dt, tol = sim_settings(study)
+    res = simulate(setup.system, run.t_end, dt=dt, tol=tol, events=events, controllers=[dc],
                    on_failure="return")
     wall = time.perf_counter() - t0
     # controller samples: times and (bypass-aware) outputs actually applied

@@ -23,6 +23,9 @@ Tables (defaults in brackets)::
     [[figures]]   id, title, panels, runs = [[run id, label]]  [one figure per scenario]
     [[claims]]    id, case, paper, rule, judge (weakgrid.study.claims.RULES), parameters
     [sweep]       axes over study fields, mode, scenarios, controllers, maps (weakgrid.study.sweep)
+    [simulation]  dt [design.T] (integration step, s), tol [the simulator's default for dt,
+                  weakgrid.sim.integrate.default_tol] (Newton tolerance, pu): numerical
+                  settings of every run of the study (weakgrid.study.runner.sim_settings)
 """
 
 from __future__ import annotations
@@ -39,7 +42,7 @@ __all__ = ["Study", "load_study", "study_from_dict", "get_path", "set_path", "sh
            "read_study_dict", "EVENT_KINDS"]
 
 TOP = {"study", "grid", "dynamics", "machine", "upqc", "design", "controllers", "scenarios",
-       "report", "figures", "claims", "sweep"}
+       "report", "figures", "claims", "sweep", "simulation"}
 GRID_KINDS = ("inline", "pandapower", "matpower", "andes")
 STRUCTURES = ("conventional", "reduced")
 EVENT_KINDS = ("fault", "line_trip", "load_step")
@@ -323,6 +326,17 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         raise ParameterError("design.settings", ds["settings"],
                              f"choose a preset for Q, R, P, γ, Ω, mesh, basis, initial policy: "
                              f"{preset_names()}")
+    sim = d.get("simulation")
+    if sim is not None:
+        _keys(sim, {"dt", "tol", "notes"}, "simulation")
+        if "dt" in sim:
+            _num(sim, "dt", "simulation", positive=True)
+        if "tol" in sim:
+            _num(sim, "tol", "simulation", positive=True)
+            if not 1e-13 <= sim["tol"] <= 1e-4:
+                raise ParameterError("simulation.tol", sim["tol"], "give a Newton tolerance "
+                                     "between 1e-13 and 1e-4 pu (omit it for the simulator's "
+                                     "default, scaled with the step)")
     ct = d.setdefault("controllers", {})
     ct.setdefault("compare", ["hji", "lqr", "pss-only"])
     from .controllers import CONTROLLER_KINDS

@@ -45,7 +45,8 @@ SWEEP_KEYS = {"axes", "mode", "scenarios", "controllers", "t_end", "design_load"
 
 _TRAINED: dict = {}     # per worker process: design key -> trained GameController
 _DESIGNS: dict = {}     # per worker process: (grid data, load, structure) -> design model (10)
-_NOT_DESIGN = ("scenarios", "sweep", "claims", "figures", "report", "study", "controllers")
+_NOT_DESIGN = ("scenarios", "sweep", "claims", "figures", "report", "study", "controllers",
+               "simulation")
 
 
 def validate_sweep(d: dict, study) -> None:
@@ -202,12 +203,13 @@ def run_point(inputs: dict):
 
     ``inputs``: ``study`` (a study dict, the point's values set), ``scenario`` (id),
     ``controller`` (name), ``design_load`` (or None: the run's own load), ``t_end`` (or None),
-    ``signals`` (bool), ``dt_factor`` (integration step = factor × T; 0.5 for the numerical
-    uncertainty check). A run that loses stability or whose Newton iteration fails returns
+    ``signals`` (bool), ``dt_factor`` (integration step = factor × the study's step; 0.5 for
+    the numerical uncertainty check, run with the simulator's default tolerance for that
+    step: :func:`weakgrid.study.runner.sim_settings`). A run that loses stability or whose Newton iteration fails returns
     ``status = "failed"`` with its cause.
     """
     from .controllers import controller_kind
-    from .runner import Run, run_scenario
+    from .runner import Run, run_scenario, sim_settings
 
     st = study_from_dict(inputs["study"], source=f"sweep:{inputs['study']['study']['name']}")
     sc = next((s for s in st.scenarios() if s["id"] == inputs["scenario"]), None)
@@ -222,9 +224,8 @@ def run_point(inputs: dict):
     design = _design(st, dload, run.upqc)
     if controller_kind(st, name) == "hji":
         trained[(dload, run.upqc)] = _trained(st, design, [dload, run.upqc])
-    T = float(st.data["design"]["T"])
-    rec = run_scenario(st, run, trained, dt=T * float(inputs.get("dt_factor") or 1.0),
-                       design_load=dload, design=design)
+    dt, tol = sim_settings(st, float(inputs.get("dt_factor") or 1.0))
+    rec = run_scenario(st, run, trained, dt=dt, tol=tol, design_load=dload, design=design)
     m = dict(rec.metrics)
     for k in ("id", "case", "controller", "load", "upqc", "wall_s"):
         m.pop(k, None)

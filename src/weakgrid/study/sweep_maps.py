@@ -18,7 +18,9 @@ uncertainty is a tie, not a win. The uncertainty of a metric is measured by runn
 to ``|m(T)|``, per load level and fault severity (the row of the map), applied to every cell
 of that row (a row without a check takes the largest measured at its load level). A cell where
 a run failed is marked failed, its detail naming the cause (voltage collapse, loss of
-synchronism, …; :mod:`weakgrid.study.failure`).
+synchronism, …; :mod:`weakgrid.study.failure`). A cell without a value gets no verdict but a
+``note`` saying why: a run failed, or the metric is undefined for a run that finished (e.g. the
+speed did not settle inside the run: no settling time).
 """
 
 from __future__ import annotations
@@ -69,6 +71,14 @@ def _rel_uncertainty(half, full, match, row_keys, metric, ctl):
     return out
 
 
+def _why_missing(metric, who) -> str:
+    """Why ``metric`` has no value for the finished run(s) of ``who`` (short, for a cell)."""
+    who = " & ".join(who)
+    if metric.endswith("settling_s"):
+        return f"{who}: no settling"
+    return f"{who}: no {metric}"
+
+
 def _unc(by_row, rk):
     """The row's measured uncertainty, else the largest measured in its facet (load level)."""
     if rk in by_row:
@@ -79,7 +89,8 @@ def _unc(by_row, rk):
 
 def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
     """One row per map cell: the swept fields, ``value``, ``verdict`` (holds/not/tie/failed or
-    None), ``uncertainty`` (relative, or NaN when not measured) and a short ``detail``."""
+    None), ``uncertainty`` (relative, or NaN when not measured), a short ``detail`` and a
+    ``note`` (why a cell has no value: which run failed, or which metric is undefined)."""
     kind = spec.get("kind")
     if kind not in MAP_KINDS:
         raise ParameterError(f"sweep.maps[{spec.get('claim')}].kind", kind,
@@ -107,14 +118,19 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
         rb = rb.iloc[0] if rb is not None and not rb.empty else None
         fa = ra["status"] != "ok"
         fb = rb is not None and rb["status"] != "ok"
-        val, verdict, u, detail = math.nan, None, math.nan, ""
+        val, verdict, u, detail, note = math.nan, None, math.nan, "", ""
+        failed = [c for c, f in ((a, fa), (b, fb)) if f]
+        if failed:
+            note = " & ".join(failed) + " failed"
         if kind == "value":
             val = _num(ra.get(spec["metric"]))
-            if "holds_within" in spec:
-                lo, hi = spec["holds_within"]
-                verdict = "failed" if fa else ("holds" if lo <= val <= hi else "not")
-            elif fa:
+            if fa:
                 verdict = "failed"
+            elif not math.isfinite(val):
+                note = _why_missing(spec["metric"], [a])     # no value: no verdict
+            elif "holds_within" in spec:
+                lo, hi = spec["holds_within"]
+                verdict = "holds" if lo <= val <= hi else "not"
         elif kind == "ratio":
             m = spec["metric"]
             va, vb = _num(ra.get(m)), _num(rb.get(m)) if rb is not None else math.nan
@@ -124,6 +140,9 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
                 u = (ua * abs(va) + ub * abs(vb)) / abs(vb) if vb else math.nan
             if fa or fb:
                 verdict = "failed"
+            elif not math.isfinite(val):      # a metric undefined for a finished run
+                note = _why_missing(m, [c for c, v in ((a, va), (b, vb))
+                                        if not math.isfinite(v)] or [f"{a}/{b}"])
             elif math.isfinite(u) and abs(va - vb) <= u * abs(vb):
                 verdict = "tie"
             else:
@@ -158,11 +177,17 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
             sb = "unstable" if fb else (rb.get("speed_verdict") if rb is not None else None)
             detail = f"{a}: {sa}, {b}: {sb}"
             verdict = "holds" if sa == "stable" and sb in ("unstable", "undamped") else "not"
+            if not fa and not math.isfinite(val):   # the verdict is on stability, not on val
+                note = _why_missing(spec.get("metric", "speed_settling_s"), [a])
+        if kind == "wins" and not fa and not math.isfinite(val) and not fb:
+            verdict = None      # no value: no verdict, the reason instead
+            note = _why_missing(metrics[0], [c for c, v in ((a, va0), (b, vb0))
+                                             if not math.isfinite(v)] or [f"{a}/{b}"])
         if verdict == "failed":     # a failed run's metrics stop at the failure: no value
             val = math.nan
             detail = "; ".join(f"{c} {failure_kind(r.get('failure'))}" for c, r, f in
                                ((a, ra, fa), (b, rb, fb)) if f)
-        rec.update(value=val, verdict=verdict, uncertainty=u, detail=detail)
+        rec.update(value=val, verdict=verdict, uncertainty=u, detail=detail, note=note)
         rows.append(rec)
     return pd.DataFrame(rows)
 
@@ -203,7 +228,8 @@ def draw_maps(study, table, folder, quick=False) -> list[dict]:
         center = 1.0 if spec["kind"] in ("ratio", "wins") else None
         fshort = facet.split(".")[-1] if facet else None
         shown = cells.rename(columns={facet: fshort}) if facet else cells
-        fig = plot_map(shown, x, y, "value", verdict="verdict", facet=fshort, mark=mark,
+        fig = plot_map(shown, x, y, "value", verdict="verdict", note="note", facet=fshort,
+                       mark=mark,
                        title=f"{spec['claim']}: {spec.get('title', '')}",
                        value_label=spec.get("label", spec.get("metric", "")),
                        x_label=_short(x), y_label=_short(y),
@@ -256,6 +282,12 @@ def map_summaries(maps) -> list[dict]:
                     txt += "; a run failed at " + ", ".join(
                         f"{v:g}" + (f" ({d})" if d else "") for v, d in
                         zip(fr[x], fr["detail"] if "detail" in fr else [""] * len(fr)))
+                if "note" in row:
+                    none = row[row["verdict"].isna() & (row["note"].fillna("") != "")]
+                    for n, grp in none.groupby("note", sort=False):
+                        txt += "; no value at " + ", ".join(
+                            f"{v:g}" if isinstance(v, float) else str(v) for v in grp[x]) \
+                            + f" ({n})"
                 parts.append(txt)
             region.append(pre + "; ".join(parts))
         nh = int((cells["verdict"] == "holds").sum())
