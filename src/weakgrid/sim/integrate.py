@@ -493,12 +493,15 @@ class Simulator:
                     guess = corr = None
                     continue
                 if h / 2 < self.min_step:
-                    collapse = self._impasse(t, z_n, f_n)
+                    # a step far too large for the fastest time constant is the cause before any
+                    # fold that the (then meaningless) predicted motion runs into
+                    too_large = self._step_diagnosis(t, z_n)
+                    collapse = None if too_large else self._impasse(t, z_n, f_n)
                     if collapse is not None:
                         raise collapse
                     raise SimulationError(t, "newton",
                                           f"no convergence with step {h:.3g} s even with a fresh "
-                                          f"Jacobian{self._step_diagnosis(t, z_n)}")
+                                          f"Jacobian{too_large}")
                 h /= 2
                 refreshed = False
                 guess = corr = None
