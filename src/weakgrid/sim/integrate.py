@@ -438,7 +438,8 @@ class Simulator:
             z[fi] = limval
         residual = self.sys.residual
         tol = self.tol
-        c = x_n + 0.5 * h * f_n
+        hh = 0.5 * h
+        c = x_n + hh * f_n
         var_lim = fi is not None and bool(self.sys._var_lim)
         for it in range(self.max_iter):
             F, ctx = residual(t1, z)
@@ -452,11 +453,13 @@ class Simulator:
                     return None, it + 1, "release"
             f = F[:nx].copy()
             R = F
-            R[:nx] = z[:nx] - c - 0.5 * h * f
+            Rx = R[:nx]
+            np.subtract(z[:nx], c, out=Rx)
+            Rx -= hh * f
             if fi is not None:
                 R[fi] = z[fi] - limval
             dz = lu_solve(lu, R)
-            nrm = np.max(np.abs(dz))
+            nrm = float(np.abs(dz).max())
             if not math.isfinite(nrm):
                 break
             if nrm < tol:

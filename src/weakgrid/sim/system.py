@@ -492,7 +492,12 @@ class System:
     def device_residual(self, t, z):
         ctx = self.evaluate(t, z)
         I = ctx.I
-        return np.concatenate([ctx.f, -I.real, -I.imag], axis=-1), ctx
+        nx, nb = self.nx, self.nb
+        F = np.empty(z.shape)
+        F[..., :nx] = ctx.f
+        np.negative(I.real, out=F[..., nx:nx + nb])
+        np.negative(I.imag, out=F[..., nx + nb:])
+        return F, ctx
 
     def residual(self, t, z):
         """Full residual ``F = [f; g]`` and the evaluation context."""
