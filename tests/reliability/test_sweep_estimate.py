@@ -60,7 +60,7 @@ def test_sweep_too_large_to_list_is_counted_and_refused(ws, cli):
     ratings = [round(0.1 + 0.02 * k, 2) for k in range(40)]
     study = _study(ws, (AXIS, f'"upqc.rating" = {ratings}\n"scenarios.c1-high-conv.events.0.xf"'
                               f' = {xf}'), (T_END, "t_end = 60.0\ndesign_load"))
-    stdout, err = _refused(ws, cli, ["sweep", study, "--workers", "2"], 28800)
+    stdout, _ = _refused(ws, cli, ["sweep", study, "--workers", "2"], 28800)
     assert "28800 runs (too many to list" in stdout, stdout
 
 

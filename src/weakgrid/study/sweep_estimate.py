@@ -24,7 +24,6 @@ import math
 import os
 import time
 from dataclasses import dataclass, replace
-from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -36,7 +35,7 @@ from ..sweep.cache import ResultCache
 from .studyfile import get_path, study_from_dict
 from .sweep import _NOT_DESIGN, _axes, run_point, sweep_points
 
-__all__ = ["SweepEstimate", "estimate_sweep", "check_sweep", "planned_runs", "probe"]
+__all__ = ["SweepEstimate", "check_sweep", "estimate_sweep", "planned_runs", "probe"]
 
 MAX_SECONDS = 1800.0          # the limits of a training (weakgrid.game.estimate.Estimate.check)
 PROBE_STEPS = (10, 40)
@@ -255,8 +254,8 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
         keys.add(k)
         if scale > 1.0 or cache.get(k) is None:
             todo[k] = p
-    n_runs = int(round(len(keys) * scale))
-    n_cached = n_runs - int(round(len(todo) * scale))
+    n_runs = round(len(keys) * scale)
+    n_cached = n_runs - round(len(todo) * scale)
     n_par = None if scheduler else (workers if workers is not None else (os.cpu_count() or 1))
     base = _rss()
     signals = any(bool(p.inputs.get("signals")) for p in pts)
@@ -305,7 +304,7 @@ def check_sweep(est: SweepEstimate, study, quick: bool = False, force: bool = Fa
     if force or est.workers is None or not est.n_todo or est.note:
         return
     if max_bytes is None:
-        max_bytes = min(float(os.environ.get("WEAKGRID_MAX_GIB", 4.0)) * GiB,
+        max_bytes = min(float(os.environ.get("WEAKGRID_MAX_GIB", "4")) * GiB,
                         0.5 * available_memory())
     slow, big = est.wall_s > max_seconds, est.bytes > max_bytes
     if not (slow or big):
