@@ -11,11 +11,13 @@ so the verdicts do not depend on the measured speed; the one sweep that runs has
 from __future__ import annotations
 
 import re
+from importlib import resources
+from pathlib import Path
 
 import pandas as pd
 import pytest
 
-from .conftest import STUDY
+STUDY = Path(str(resources.files("weakgrid") / "data" / "studies" / "case1-weak-grid.toml"))
 
 AXIS = '"upqc.rating" = [0.1, 0.15, 0.3, 0.6, 1.0]'
 T_END = "t_end = 2.0\ndesign_load"
@@ -86,8 +88,8 @@ def test_force_runs_and_cached_runs_are_free(ws, cli, monkeypatch):
     assert code == 0, stdout + err
     line = stdout.splitlines()[0]
     assert re.fullmatch(r"sweep: 2 runs \(0 cached\), ≈ \d+ CPU-s, ≈ \d+ s in this process, "
-                        r"≈ [\d.e+-]+ GiB \(estimate: [\d.e+-]+ ms per step measured on this "
-                        r"grid\)", line), line
+                        r"≈ [\d.e+-]+ GiB \(measured on this grid: [\d.e+-]+ ms per quiet step, "
+                        r"[\d.e+-]+ ms from a disturbance on\)", line), line
     assert "2 runs, 0 failed" in stdout
     table = out / "case1-weak-grid-sweep.parquet"
     first = pd.read_parquet(table)

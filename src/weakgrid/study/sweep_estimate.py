@@ -39,6 +39,7 @@ __all__ = ["SweepEstimate", "check_sweep", "estimate_sweep", "planned_runs", "pr
 
 MAX_SECONDS = 1800.0          # the limits of a training (weakgrid.game.estimate.Estimate.check)
 PROBE_STEPS = (10, 40)
+TRANSIENT_STEPS = 60          # steps probed after the last disturbance
 MAX_LISTED = 20000            # runs listed (and looked up in the cache) one by one
 
 
@@ -68,6 +69,8 @@ class SweepEstimate:
         Why the time is unknown (the probe failed; the runs will report it), else "".
     unlisted : str
         Set when the sweep was too large to list (runs counted, cache not consulted).
+    transient_step_s : float
+        Measured cost of a step from the first disturbance on [s].
     """
 
     n_runs: int
@@ -82,6 +85,7 @@ class SweepEstimate:
     bytes: float
     note: str = ""
     unlisted: str = ""
+    transient_step_s: float = math.nan
 
     @property
     def n_todo(self) -> int:
@@ -103,7 +107,8 @@ class SweepEstimate:
                 f"on {self.workers} worker{'s' if self.workers != 1 else ''}"
             where = f"≈ {_duration(self.wall_s)} {on}"
         return (f"{head}, ≈ {_cpu(self.cpu_s)}, {where}, ≈ {self.bytes / GiB:.2g} GiB "
-                f"(estimate: {self.per_step_s * 1e3:.2g} ms per step measured on this grid)")
+                f"(measured on this grid: {self.per_step_s * 1e3:.2g} ms per quiet step, "
+                f"{self.transient_step_s * 1e3:.2g} ms from a disturbance on)")
 
 
 def _duration(s: float) -> str:
@@ -147,6 +152,24 @@ def _steps(inputs: dict) -> float:
     return math.ceil(float(t_end) / dt)
 
 
+def _event_window(events):
+    """(start of the first, end of the last) disturbance [s], or (None, None)."""
+    starts = [float(e.get("t_on", e.get("t", 0.0))) for e in events]
+    ends = [float(e.get("t_off", e.get("t_on", e.get("t", 0.0)))) for e in events]
+    return (min(starts), max(ends)) if starts else (None, None)
+
+
+def _quiet_steps(inputs: dict) -> int:
+    """Steps of a run before its first disturbance (at the operating point)."""
+    d = inputs["study"]
+    first, _ = _event_window(_scenario(d, inputs["scenario"]).get("events") or [])
+    if first is None:
+        return _steps(inputs)
+    sim = d.get("simulation") or {}
+    dt = float(sim.get("dt") or d["design"]["T"]) * float(inputs.get("dt_factor") or 1.0)
+    return min(math.floor(first / dt), _steps(inputs))
+
+
 def _training_key(inputs: dict):
     """What one HJI training of this run depends on (None: the run trains nothing)."""
     from .controllers import controller_kind
@@ -176,7 +199,7 @@ def probe(inputs: dict, steps=PROBE_STEPS) -> dict:
     from ..sim.integrate import simulate
     from .build import build_setup
     from .controllers import controller_variant, design_problem
-    from .runner import Run, _MeasureOnly, sim_settings
+    from .runner import Run, _MeasureOnly, enable_windows, make_events, sim_settings
 
     st = study_from_dict(inputs["study"], source=f"sweep:{inputs['study']['study']['name']}")
     sc = next(s for s in st.scenarios() if s["id"] == inputs["scenario"])
@@ -186,10 +209,10 @@ def probe(inputs: dict, steps=PROBE_STEPS) -> dict:
     setup = build_setup(st, run.load, run.upqc, controller_variant(st, run.controller))
     t_setup = time.perf_counter() - t0
     timed = []
-    for n in steps:
-        target = UPQCTarget(setup.upqc_name) if setup.upqc_name else _MeasureOnly()
+    for n in steps:    # at the operating point: the fixed cost and the cost of a quiet step
         dc = DigitalController(lambda m: np.zeros(2), T=setup.design.T, measure=setup.measure,
-                               target=target, name="probe")
+                               target=UPQCTarget(setup.upqc_name) if setup.upqc_name
+                               else _MeasureOnly(), name="probe")
         t0 = time.perf_counter()
         res = simulate(setup.system, n * dt, dt=dt, tol=tol, controllers=[dc],
                        on_failure="return")
@@ -197,11 +220,31 @@ def probe(inputs: dict, steps=PROBE_STEPS) -> dict:
                       len(res.names)))
     (t1, s1, _), (t2, s2, n_vars) = timed
     per_step = (t2 - t1) / (s2 - s1) if s2 > s1 and t2 > t1 else t2 / max(s2, 1)
-    per_run = t_setup + max(t1 - s1 * per_step, 0.0)
+    fixed_sim = max(t1 - s1 * per_step, 0.0)
+    per_run = t_setup + fixed_sim
+    # through the run's disturbances and TRANSIENT_STEPS beyond the last: the cost of a step
+    # of the transient (more Newton iterations and Jacobians), most of a run after a fault
+    transient = per_step
+    first, last = _event_window(run.events)
+    if first is not None:
+        t_probe = min(run.t_end, last + TRANSIENT_STEPS * dt)
+        dc = DigitalController(lambda m: np.zeros(2), T=setup.design.T, measure=setup.measure,
+                               target=UPQCTarget(setup.upqc_name) if setup.upqc_name
+                               else _MeasureOnly(), enable=enable_windows(run.bypass, t_probe),
+                               name="probe")
+        t0 = time.perf_counter()
+        res = simulate(setup.system, t_probe, dt=dt, tol=tol, controllers=[dc],
+                       events=make_events(setup, run), on_failure="return")
+        t3 = time.perf_counter() - t0
+        n_quiet = min(math.floor(first / dt), int(res.stats.get("steps") or 0))
+        n_after = int(res.stats.get("steps") or 0) - n_quiet
+        if n_after > 0:
+            transient = max((t3 - fixed_sim - n_quiet * per_step) / n_after, per_step)
     prob = design_problem(st, setup.design)
     train = training_estimate(int(prob.mesh.points.shape[0]), prob.basis.size,
                               prob.system.n_states)
-    return {"per_step_s": per_step, "per_run_s": per_run, "n_vars": n_vars, "train": train}
+    return {"per_step_s": per_step, "transient_step_s": transient, "per_run_s": per_run,
+            "n_vars": n_vars, "train": train}
 
 
 def planned_runs(study, quick: bool = False) -> int:
@@ -279,7 +322,9 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
             runs_per_key[tk] = runs_per_key.get(tk, 0) + 1
     par = max(n_par or 1, 1)
     n_train = sum(min(par, n) for n in runs_per_key.values())
-    run_s = [pr["per_run_s"] + s * pr["per_step_s"] for s in steps.values()]
+    quiet = {k: _quiet_steps(p.inputs) for k, p in todo.items()}
+    run_s = [pr["per_run_s"] + quiet[k] * pr["per_step_s"]
+             + (n - quiet[k]) * pr["transient_step_s"] for k, n in steps.items()]
     cpu = scale * sum(run_s) + n_train * pr["train"].seconds
     wall = None if n_par is None else max(cpu / par, max(run_s))
     longest = max(steps.values())
@@ -293,7 +338,8 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
     else:                 # this process and n_par workers like it
         total = base + table + sig + n_par * (base + extra)
     return SweepEstimate(n_runs, n_cached, scale * sum(steps.values()), pr["per_step_s"],
-                         pr["per_run_s"], n_train, cpu, n_par, wall, total, unlisted=unlisted)
+                         pr["per_run_s"], n_train, cpu, n_par, wall, total, unlisted=unlisted,
+                         transient_step_s=pr["transient_step_s"])
 
 
 def check_sweep(est: SweepEstimate, study, quick: bool = False, force: bool = False,
