@@ -1,14 +1,16 @@
 """What a study's sweep will cost, before it starts: runs, CPU and wall time, memory.
 
 The time is measured, not assumed: a short probe of the study's own grid (the first run
-still to do, with its integration step and tolerance) is timed in this process — two
-simulations of 10 and 40 steps from the operating point, the difference giving the cost
-of one step and the rest the fixed cost of a run (grid set-up, initialization). Every
-remaining run then costs ``fixed + (simulated time / step) × per-step``; the HJI
-trainings (once per design point and worker process) come from
-:func:`weakgrid.game.estimate.training_estimate`. The probe steps at the operating point:
-a fault needs a few more Newton iterations per step, so a run with a long fault costs
-somewhat more than estimated (rough, ±2×, like the training estimate). Runs already in
+still to do, with its integration step and tolerance, the controller idle) is timed in this
+process — two simulations of 10 and 40 steps at the operating point (their difference gives
+the cost of a quiet step, the rest the fixed cost of a run: grid set-up, initialization),
+then one through the run's disturbances and 60 steps beyond (the cost of a step of the
+transient, ≈ 3× a quiet one: more Newton iterations and Jacobians). Every remaining run then
+costs ``fixed + quiet steps × quiet cost + steps from its first disturbance on × transient
+cost``; the HJI trainings (once per design point and worker process) come from
+:func:`weakgrid.game.estimate.training_estimate`. Rough (±2×): on the development machine a
+case-1 run estimated at 1.4 s took 1.7 s, a case-2 run estimated at 5.5 s took 3.1 s (the
+transient right after a fault is the costliest part of a run). Runs already in
 the cache cost nothing.
 
 The memory: one worker process holds what this process holds after the probe (the
