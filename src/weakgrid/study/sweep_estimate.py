@@ -11,7 +11,9 @@ cost``; the HJI trainings (once per design point and worker process) come from
 :func:`weakgrid.game.estimate.training_estimate`. Rough (±2×): on the development machine a
 case-1 run estimated at 1.4 s took 1.7 s, a case-2 run estimated at 5.5 s took 3.1 s (the
 transient right after a fault is the costliest part of a run). Runs already in
-the cache cost nothing.
+the cache cost nothing. The wall time divides the CPU time by the workers, at most one per
+core; other work on the machine slows it down (on the shared development machine, load ≈ 2
+on 2 cores, the quick maps' sweep of `reproduce`, 18 runs, estimated at 14 s took 30 s).
 
 The memory: one worker process holds what this process holds after the probe (the
 package, the grid; its resident size is measured), plus the trajectories of its longest
@@ -42,6 +44,7 @@ __all__ = ["SweepEstimate", "check_sweep", "estimate_sweep", "planned_runs", "pr
 MAX_SECONDS = 1800.0          # the limits of a training (weakgrid.game.estimate.Estimate.check)
 PROBE_STEPS = (10, 40)
 TRANSIENT_STEPS = 60          # steps probed after the last disturbance
+CLUSTER_START_S = 2.0         # a local Dask cluster of 2 workers up and importing weakgrid
 MAX_LISTED = 20000            # runs listed (and looked up in the cache) one by one
 
 
@@ -328,7 +331,11 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
     run_s = [pr["per_run_s"] + quiet[k] * pr["per_step_s"]
              + (n - quiet[k]) * pr["transient_step_s"] for k, n in steps.items()]
     cpu = scale * sum(run_s) + n_train * pr["train"].seconds
-    wall = None if n_par is None else max(cpu / par, max(run_s))
+    # workers beyond the cores share them; a local cluster starts in ≈ 2 s (measured: 1.6 s,
+    # then 0.4 s for a worker's first import)
+    cores = max(min(par, os.cpu_count() or 1), 1)
+    wall = None if n_par is None else \
+        max(cpu / cores, max(run_s)) + (CLUSTER_START_S if n_par else 0.0)
     longest = max(steps.values())
     run_bytes = 2 * 8.0 * pr["n_vars"] * longest
     sig = 8.0 * pr["n_vars"] * longest if signals else 0.0
