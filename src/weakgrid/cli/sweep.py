@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._common import add_cluster_arguments, check_cluster, output_folder
+from ._common import add_cluster_arguments, add_force_argument, check_cluster, output_folder
 
 NAME = "sweep"
 
@@ -20,7 +20,10 @@ def add_parser(sub):
                     "a row per run (its parameters, every metric, status, failure cause, wall "
                     "time). Finished runs are cached under a hash of their full input and the "
                     "code: an interrupted sweep (Ctrl-C, SIGTERM) resumes, a repeated one is "
-                    "free.",
+                    "free. Before any run it prints an estimate of the time and memory of the "
+                    "runs still to do (a short probe of the study's grid is timed) and refuses "
+                    "a sweep beyond 30 min or 4 GiB / half the available memory "
+                    "(WEAKGRID_MAX_GIB) unless --force.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     p.add_argument("study", help="a study file (TOML) or a shipped study's name")
     p.add_argument("--output", "-o", type=output_folder, default=None,
@@ -31,6 +34,7 @@ def add_parser(sub):
                    help="keep every run's signals (Parquet, in the cache folder)")
     p.add_argument("--maps", action="store_true", help="also draw the sweep's maps (PNG)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_force_argument(p)
     p.set_defaults(func=run)
     return p
 
@@ -39,6 +43,7 @@ def run(args) -> int:
     """Run ``weakgrid sweep`` with the parsed ``args``; return the exit status."""
     from ..study.studyfile import load_study
     from ..study.sweep import run_study_sweep
+    from ..study.sweep_estimate import check_sweep, estimate_sweep
     from ..sweep import SweepInterrupted
 
     st = load_study(args.study)
@@ -46,6 +51,11 @@ def run(args) -> int:
         st.data["sweep"]["signals"] = True
     check_cluster(args)
     out = args.output or Path(f"{st.name}-sweep")
+    # before anything is written: what the runs still to do will cost (refused beyond limits)
+    est = estimate_sweep(st, out / "cache", quick=args.quick, workers=args.workers,
+                         scheduler=args.scheduler)
+    print(est.line())
+    check_sweep(est, st, quick=args.quick, force=args.force)
     try:
         table = run_study_sweep(st, out, quick=args.quick, scheduler=args.scheduler,
                                 workers=args.workers, progress=not args.no_progress)

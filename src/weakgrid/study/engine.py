@@ -35,6 +35,7 @@ from .report import write_html, write_tables
 from ..sweep import open_client, run_sweep
 from .runner import Run, RunRecord, run_scenario
 from .sweep import run_point, sweep_points
+from .sweep_estimate import estimate_sweep
 from .sweep_maps import draw_maps, map_summaries
 
 __all__ = ["run_studies", "mode_check", "MODE_TOLERANCE"]
@@ -255,6 +256,9 @@ def run_studies(studies, output, quick=False, log=print, title=None, progress=Tr
             log(f"kept {n_kept} finished result(s) of an earlier run with the same inputs")
         if swept:
             pts = [p for st in swept for p in sweep_points(st, quick)]
+            # the shipped maps' sweep: its estimate is printed, never refused
+            log(estimate_sweep(None, out / "sweep-cache", quick, workers=0 if serial else
+                               workers, scheduler=scheduler, points=pts).line("maps"))
             sweep_table = run_sweep(pts, run_point, cache_dir=out / "sweep-cache",
                                     workers=0 if serial else None, client=client,
                                     progress=progress, log=log,

@@ -81,12 +81,13 @@ class ResultCache:
     Parameters
     ----------
     folder : str or Path
-        Created if missing.
+        Created if missing (unless ``create`` is false: a missing folder holds nothing).
     """
 
-    def __init__(self, folder):
+    def __init__(self, folder, create: bool = True):
         self.folder = Path(folder)
-        self.folder.mkdir(parents=True, exist_ok=True)
+        if create:
+            self.folder.mkdir(parents=True, exist_ok=True)
 
     def path(self, key: str) -> Path:
         return self.folder / f"{key}.json"

@@ -1,0 +1,391 @@
+"""What a study's sweep will cost, before it starts: runs, CPU and wall time, memory.
+
+The time is measured, not assumed: a short probe of the study's own grid (the first run
+still to do, with its integration step and tolerance, the controller idle) is timed in this
+process — two simulations of 10 and 40 steps at the operating point (their difference gives
+the cost of a quiet step, the rest the fixed cost of a run: grid set-up, initialization),
+then one through the run's disturbances and 60 steps beyond (the cost of a step of the
+transient, ≈ 3× a quiet one: more Newton iterations and Jacobians). Every remaining run then
+costs ``fixed + quiet steps × quiet cost + steps from its first disturbance on × transient
+cost``; the HJI trainings (once per design point and worker process) come from
+:func:`weakgrid.game.estimate.training_estimate`. Rough (±2×): on the development machine a
+case-1 run estimated at 1.4 s took 1.7 s, a case-2 run estimated at 5.5 s took 3.1 s (the
+transient right after a fault is the costliest part of a run). Runs already in
+the cache cost nothing. The wall time divides the CPU time by the workers, at most one per
+core; other work on the machine slows it down (on the shared development machine, load ≈ 2
+on 2 cores, the quick maps' sweep of `reproduce`, 18 runs, estimated at 14 s took 30 s).
+
+The memory: one worker process holds what this process holds after the probe (the
+package, the grid; its resident size is measured), plus the trajectories of its longest
+run (steps × variables × 8 bytes, twice: while they grow and as the final array), plus a
+training's working memory; this process holds the table (a row per run) and, with
+``signals``, one run's signals in transit.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import dataclass, replace
+from types import SimpleNamespace
+
+import numpy as np
+
+from ..game.errors import ParameterError
+from ..game.estimate import GiB, available_memory, training_estimate
+from ..sweep import canonical_json, run_key
+from ..sweep.cache import ResultCache
+from .studyfile import get_path, study_from_dict
+from .sweep import _NOT_DESIGN, _axes, run_point, sweep_points
+
+__all__ = ["SweepEstimate", "check_sweep", "estimate_sweep", "planned_runs", "probe"]
+
+MAX_SECONDS = 1800.0          # the limits of a training (weakgrid.game.estimate.Estimate.check)
+PROBE_STEPS = (10, 40)
+TRANSIENT_STEPS = 60          # steps probed after the last disturbance
+CLUSTER_START_S = 2.0         # a local Dask cluster of 2 workers up and importing weakgrid
+MAX_LISTED = 20000            # runs listed (and looked up in the cache) one by one
+
+
+@dataclass(frozen=True)
+class SweepEstimate:
+    """The cost of a sweep's remaining runs.
+
+    Attributes
+    ----------
+    n_runs, n_cached : int
+        Distinct runs of the sweep, and those already in the cache.
+    steps : float
+        Integration steps of the remaining runs.
+    per_step_s, per_run_s : float
+        Measured cost of one step and fixed cost of one run [s] (0 if nothing to run).
+    n_trainings : int
+        HJI trainings at most (once per design point and worker process).
+    cpu_s : float
+        CPU time of the remaining runs and trainings [s].
+    workers : int or None
+        Processes working in parallel (None: an existing cluster of unknown size).
+    wall_s : float or None
+        Wall time on ``workers`` (None for an existing cluster).
+    bytes : float
+        Memory of this process and its workers together [B].
+    note : str
+        Why the time is unknown (the probe failed; the runs will report it), else "".
+    unlisted : str
+        Set when the sweep was too large to list (runs counted, cache not consulted).
+    transient_step_s : float
+        Measured cost of a step from the first disturbance on [s].
+    """
+
+    n_runs: int
+    n_cached: int
+    steps: float
+    per_step_s: float
+    per_run_s: float
+    n_trainings: int
+    cpu_s: float
+    workers: int | None
+    wall_s: float | None
+    bytes: float
+    note: str = ""
+    unlisted: str = ""
+    transient_step_s: float = math.nan
+
+    @property
+    def n_todo(self) -> int:
+        return self.n_runs - self.n_cached
+
+    def line(self, label: str = "sweep") -> str:
+        """One line, e.g. ``sweep: 192 runs (24 cached), ≈ 14 CPU-min, ≈ 7 min on 2 workers,
+        ≈ 0.3 GiB (…)``."""
+        head = f"{label}: {self.n_runs} runs " + (f"({self.unlisted})" if self.unlisted
+                                                 else f"({self.n_cached} cached)")
+        if not self.n_todo:
+            return f"{head}, nothing to run"
+        if self.note:
+            return f"{head}, time unknown ({self.note})"
+        if self.workers is None:
+            where = "on the given cluster"
+        else:
+            on = "in this process" if self.workers == 0 else \
+                f"on {self.workers} worker{'s' if self.workers != 1 else ''}"
+            where = f"≈ {_duration(self.wall_s)} {on}"
+        return (f"{head}, ≈ {_cpu(self.cpu_s)}, {where}, ≈ {self.bytes / GiB:.2g} GiB "
+                f"(measured on this grid: {self.per_step_s * 1e3:.2g} ms per quiet step, "
+                f"{self.transient_step_s * 1e3:.2g} ms from a disturbance on)")
+
+
+def _duration(s: float) -> str:
+    if s < 90:
+        return f"{s:.0f} s"
+    if s < 5400:
+        return f"{s / 60:.0f} min"
+    return f"{s / 3600:.1f} h"
+
+
+def _cpu(s: float) -> str:
+    if s < 90:
+        return f"{s:.0f} CPU-s"
+    if s < 5400:
+        return f"{s / 60:.0f} CPU-min"
+    return f"{s / 3600:.1f} CPU-h"
+
+
+def _rss() -> float:
+    """Resident memory of this process [B] (0 where unknown)."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmRSS:"):
+                    return float(line.split()[1]) * 1024
+    except OSError:  # pragma: no cover
+        pass
+    return 0.0
+
+
+def _scenario(d: dict, sid: str) -> dict:
+    return get_path(d, f"scenarios.{sid}")
+
+
+def _steps(inputs: dict) -> float:
+    """Integration steps of one run: simulated time / step (as :func:`sim_settings`)."""
+    d = inputs["study"]
+    t_end = inputs.get("t_end") or _scenario(d, inputs["scenario"])["t_end"]
+    sim = d.get("simulation") or {}
+    dt = float(sim.get("dt") or d["design"]["T"]) * float(inputs.get("dt_factor") or 1.0)
+    return math.ceil(float(t_end) / dt)
+
+
+def _event_window(events):
+    """(start of the first, end of the last) disturbance [s], or (None, None)."""
+    starts = [float(e.get("t_on", e.get("t", 0.0))) for e in events]
+    ends = [float(e.get("t_off", e.get("t_on", e.get("t", 0.0)))) for e in events]
+    return (min(starts), max(ends)) if starts else (None, None)
+
+
+def _quiet_steps(inputs: dict) -> int:
+    """Steps of a run before its first disturbance (at the operating point)."""
+    d = inputs["study"]
+    first, _ = _event_window(_scenario(d, inputs["scenario"]).get("events") or [])
+    if first is None:
+        return _steps(inputs)
+    sim = d.get("simulation") or {}
+    dt = float(sim.get("dt") or d["design"]["T"]) * float(inputs.get("dt_factor") or 1.0)
+    return min(math.floor(first / dt), _steps(inputs))
+
+
+def _training_key(inputs: dict):
+    """What one HJI training of this run depends on (None: the run trains nothing)."""
+    from .controllers import controller_kind
+
+    d = inputs["study"]
+    kind = controller_kind(SimpleNamespace(data=d), inputs["controller"])
+    if kind not in ("hji", "hji-bounded"):
+        return None
+    sc = _scenario(d, inputs["scenario"])
+    dload = inputs.get("design_load") or sc.get("design_load") or sc["load"]
+    design = {k: v for k, v in d.items() if k not in _NOT_DESIGN}
+    design["upqc"] = {k: v for k, v in design["upqc"].items() if k != "rating"}
+    extra = None
+    if kind == "hji-bounded":
+        opts = d["controllers"].get(inputs["controller"], {})
+        extra = (opts if isinstance(opts, dict) else {}).get("u_bound", d["upqc"]["rating"])
+    return canonical_json([design, dload, sc["upqc"], kind, extra])
+
+
+def probe(inputs: dict, steps=PROBE_STEPS) -> dict:
+    """Time the study's grid of the run ``inputs`` (see the module's text).
+
+    Returns ``per_step_s``, ``per_run_s``, ``n_vars`` (variables recorded per step) and
+    ``train`` (the :class:`~weakgrid.game.estimate.Estimate` of one HJI training).
+    """
+    from ..sim.controllers import DigitalController, UPQCTarget
+    from ..sim.integrate import simulate
+    from .build import build_setup
+    from .controllers import controller_variant, design_problem
+    from .runner import Run, _MeasureOnly, enable_windows, make_events, sim_settings
+
+    st = study_from_dict(inputs["study"], source=f"sweep:{inputs['study']['study']['name']}")
+    sc = next(s for s in st.scenarios() if s["id"] == inputs["scenario"])
+    run = Run.of(st, sc, inputs["controller"])
+    dt, tol = sim_settings(st, float(inputs.get("dt_factor") or 1.0))
+    t0 = time.perf_counter()
+    setup = build_setup(st, run.load, run.upqc, controller_variant(st, run.controller))
+    t_setup = time.perf_counter() - t0
+    timed = []
+    for n in steps:    # at the operating point: the fixed cost and the cost of a quiet step
+        dc = DigitalController(lambda m: np.zeros(2), T=setup.design.T, measure=setup.measure,
+                               target=UPQCTarget(setup.upqc_name) if setup.upqc_name
+                               else _MeasureOnly(), name="probe")
+        t0 = time.perf_counter()
+        res = simulate(setup.system, n * dt, dt=dt, tol=tol, controllers=[dc],
+                       on_failure="return")
+        timed.append((time.perf_counter() - t0, int(res.stats.get("steps") or n),
+                      len(res.names)))
+    (t1, s1, _), (t2, s2, n_vars) = timed
+    per_step = (t2 - t1) / (s2 - s1) if s2 > s1 and t2 > t1 else t2 / max(s2, 1)
+    fixed_sim = max(t1 - s1 * per_step, 0.0)
+    per_run = t_setup + fixed_sim
+    # through the run's disturbances and TRANSIENT_STEPS beyond the last: the cost of a step
+    # of the transient (more Newton iterations and Jacobians), most of a run after a fault
+    transient = per_step
+    first, last = _event_window(run.events)
+    if first is not None:
+        t_probe = min(run.t_end, last + TRANSIENT_STEPS * dt)
+        dc = DigitalController(lambda m: np.zeros(2), T=setup.design.T, measure=setup.measure,
+                               target=UPQCTarget(setup.upqc_name) if setup.upqc_name
+                               else _MeasureOnly(), enable=enable_windows(run.bypass, t_probe),
+                               name="probe")
+        t0 = time.perf_counter()
+        res = simulate(setup.system, t_probe, dt=dt, tol=tol, controllers=[dc],
+                       events=make_events(setup, run), on_failure="return")
+        t3 = time.perf_counter() - t0
+        n_quiet = min(math.floor(first / dt), int(res.stats.get("steps") or 0))
+        n_after = int(res.stats.get("steps") or 0) - n_quiet
+        if n_after > 0:
+            transient = max((t3 - fixed_sim - n_quiet * per_step) / n_after, per_step)
+    prob = design_problem(st, setup.design)
+    train = training_estimate(int(prob.mesh.points.shape[0]), prob.basis.size,
+                              prob.system.n_states)
+    return {"per_step_s": per_step, "transient_step_s": transient, "per_run_s": per_run,
+            "n_vars": n_vars, "train": train}
+
+
+def planned_runs(study, quick: bool = False) -> int:
+    """Runs of the study's sweep counted from its axes, without listing them (the
+    ``dt_check`` repetitions not included)."""
+    sw = study.data["sweep"]
+    axes = _axes(sw, quick)
+    n = math.prod(len(v) for v in axes.values()) if sw.get("mode", "product") == "product" \
+        else len(next(iter(axes.values())))
+    return n * sum(len(sw.get("controllers") or _scenario(study.data, sid)["controllers"])
+                   for sid in sw["scenarios"])
+
+
+def _first_values(study, quick):
+    """The study with every axis cut to its first value (one point per scenario and
+    controller), standing for all the points of a sweep too large to list."""
+    sw = dict(study.data["sweep"])
+    q = dict(sw.get("quick") or {})
+    key = q if quick and "axes" in q else sw
+    key["axes"] = {k: list(v[:1]) for k, v in key["axes"].items()}
+    if q:
+        sw["quick"] = q
+    sw["dt_check"] = {}
+    return replace(study, data={**study.data, "sweep": sw})
+
+
+def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = None,
+                   scheduler: str | None = None, points=None) -> SweepEstimate:
+    """Estimate the remaining runs of ``study``'s sweep (cached in ``cache_dir``).
+
+    Nothing is written (the cache folder is not created). ``workers``/``scheduler`` as for
+    :func:`weakgrid.sweep.run_sweep` (None: one worker per core; 0: serially here). A sweep
+    of more than :data:`MAX_LISTED` runs is not listed (that alone would take minutes): its
+    runs are counted from the axes, costed like those at the axes' first values, and the
+    cache is not consulted.
+    """
+    scale = 1.0
+    if points is None and planned_runs(study, quick) > MAX_LISTED:
+        pts = sweep_points(_first_values(study, quick), quick)
+        scale = planned_runs(study, quick) / len(pts)
+    else:
+        pts = sweep_points(study, quick) if points is None else points
+    cache = ResultCache(cache_dir, create=False)
+    todo: dict[str, object] = {}
+    keys = set()
+    for p in pts:
+        k = run_key(p.inputs, run_point)
+        if k in keys:
+            continue
+        keys.add(k)
+        if scale > 1.0 or cache.get(k) is None:
+            todo[k] = p
+    n_runs = round(len(keys) * scale)
+    n_cached = n_runs - round(len(todo) * scale)
+    n_par = None if scheduler else (workers if workers is not None else (os.cpu_count() or 1))
+    base = _rss()
+    signals = any(bool(p.inputs.get("signals")) for p in pts)
+    table = 2048.0 * n_runs       # a row of ~60 columns, in pandas and in Parquet
+    unlisted = "" if scale == 1.0 else "too many to list: the cache was not consulted"
+    if not todo:
+        return SweepEstimate(n_runs, n_cached, 0.0, 0.0, 0.0, 0, 0.0, n_par, 0.0,
+                             base + table)
+    steps = {k: _steps(p.inputs) for k, p in todo.items()}
+    try:
+        pr = probe(next(iter(todo.values())).inputs)
+    except Exception as exc:  # a grid that does not run: every run will say why, as a row
+        return SweepEstimate(n_runs, n_cached, scale * sum(steps.values()),
+                             math.nan, math.nan, 0, math.nan, n_par, None, base + table,
+                             note=f"the probe failed: {type(exc).__name__}: "
+                                  f"{str(exc)[:120]}")
+    runs_per_key: dict[str, int] = {}
+    for p in todo.values():
+        tk = _training_key(p.inputs)
+        if tk is not None:
+            runs_per_key[tk] = runs_per_key.get(tk, 0) + 1
+    par = max(n_par or 1, 1)
+    n_train = sum(min(par, n) for n in runs_per_key.values())
+    quiet = {k: _quiet_steps(p.inputs) for k, p in todo.items()}
+    run_s = [pr["per_run_s"] + quiet[k] * pr["per_step_s"]
+             + (n - quiet[k]) * pr["transient_step_s"] for k, n in steps.items()]
+    cpu = scale * sum(run_s) + n_train * pr["train"].seconds
+    # workers beyond the cores share them; a local cluster starts in ≈ 2 s (measured: 1.6 s,
+    # then 0.4 s for a worker's first import)
+    cores = max(min(par, os.cpu_count() or 1), 1)
+    wall = None if n_par is None else \
+        max(cpu / cores, max(run_s)) + (CLUSTER_START_S if n_par else 0.0)
+    longest = max(steps.values())
+    run_bytes = 2 * 8.0 * pr["n_vars"] * longest
+    sig = 8.0 * pr["n_vars"] * longest if signals else 0.0
+    extra = max(run_bytes + sig, pr["train"].bytes if runs_per_key else 0.0)
+    if n_par is None:     # an existing cluster: its workers are elsewhere; one of them
+        total = base + extra
+    elif n_par == 0:      # serially in this process
+        total = base + table + extra
+    else:                 # this process and n_par workers like it
+        total = base + table + sig + n_par * (base + extra)
+    return SweepEstimate(n_runs, n_cached, scale * sum(steps.values()), pr["per_step_s"],
+                         pr["per_run_s"], n_train, cpu, n_par, wall, total, unlisted=unlisted,
+                         transient_step_s=pr["transient_step_s"])
+
+
+def check_sweep(est: SweepEstimate, study, quick: bool = False, force: bool = False,
+                max_seconds: float = MAX_SECONDS, max_bytes: float | None = None) -> None:
+    """Refuse (:class:`ParameterError`, before any run) a sweep beyond the limits of a
+    training — 30 min of wall time, 4 GiB (``WEAKGRID_MAX_GIB``) or half the available
+    memory — unless ``force``. An existing cluster (unknown size) is never refused."""
+    if force or est.workers is None or not est.n_todo or est.note:
+        return
+    if max_bytes is None:
+        max_bytes = min(float(os.environ.get("WEAKGRID_MAX_GIB", "4")) * GiB,
+                        0.5 * available_memory())
+    slow, big = est.wall_s > max_seconds, est.bytes > max_bytes
+    if not (slow or big):
+        return
+    sw = study.data["sweep"]
+    axes = (sw.get("quick") or {}).get("axes") if quick else None
+    axes = axes or sw["axes"]
+    where = "sweep.quick.axes" if quick and (sw.get("quick") or {}).get("axes") else \
+        "sweep.axes"
+    widest = max(axes, key=lambda k: len(axes[k]))
+    fixes = [f"fewer points on [{where}] of {study.source} (the largest axis, "
+             f"\"{widest}\", has {len(axes[widest])})"]
+    if slow:
+        fixes.append("a shorter sweep.t_end")
+        if not quick and sw.get("quick"):
+            fixes.append("--quick")
+        fixes.append(f"more workers (now {est.workers or 1}; --workers up to the "
+                     f"{os.cpu_count() or 1} cores here, or a larger Dask cluster: --scheduler)")
+    if big:
+        fix = "fewer --workers (each holds a run's trajectories)" if est.workers \
+            and est.workers > 1 else "a shorter sweep.t_end"
+        if fix not in fixes:
+            fixes.append(fix)
+    raise ParameterError(
+        where, f"{est.n_todo} runs to do",
+        f"the sweep needs ≈ {_cpu(est.cpu_s)}, ≈ {_duration(est.wall_s)} on "
+        f"{est.workers or 1} worker(s) and ≈ {est.bytes / GiB:.2g} GiB (limits "
+        f"{_duration(max_seconds)}, {max_bytes / GiB:.2g} GiB). Fix: "
+        + ", ".join(fixes) + "; or pass --force to run it anyway")

@@ -1,0 +1,124 @@
+"""Long work: `weakgrid sweep` estimates the time and memory of the runs still to do before
+any of them starts, refuses a sweep beyond the limits (30 min, 4 GiB or half the available
+memory, ``WEAKGRID_MAX_GIB``) with the number of runs and the fix, unless ``--force``, and
+counts cached runs as free.
+
+The refused sweeps are far beyond the limits on any machine (10⁸–10⁹ integration steps),
+so the verdicts do not depend on the measured speed; the one sweep that runs has two runs of
+0.3 s.
+"""
+
+from __future__ import annotations
+
+import re
+from importlib import resources
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+STUDY = Path(str(resources.files("weakgrid") / "data" / "studies" / "case1-weak-grid.toml"))
+
+AXIS = '"upqc.rating" = [0.1, 0.15, 0.3, 0.6, 1.0]'
+T_END = "t_end = 2.0\ndesign_load"
+RATINGS = [round(0.1 + 0.02 * k, 2) for k in range(30)]     # 30 ratings, 0.15 not among them
+
+
+def _study(ws, *edits) -> str:
+    """A copy of case1-weak-grid with the first occurrence of each ``old`` replaced."""
+    text = STUDY.read_text()
+    for old, new in edits:
+        assert old in text, old
+        text = text.replace(old, new, 1)
+    p = ws.root / "big-study.toml"
+    p.write_text(text)
+    return p
+
+
+def _refused(ws, cli, argv, runs):
+    ws.snapshot()
+    out = ws.root / "sw"
+    code, stdout, err = cli(argv + ["-o", out])
+    assert code == 2, stdout + err
+    assert f"{runs} runs to do" in err, err
+    assert "Fix: fewer points on [sweep.axes]" in err and "--force" in err, err
+    assert not out.exists(), "the refused sweep wrote its output folder"
+    ws.check_untouched()
+    return stdout, err
+
+
+def test_huge_sweep_is_refused_before_any_run(ws, cli):
+    """540 runs of 600 s (≈ 4·10⁸ steps): refused with the count, the limits and the fix."""
+    study = _study(ws, (AXIS, f'"upqc.rating" = {RATINGS}'), (T_END, "t_end = 600.0\ndesign_load"))
+    stdout, err = _refused(ws, cli, ["sweep", study], 540)
+    assert re.search(r"sweep: 540 runs \(0 cached\), ≈ [\d.]+ CPU-h", stdout), stdout
+    assert "limits 30 min" in err and "more workers" in err and "--quick" in err, err
+    assert '"upqc.rating", has 30' in err, err
+
+
+def test_sweep_too_large_to_list_is_counted_and_refused(ws, cli):
+    """28 800 runs are counted from the axes (not listed one by one) and refused."""
+    xf = [round(0.05 + 0.01 * k, 2) for k in range(40)]
+    ratings = [round(0.1 + 0.02 * k, 2) for k in range(40)]
+    study = _study(ws, (AXIS, f'"upqc.rating" = {ratings}\n"scenarios.c1-high-conv.events.0.xf"'
+                              f' = {xf}'), (T_END, "t_end = 60.0\ndesign_load"))
+    stdout, _ = _refused(ws, cli, ["sweep", study, "--workers", "2"], 28800)
+    assert "28800 runs (too many to list" in stdout, stdout
+
+
+SMALL = ('"upqc.rating" = [0.1, 0.3]',
+         ('"scenarios.c1-high-conv.events.0.t_off" = [0.22, 0.25, 0.30]',
+          '"scenarios.c1-high-conv.events.0.t_off" = [0.25]'),
+         ('"scenarios.c1-high-conv.load" = ["high", "low"]\n\n',
+          '"scenarios.c1-high-conv.load" = ["high"]\n\n'),
+         ('controllers = ["hji", "nonlinear-29", "hji-bounded"]', 'controllers = ["nonlinear-29"]'),
+         (T_END, "t_end = 0.3\ndesign_load"))
+
+
+def test_force_runs_and_cached_runs_are_free(ws, cli, monkeypatch):
+    """Under a tiny memory limit a 2-run sweep is refused; --force runs it (the estimate line
+    first); the same command again finds both runs cached: nothing to run, not refused."""
+    study = _study(ws, (AXIS, SMALL[0]), *SMALL[1:])
+    monkeypatch.setenv("WEAKGRID_MAX_GIB", "0.001")
+    argv = ["sweep", study, "--workers", "0", "--no-progress"]
+    _, err = _refused(ws, cli, argv, 2)
+    assert "GiB" in err and "limits" in err, err
+    out = ws.root / "sw"
+    code, stdout, err = cli(argv + ["-o", out, "--force"])
+    assert code == 0, stdout + err
+    line = stdout.splitlines()[0]
+    assert re.fullmatch(r"sweep: 2 runs \(0 cached\), ≈ \d+ CPU-s, ≈ \d+ s in this process, "
+                        r"≈ [\d.e+-]+ GiB \(measured on this grid: [\d.e+-]+ ms per quiet step, "
+                        r"[\d.e+-]+ ms from a disturbance on\)", line), line
+    assert "2 runs, 0 failed" in stdout
+    table = out / "case1-weak-grid-sweep.parquet"
+    first = pd.read_parquet(table)
+    code, stdout, err = cli(argv + ["-o", out])      # no --force: nothing left to cost
+    assert code == 0, stdout + err
+    assert stdout.splitlines()[0] == "sweep: 2 runs (2 cached), nothing to run", stdout
+    assert "2 runs, 0 failed" in stdout
+    pd.testing.assert_frame_equal(pd.read_parquet(table), first)
+
+
+def test_estimate_counts_steps_and_cached_runs(ws, tmp_path):
+    """The API: steps = Σ t_end / dt of the runs to do (dt = the study's step × dt factor),
+    and a cached run is not counted."""
+    from weakgrid.study.studyfile import load_study
+    from weakgrid.study.sweep import run_point, sweep_points
+    from weakgrid.study.sweep_estimate import estimate_sweep
+    from weakgrid.sweep import ResultCache, run_key
+
+    st = load_study(_study(ws, (AXIS, SMALL[0]), *SMALL[1:]))
+    dt = st.data["design"]["T"]
+    est = estimate_sweep(st, tmp_path / "cache", workers=0)
+    assert (est.n_runs, est.n_cached) == (2, 0)
+    assert est.steps == pytest.approx(2 * 0.3 / dt, abs=4)
+    assert est.per_step_s > 0 and est.per_run_s >= 0
+    assert est.cpu_s >= est.steps * est.per_step_s
+    assert not (tmp_path / "cache").exists()
+    pts = sweep_points(st)
+    k = run_key(pts[0].inputs, run_point)
+    ResultCache(tmp_path / "cache").put({"key": k, "status": "ok", "metrics": {}})
+    est2 = estimate_sweep(st, tmp_path / "cache", workers=0)
+    assert (est2.n_runs, est2.n_cached) == (2, 1)
+    assert est2.steps == pytest.approx(est.steps / 2, abs=1)
