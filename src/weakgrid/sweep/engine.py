@@ -114,8 +114,11 @@ def open_client(scheduler=None, workers=None):
             client.close()
         return
     n = workers or os.cpu_count() or 1
+    # the workers' own logs stay quiet: a run's failure is a row of the table, and an interrupt
+    # (SIGINT/SIGTERM) must not print the workers' shutdown tracebacks (heartbeats to a closing
+    # scheduler); a lost worker still reaches the client as an exception
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR)
+                           dashboard_address=None, silence_logs=logging.CRITICAL)
     client = Client(cluster)
     try:
         yield client
