@@ -69,12 +69,17 @@ class Estimate:
                 f"{_duration(max_seconds)}): {fix}, or pass --force to run it anyway")
 
 
-def _duration(s: float) -> str:
+def format_duration(s: float, cpu: bool = False) -> str:
+    """``s`` seconds as "42 s", "17 min" or "2.5 h" ("CPU-s", "CPU-min", "CPU-h" with ``cpu``)."""
+    p = "CPU-" if cpu else ""
     if s < 90:
-        return f"{s:.0f} s"
+        return f"{s:.0f} {p}s"
     if s < 5400:
-        return f"{s / 60:.0f} min"
-    return f"{s / 3600:.1f} h"
+        return f"{s / 60:.0f} {p}min"
+    return f"{s / 3600:.1f} {p}h"
+
+
+_duration = format_duration
 
 
 def training_estimate(n_points: int, basis_size: int, n_states: int) -> Estimate:

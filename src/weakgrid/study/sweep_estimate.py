@@ -33,7 +33,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from ..game.errors import ParameterError
-from ..game.estimate import GiB, available_memory, training_estimate
+from ..game.estimate import GiB, available_memory, format_duration, training_estimate
 from ..sweep import canonical_json, run_key
 from ..sweep.cache import ResultCache
 from .studyfile import get_path, study_from_dict
@@ -117,19 +117,11 @@ class SweepEstimate:
 
 
 def _duration(s: float) -> str:
-    if s < 90:
-        return f"{s:.0f} s"
-    if s < 5400:
-        return f"{s / 60:.0f} min"
-    return f"{s / 3600:.1f} h"
+    return format_duration(s)
 
 
 def _cpu(s: float) -> str:
-    if s < 90:
-        return f"{s:.0f} CPU-s"
-    if s < 5400:
-        return f"{s / 60:.0f} CPU-min"
-    return f"{s / 3600:.1f} CPU-h"
+    return format_duration(s, cpu=True)
 
 
 def _rss() -> float:
