@@ -111,3 +111,4 @@ def cli(capsys):
         assert "Traceback" not in out + err, err
         return code, out, err
     return run
+

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from .errors import ParameterError
 
-__all__ = ["Estimate", "training_estimate", "dp_estimate", "available_memory"]
+__all__ = ["Estimate", "available_memory", "dp_estimate", "format_duration", "proc_kib", "training_estimate"]
 
 # solve_hji: bytes per (mesh point × basis term), for 2 states (scaled by (2+n+n²)/8)
 _HJI_BYTES = 176.0
@@ -28,16 +28,22 @@ _DP_SECONDS = 5e-5
 GiB = 1024.0**3
 
 
-def available_memory() -> float:
-    """MemAvailable of /proc/meminfo in bytes (inf where unknown)."""
+def proc_kib(path: str, key: str, default: float) -> float:
+    """A ``key: <n> kB`` line of a /proc file (``/proc/meminfo``, ``/proc/self/status``) in
+    bytes; ``default`` where the file or the line is missing."""
     try:
-        with open("/proc/meminfo") as fh:
+        with open(path) as fh:
             for line in fh:
-                if line.startswith("MemAvailable:"):
+                if line.startswith(key + ":"):
                     return float(line.split()[1]) * 1024
     except OSError:  # pragma: no cover
         pass
-    return float("inf")
+    return default
+
+
+def available_memory() -> float:
+    """MemAvailable of /proc/meminfo in bytes (inf where unknown)."""
+    return proc_kib("/proc/meminfo", "MemAvailable", float("inf"))
 
 
 @dataclass(frozen=True)

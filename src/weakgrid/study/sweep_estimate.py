@@ -33,7 +33,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from ..game.errors import ParameterError
-from ..game.estimate import GiB, available_memory, format_duration, training_estimate
+from ..game.estimate import GiB, available_memory, format_duration, proc_kib, training_estimate
 from ..sweep import canonical_json, run_key
 from ..sweep.cache import ResultCache
 from .studyfile import get_path, study_from_dict
@@ -126,14 +126,7 @@ def _cpu(s: float) -> str:
 
 def _rss() -> float:
     """Resident memory of this process [B] (0 where unknown)."""
-    try:
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith("VmRSS:"):
-                    return float(line.split()[1]) * 1024
-    except OSError:  # pragma: no cover
-        pass
-    return 0.0
+    return proc_kib("/proc/self/status", "VmRSS", 0.0)
 
 
 def _scenario(d: dict, sid: str) -> dict:

@@ -19,17 +19,6 @@ from .base import BASE_PARAMS, SyncMachine
 from .shaft import swing
 
 
-def solve_stator(psi2d, psi2q, vd, vq, ra, xd2, xq2):
-    """Solve the two algebraic stator equations for ``(Id, Iq)`` [pu, system base].
-
-    ``xd2*Id + ra*Iq = psi2d - vq`` and ``-ra*Id + xq2*Iq = vd - psi2q``.
-    """
-    det = xd2 * xq2 + ra * ra
-    a = psi2d - vq
-    b = vd - psi2q
-    return (xq2 * a - ra * b) / det, (xd2 * b + ra * a) / det
-
-
 class GENCLS(SyncMachine):
     """Classical machine model (PSS/E and ANDES ``GENCLS``).
 
@@ -65,7 +54,7 @@ class GENCLS(SyncMachine):
         super().setup(system)
         ra, xq = self.p["ra"], self.p["xd1"]
         det = xq * xq + ra * ra
-        # folded constants of the stator solution (solve_stator with xd2 = xq2 = xd1, psi2q = 0)
+        # folded constants of the stator equations (module docstring): det = xd1^2 + ra^2
         self._cIa, self._cIb = xq / det, ra / det
 
     def compute(self, ctx):
@@ -77,7 +66,7 @@ class GENCLS(SyncMachine):
         vd = Vre * sd - Vim * cd               # dq_voltage
         vq = Vre * cd + Vim * sd
         vf = ctx.sig["vf"][..., self._mi]
-        a, b = vf - vq, vd                     # solve_stator(vf, 0, vd, vq, ra, xd1, xd1)
+        a, b = vf - vq, vd                     # xd1*Id + ra*Iq = a,  -ra*Id + xd1*Iq = b
         cIa, cIb = self._cIa, self._cIb
         Id = cIa * a - cIb * b
         Iq = cIa * b + cIb * a

@@ -161,7 +161,7 @@ class GENROU(SyncMachine):
         Vre, Vim = V.real, V.imag
         vd = Vre * sd - Vim * cd
         vq = Vre * cd + Vim * sd
-        # stator (see gencls.solve_stator)
+        # stator: xd2*Id + ra*Iq = psi2d - vq,  -ra*Id + xq2*Iq = vd - psi2q
         a = psi2d - vq
         b = vd - psi2q
         if self._ra0:

@@ -99,7 +99,7 @@ class IEEEST(MachineControl):
         m = self.mach
         mode = p["MODE"]
         u0 = np.select([mode == 1, mode == 3, mode == 4, mode == 5],
-                       [0.0 * m, sig["Pe0"][m] * system.Sb / self.Sn, 0.0 * m, sig["Vt0"][m]])
+                       [0.0 * m, sig["Pe0"][m] * self._pe_scale, 0.0 * m, sig["Vt0"][m]])
         x[self.sl(0)] = u0
         x[self.sl(1)] = 0.0
         x[self.sl(2)] = u0

@@ -1,0 +1,17 @@
+"""The check every catalogue entry of the reliability tests goes through."""
+
+
+def check_bad_input(case, ws, cli):
+    """Run one catalogue entry ``(name, category, build, code, needles)``: the exit code, one
+    or two lines naming every needle, no traceback, and no existing file touched."""
+    _name, _category, build, code, needles = case
+    argv = build(ws)
+    ws.snapshot()
+    got, _out, err = cli(argv)
+    assert got == code, f"exit {got}, expected {code}\n{err}"
+    assert "error:" in err
+    body = err.strip().splitlines()
+    assert 1 <= len(body) <= 2, f"not one or two lines:\n{err}"
+    for needle in needles:
+        assert needle in err, f"{needle!r} missing from: {err}"
+    ws.check_untouched()
