@@ -254,3 +254,24 @@ def test_report_is_one_self_contained_file(tmp_path):
     refs = [a or b for a, b in refs]
     assert len(refs) == 2 and all(r.startswith("data:image/png;base64,") for r in refs)
     assert "holds at 0.3, 0.6" in text and "a change" in text
+
+
+def test_ratio_cell_where_only_the_baseline_fails_holds():
+    """HJI settles while LQR loses synchronism: the ratio has no value, but the claim holds
+    there (as for "wins"); the note and the region name the baseline's failure."""
+    t = _cells_table()
+    t = t[t["dt_factor"] == 1.0].copy()
+    t.loc[(t["upqc.rating"] == 0.5) & (t["controller"] == "a"), "status"] = "ok"
+    t.loc[(t["upqc.rating"] == 0.5) & (t["controller"] == "b"), "status"] = "failed"
+    t["failure"] = np.where(t["status"] == "failed",
+                            "t = 1.2 s: loss of synchronism: rotor angle spread 181 deg", "")
+    spec = {"claim": "X", "kind": "ratio", "metric": "cost", "a": "a", "b": "b",
+            "holds_below": 0.8}
+    cells = map_cells(t, spec, ["upqc.rating", "t_off", "load"])
+    c = cells[cells["upqc.rating"] == 0.5].iloc[0]
+    assert c["verdict"] == "holds" and math.isnan(c["value"])
+    assert c["note"] == "b loss of synchronism" and "loss of synchronism" in c["detail"]
+    from weakgrid.study.sweep_maps import map_summaries
+    s = map_summaries([{"spec": spec, "cells": cells, "mark": None,
+                        "axes": ("upqc.rating", "t_off", "load")}])[0]
+    assert "0.5 (b loss of synchronism)" in s["region"] and "0.3" in s["region"]

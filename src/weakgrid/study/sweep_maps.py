@@ -6,6 +6,7 @@ table (a row per run; :mod:`weakgrid.study.sweep`)::
     claim, title, label        the claim's id, the map's title and colour-bar label
     id                         the map's own id when a claim has several maps [claim]
     kind = "ratio"             metric of controller a / of b; holds if ≤ holds_below
+                               (or b failed while a finished: no value, holds, b's cause noted)
     kind = "value"             metric of controller a; holds if within holds_within = [lo, hi]
                                (no rule: the map only shows the quantity)
     kind = "wins"              a smaller than b on every one of ``metrics`` (or b failed)
@@ -138,8 +139,12 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
             ua, ub = _unc(unc[(m, a)], rk), _unc(unc[(m, b)], rk)
             if ua is not None and ub is not None:
                 u = (ua * abs(va) + ub * abs(vb)) / abs(vb) if vb else math.nan
-            if fa or fb:
+            if fa:
                 verdict = "failed"
+            elif fb:    # only the baseline lost the run (e.g. LQR out of step): a holds, no value
+                val = math.nan
+                verdict, detail = "holds", f"{b} failed: {rb.get('failure', '')}"[:120]
+                note = f"{b} {failure_kind(rb.get('failure'))}"
             elif not math.isfinite(val):      # a metric undefined for a finished run
                 note = _why_missing(m, [c for c, v in ((a, va), (b, vb))
                                         if not math.isfinite(v)] or [f"{a}/{b}"])
@@ -269,12 +274,15 @@ def map_summaries(maps) -> list[dict]:
                 continue
             parts = []
             for yv, row in sub.groupby(y, sort=True):
-                ok = row[row["verdict"] == "holds"][x].tolist()
+                hr = row[row["verdict"] == "holds"]
+                ok = hr[x].tolist()
+                why = (hr["note"].fillna("").tolist() if "note" in hr else [""] * len(hr))
                 ties = row[row["verdict"] == "tie"][x].tolist()
                 fails = row[row["verdict"] == "failed"][x].tolist()
                 txt = f"{_short(y).split(' [')[0]} {yv:g}: " if isinstance(yv, float) else \
                     f"{yv}: "
-                txt += ("holds at " + ", ".join(f"{v:g}" for v in ok)) if ok else "holds nowhere"
+                txt += ("holds at " + ", ".join(f"{v:g}" + (f" ({w})" if w else "")
+                                                for v, w in zip(ok, why))) if ok else "holds nowhere"
                 if ties:
                     txt += "; tie at " + ", ".join(f"{v:g}" for v in ties)
                 if fails:
