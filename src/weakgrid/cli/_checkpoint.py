@@ -158,6 +158,7 @@ class TrainingCheckpoint:
             raise
 
     def discard(self):
+        """Remove the checkpoint (the result is written)."""
         self.keeper.discard()
 
 

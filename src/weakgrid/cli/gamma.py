@@ -48,7 +48,7 @@ def add_parser(sub):
     p.add_argument("--report", type=output_file(".json"), default=None,
                    help="write the search (bracket, history, parameters) as JSON")
     p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
-    add_restart_argument(p, "OUTPUT, else REPORT, else NAME.gamma, with the suffix "
+    add_restart_argument(p, "OUTPUT, else REPORT, else NAME, with the suffix "
                             ".gamma.checkpoint.npz")
     add_force_argument(p)
     p.set_defaults(func=run)
