@@ -78,12 +78,17 @@ def load_kept(path: Path, key: str, load, command: str, log=print):
 
 class Keeper:
     """The latest state of a long computation, saved to ``path`` with ``key`` by
-    ``save(path, state, key)``: at most every :data:`CHECKPOINT_SECONDS`, or at once."""
+    ``save(path, state, key)``: at most every :data:`CHECKPOINT_SECONDS`, or at once.
 
-    def __init__(self, path: Path, key: str, save, saved=None):
-        self.path, self.key, self._save = Path(path), key, save
+    A checkpoint that cannot be written (read-only folder, disk full) is said once in a
+    warning line and the work goes on without one: the checkpoint only protects the work.
+    """
+
+    def __init__(self, path: Path, key: str, save, saved=None, command="train"):
+        self.path, self.key, self._save, self.command = Path(path), key, save, command
         self.state = self.saved = saved  # `saved`: a state loaded from the file
         self._at = time.monotonic()
+        self.failed = None
 
     def keep(self, state, now: bool = False):
         """Hold ``state``; save it if ``now`` or if the last save is old enough."""
@@ -93,15 +98,29 @@ class Keeper:
 
     def flush(self):
         """Save the state held if it is not saved yet; return the state saved (or None)."""
-        if self.state is not None and self.state is not self.saved:
-            self._save(self.path, self.state, self.key)
+        if self.state is not None and self.state is not self.saved and self.failed is None:
+            try:
+                self._save(self.path, self.state, self.key)
+            except OSError as exc:
+                from .main import describe_error
+
+                self.failed = describe_error(exc)[0]
+                print(f"weakgrid {self.command}: warning: cannot write the checkpoint: "
+                      f"{self.failed}; going on without one (an interruption will lose the "
+                      "work done)", file=sys.stderr, flush=True)
+                return self.saved
             self.saved, self._at = self.state, time.monotonic()
         return self.saved
 
     def discard(self):
         """Remove the checkpoint (the result is written)."""
-        if self.path.exists():
-            self.path.unlink()
+        try:
+            self.path.unlink(missing_ok=True)
+        except OSError as exc:
+            from .main import describe_error
+
+            print(f"weakgrid {self.command}: warning: cannot remove the checkpoint: "
+                  f"{describe_error(exc)[0]}", file=sys.stderr, flush=True)
 
 
 def say_kept(what: str, path: Path, log=print):
@@ -130,7 +149,7 @@ class TrainingCheckpoint:
         self.path, self.command, self.what, self.log = Path(path), command, what, log
         self.start = None if restart else load_kept(self.path, key, load_checkpoint,
                                                     command, log)
-        self.keeper = Keeper(self.path, key, save_checkpoint, self.start)
+        self.keeper = Keeper(self.path, key, save_checkpoint, self.start, command)
         if self.start is not None:
             log(f"  resuming from the checkpoint {self.path}: {self.start.outer} finished "
                 f"outer iteration(s){self.what} kept, continuing at iteration "

@@ -98,7 +98,7 @@ def run(args) -> int:
 
     # the bar (stderr, only on a terminal) follows the training of the running trial
     bar = tqdm(desc="  gamma search", unit=" outer it", leave=False, disable=None)
-    keeper = Keeper(ckpt, key, save_search_checkpoint, resume)
+    keeper = Keeper(ckpt, key, save_search_checkpoint, resume, NAME)
 
     def keep(state, decided):
         keeper.keep(state, now=decided)

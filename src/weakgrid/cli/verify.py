@@ -139,7 +139,7 @@ def run(args) -> int:
         print(f"  {r['iteration']:9d}  {r['max_rel_dV']:13.3e}  {r['max_dz']:8.2e}  "
               f"{r['n_bad_inertia']:17d}  {r['seconds']:7.2f}", flush=True)
 
-    keeper = Keeper(dp_ckpt, dp_key, save_dp_checkpoint, start)
+    keeper = Keeper(dp_ckpt, dp_key, save_dp_checkpoint, start, NAME)
     try:
         dp = solve_game_dp(problem.system, ctl.cost, lo, hi, settings, progress=progress,
                            start=start, checkpoint=keeper.keep)
