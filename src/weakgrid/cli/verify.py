@@ -112,7 +112,7 @@ def run(args) -> int:
               + f", gamma = {ctl.cost.gamma:g}")
     dp_ckpt = checkpoint_path(base, "dp")
     dp_key = content_key({"command": NAME, "problem": problem.raw, "name": problem.name,
-                          "model": problem.system.to_dict(), "cost": ctl.cost.to_dict(),
+                          "cost": ctl.cost.to_dict(),
                           "lower": list(problem.mesh.lower), "upper": list(problem.mesh.upper),
                           "dp": settings.to_dict()})
     start = None if args.restart else load_kept(dp_ckpt, dp_key, load_dp_checkpoint, NAME)
