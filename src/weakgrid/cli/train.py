@@ -102,12 +102,7 @@ def run(args) -> int:
     # the finished outer iterations are saved at most every CHECKPOINT_SECONDS, and on an
     # interruption (Ctrl-C, SIGTERM) before the error boundary reports it
     try:
-        ctl = problem.train(settings, progress=progress, start=cp.start,
-                            checkpoint=cp.keeper.keep)
-    except KeyboardInterrupt:
-        bar.close()
-        cp.interrupted()
-        raise
+        ctl = cp.train(problem, settings, progress)
     finally:
         bar.close()
     it = ctl.iterations
