@@ -42,31 +42,48 @@ def _same(got, ref):
         [r.max_du for r in ref.controller.history]
 
 
-def test_the_search_reports_every_decided_trial_and_every_training_iteration(search):
+def _decided(states):
+    return [s for s, finished in states if finished and s.running is None]
+
+
+def test_the_search_reports_every_decided_trial_failed_start_and_training_iteration(search):
     p, ref, states = search
-    decided = [s for s, d in states if d]
+    decided = _decided(states)
     assert [len(s.trials) for s in decided] == list(range(1, len(ref.history) + 1))
-    assert all(s.running is None for s in decided)
-    running = [s for s, d in states if not d]
-    assert running and all(s.running.training.outer >= 1 for s in running)
-    assert {s.running.gamma for s in running} == {t.gamma for t in ref.history}
+    training = [s for s, finished in states if not finished]
+    assert training and all(s.running.training.outer >= 1 for s in training)
+    assert {s.running.gamma for s in training} == {t.gamma for t in ref.history}
+    # a failed start is saved at once, with the next start due and the reasons so far
+    failed = [s for s, finished in states if finished and s.running is not None]
+    rejected = [t for t in ref.history if not t.accepted]
+    assert failed and all(s.running.training is None for s in failed)
+    assert {s.running.gamma for s in failed} == {t.gamma for t in rejected}
+    for t in rejected:  # every start of a rejected trial but the last one
+        marks = [s.running for s in failed if s.running.gamma == t.gamma]
+        assert [m.start for m in marks] == list(SETTINGS.starts[1:])
+        assert len(marks[-1].reasons) == len(SETTINGS.starts) - 1
+        assert t.reason.startswith("; ".join(marks[-1].reasons) + f"; [{SETTINGS.starts[-1]}]")
 
 
 @pytest.mark.parametrize("where", ["after trial 3", "mid-training", "failed training",
-                                   "all decided"])
+                                   "after a failed start", "all decided"])
 def test_a_resumed_search_gives_the_uninterrupted_result(tmp_path, search, where):
     p, ref, states = search
-    decided = [s for s, d in states if d]
+    decided = _decided(states)
     rejected = {t.gamma for t in ref.history if not t.accepted}
+    training = [s for s, finished in states if not finished]
     if where == "after trial 3":
         state = decided[2]
     elif where == "mid-training":  # an accepted trial after an accepted and a rejected one
-        cand = [s for s, d in states if not d and s.running.gamma not in rejected
+        cand = [s for s in training if s.running.gamma not in rejected
                 and any(not t.accepted for t in s.trials) and s.running.training.outer > 3]
         state = cand[len(cand) // 2]
     elif where == "failed training":  # the last iteration of a start that does not converge
-        cand = [s for s, d in states if not d and s.running.gamma in rejected]
+        cand = [s for s in training if s.running.gamma in rejected]
         state = cand[-1]
+    elif where == "after a failed start":  # the last start of a rejected trial is due
+        state = [s for s, finished in states if finished and s.running is not None][-1]
+        assert state.running.training is None and state.running.reasons
     else:
         state = decided[-1]
     path = save_search_checkpoint(tmp_path / "s.npz", state, "key")
@@ -81,14 +98,15 @@ def test_a_resumed_search_gives_the_uninterrupted_result(tmp_path, search, where
 
 def test_a_search_checkpoint_of_other_inputs_or_damaged_is_refused(tmp_path, search):
     p, ref, states = search
-    path = save_search_checkpoint(tmp_path / "s.npz", states[5][0], "key")
+    state = [s for s, finished in states if not finished][5]
+    path = save_search_checkpoint(tmp_path / "s.npz", state, "key")
     with pytest.raises(StaleCheckpointError):
         load_search_checkpoint(path, "other")
     (tmp_path / "bad.npz").write_bytes(path.read_bytes()[:100])
     with pytest.raises(CheckpointError):
         load_search_checkpoint(tmp_path / "bad.npz", "key")
     # a training checkpoint is not a search checkpoint (and says so)
-    save_checkpoint(tmp_path / "t.npz", states[5][0].running.training, "key")
+    save_checkpoint(tmp_path / "t.npz", state.running.training, "key")
     with pytest.raises(CheckpointError, match="not a weakgrid-gamma-search-checkpoint"):
         load_search_checkpoint(tmp_path / "t.npz", "key")
 

@@ -55,6 +55,23 @@ def add_parser(sub):
     return p
 
 
+def _running(r, text) -> str:
+    """``text`` about the running trial ``r`` ({g}, {what}: its start and iterations,
+    {kept}: what of it is kept), or "" without one."""
+    if r is None:
+        return ""
+    failed = f"{len(r.reasons)} start(s) failed, " if r.reasons else ""
+    if r.training is None:
+        what = f"({failed}next the {r.start} start)"
+        kept = f"({failed}the {r.start} start due)"
+    else:
+        what = (f"({failed}the training from the {r.start} start at outer iteration "
+                f"{r.training.outer + 1})")
+        kept = (f"({failed}{r.training.outer} outer iteration(s) of the training from the "
+                f"{r.start} start)")
+    return text.format(g=f"{r.gamma:.6g}", what=what, kept=kept)
+
+
 def run(args) -> int:
     """Run ``weakgrid gamma`` with the parsed ``args``; return the exit status."""
     problem = problem_of(args)
@@ -77,10 +94,8 @@ def run(args) -> int:
     resume = None if args.restart else load_kept(ckpt, key, load_search_checkpoint, NAME)
     kept = len(resume.trials) if resume is not None else 0
     if resume is not None:
-        r = resume.running
         print(f"  resuming from the checkpoint {ckpt}: {kept} decided trial(s) kept"
-              + (f", the trial at gamma = {r.gamma:.6g} continues its training ({r.start} "
-                 f"start) at outer iteration {r.training.outer + 1}" if r is not None else ""))
+              + _running(resume.running, ", the trial at gamma = {g} continues {what}"))
     if not args.quiet:
         print("\n  trial      gamma     decision  start           seconds  reason")
     count = [0]
@@ -100,9 +115,9 @@ def run(args) -> int:
     bar = tqdm(desc="  gamma search", unit=" outer it", leave=False, disable=None)
     keeper = Keeper(ckpt, key, save_search_checkpoint, resume, NAME)
 
-    def keep(state, decided):
-        keeper.keep(state, now=decided)
-        if state.running is not None:
+    def keep(state, finished):
+        keeper.keep(state, now=finished)
+        if state.running is not None and state.running.training is not None:
             bar.update(1)
             bar.set_postfix_str(f"trial {len(state.trials) + 1}, gamma "
                                 f"{state.running.gamma:.6g} ({state.running.start})",
@@ -121,10 +136,8 @@ def run(args) -> int:
         bar.close()
         saved = keeper.flush()
         if saved is not None and (saved.trials or saved.running is not None):
-            r = saved.running
             say_kept(f"{len(saved.trials)} decided trial(s)"
-                     + (f" and {r.training.outer} outer iteration(s) of the trial at gamma = "
-                        f"{r.gamma:.6g}" if r is not None else ""), ckpt)
+                     + _running(saved.running, " and the trial at gamma = {g} {kept}"), ckpt)
         raise
     finally:
         bar.close()

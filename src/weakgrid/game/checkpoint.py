@@ -204,19 +204,21 @@ class RunningTrial:
     ----------
     gamma : float
     start : str
-        The start of the policy iteration being trained.
+        The start of the policy iteration being trained (or due next, if ``training``
+        is None).
     reasons : list of str
         Why the starts before it failed.
     seconds : float
         Time spent on the trial, s.
-    training : TrainingState
+    training : TrainingState or None
+        The finished outer iterations of the training from ``start``.
     """
 
     gamma: float
     start: str
     reasons: list
     seconds: float
-    training: TrainingState
+    training: TrainingState | None = None
 
 
 @dataclass
@@ -249,11 +251,13 @@ def save_search_checkpoint(path, state: SearchState, key: str) -> Path:
     arrays = {}
     r = state.running
     if r is not None:
-        tmeta, tarr = _training_parts(r.training)
         meta["running"] = {"gamma": float(r.gamma), "start": r.start,
                            "reasons": list(r.reasons), "seconds": float(r.seconds),
-                           "training": tmeta}
-        arrays = {"running_policy": tarr["policy"], "running_weights": tarr["weights"]}
+                           "training": None}
+        if r.training is not None:
+            tmeta, tarr = _training_parts(r.training)
+            meta["running"]["training"] = tmeta
+            arrays = {"running_policy": tarr["policy"], "running_weights": tarr["weights"]}
     return _write(path, meta, arrays)
 
 
@@ -275,9 +279,10 @@ def load_search_checkpoint(path, key: str) -> SearchState:
         if meta["running"] is not None:
             r = meta["running"]
             running = RunningTrial(float(r["gamma"]), str(r["start"]), list(r["reasons"]),
-                                   float(r["seconds"]), _training_from_parts(
-                                       r["training"], arrays["running_policy"],
-                                       arrays["running_weights"]))
+                                   float(r["seconds"]), None if r["training"] is None else
+                                   _training_from_parts(r["training"],
+                                                        arrays["running_policy"],
+                                                        arrays["running_weights"]))
     except (KeyError, TypeError, ValueError) as exc:
         raise CheckpointError(path, f"{type(exc).__name__}: {exc}") from None
     return SearchState(trials, best, running)

@@ -251,9 +251,10 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
         the same (γ*, bracket, history, controller weights) as that of a search that
         was never interrupted.
     checkpoint : callable, optional
-        ``checkpoint(state, decided)`` with a :class:`~weakgrid.game.checkpoint.SearchState`
-        after each decided trial (``decided=True``) and after each finished outer
-        iteration of a trial's training (``decided=False``); e.g. save it.
+        ``checkpoint(state, finished)`` with a :class:`~weakgrid.game.checkpoint.SearchState`
+        after each decided trial and after each failed start of a trial
+        (``finished=True``: a unit of work is finished, save it now) and after each
+        finished outer iteration of a trial's training (``finished=False``).
 
     Returns
     -------
@@ -332,6 +333,14 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
             reasons, before = list(running.reasons), running.start
             go_on, spent = running.training, running.seconds
             running = None
+
+        def failed(start, why):
+            """Record why ``start`` failed; save that the next start is due."""
+            reasons.append(f"[{start}] {why}")
+            nxt = settings.starts[settings.starts.index(start) + 1:]
+            if nxt:
+                save(True, RunningTrial(float(gamma), nxt[0], list(reasons),
+                                        spent + time.perf_counter() - t1, None))
         for start in settings.starts:
             if before is not None:  # resumed: the starts before this one failed already
                 if start != before:
@@ -348,20 +357,20 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
                 ctl = solve_hji(system, basis, c, mesh, pol, solver, problem=problem,
                                 start=go_on, checkpoint=keep)
             except WeakgridError as exc:
-                reasons.append(f"[{start}] {type(exc).__name__}: {_short(exc)}")
+                failed(start, f"{type(exc).__name__}: {_short(exc)}")
                 continue
             finally:
                 go_on = None
             eu, ew = ctl.block_eigenvalues(mesh.points)
             if not (ew.max() < 0 and eu.min() > 0):
-                reasons.append(f"[{start}] Yw not ≺ 0 or Yu not ≻ 0 on the mesh "
-                               f"(max eig Yw {ew.max():.3g}, min eig Yu {eu.min():.3g})")
+                failed(start, f"Yw not ≺ 0 or Yu not ≻ 0 on the mesh (max eig Yw "
+                              f"{ew.max():.3g}, min eig Yu {eu.min():.3g})")
                 continue
             ok, final, why = worst_case_rollout_check(
                 ctl, mesh, settings.rollout_steps, settings.escape_factor,
                 settings.return_fraction)
             if not ok:
-                reasons.append(f"[{start}] {why}")
+                failed(start, why)
                 continue
             rec = GammaTrial(float(gamma), True, f"[{start}] converged, Yw ≺ 0 on the mesh, "
                              f"worst-case closed loop {why}", start, ctl.iterations["outer"],
