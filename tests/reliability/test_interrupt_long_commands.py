@@ -112,8 +112,8 @@ def test_an_interrupted_gamma_search_resumes_without_redoing_its_trials(tmp_path
                 if TRIAL.match(ln) and "(kept)" not in ln]
     assert len(kept_rows) == n_kept  # shown, not run again
     assert new_rows == list(range(n_kept + 1, n_ref + 1))
-    assert f"{n_ref} trials ({n_ref - n_kept} run now, {n_kept} kept from the checkpoint)" \
-        in stdout
+    assert (f"{n_ref} trials ({n_ref - n_kept} run now, {n_kept} kept from the "
+            "checkpoint)") in stdout
     got = json.loads(rep.read_text())
     assert got["gamma_star"] == ref["gamma_star"] and got["bracket"] == ref["bracket"]
     assert [(t["gamma"], t["accepted"], t["reason"]) for t in got["history"]] == \
@@ -273,3 +273,34 @@ def test_a_checkpoint_that_cannot_be_written_is_one_warning_and_the_work_goes_on
     ref, got = (json.loads((tmp_path / n).read_text()) for n in ("ref.json", "r.json"))
     assert got["bracket"] == ref["bracket"] and got["gamma_star"] == ref["gamma_star"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.json", "ref.json"]
+
+
+def test_verify_and_design_ignore_a_checkpoint_of_other_inputs(tmp_path, capsys):
+    """The same for `verify` (its training and its DP) and `design`: a checkpoint of other
+    inputs is said to be so, ignored (the work starts at iteration 1) and replaced."""
+    from weakgrid.cli._checkpoint import checkpoint_path
+    from weakgrid.game.checkpoint import DPState, save_checkpoint, save_dp_checkpoint
+    from weakgrid.models import load_preset
+
+    states = []
+    load_preset("case1-paper").train(checkpoint=states.append)
+    rep = tmp_path / "v.json"
+    save_checkpoint(checkpoint_path(rep, "training"), states[3], "other inputs")
+    save_dp_checkpoint(checkpoint_path(rep, "dp"), DPState(1, np.zeros((961, 2)),
+                                                           np.zeros(961), np.zeros(961),
+                                                           [{"iteration": 1}]), "other")
+    assert main(["verify", "--preset", "case1-paper", "--points", "31", "--steps", "500",
+                 "--report", rep]) == 0
+    out = capsys.readouterr().out
+    assert out.count("is of other inputs") == 2 and "kept from the checkpoint" not in out
+    assert _rows(DP_ROW, out)[0] == 1 and "resuming" not in out
+    assert not checkpoint_path(rep, "dp").exists()
+
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY.read_text())
+    out_file = tmp_path / "c.controller.json"
+    save_checkpoint(checkpoint_path(out_file), states[3], "other inputs")
+    assert main(["design", study, "-o", out_file]) == 0
+    out = capsys.readouterr().out
+    assert "is of other inputs" in out and "kept from the checkpoint" not in out
+    assert not checkpoint_path(out_file).exists()

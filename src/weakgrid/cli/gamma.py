@@ -147,7 +147,7 @@ def run(args) -> int:
     print(f"  lower bound (game-Riccati limit of the linearization) = {res.linear_limit:.6g}; "
           f"gamma*/bound = {res.gamma_star / res.linear_limit:.4g}")
     print(f"  {len(res.history)} trials ({len(res.history) - kept} run now, {kept} kept from "
-          f"the checkpoint) in {res.seconds:.1f} s" if kept else
+          f"the checkpoint) in {res.seconds:.1f} s (this run)" if kept else
           f"  {len(res.history)} trials in {res.seconds:.1f} s"
           + ("" if res.converged else "  (stopped at --max-trials before the bracket closed)"))
     if args.report:
