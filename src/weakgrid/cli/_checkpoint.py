@@ -181,14 +181,24 @@ class TrainingCheckpoint:
         self.keeper.discard()
 
 
-def outer_bar(initial: int, tol: float, desc="  training"):
+LINE_SECONDS = 10.0  # without a terminal, a progress line at most this often
+
+
+def outer_bar(initial: int, tol: float, desc="  training", lines=False):
     """A progress bar (stderr, only on a terminal) counting outer iterations; returns
-    ``(bar, update(record))``."""
+    ``(bar, update(record))``. With ``lines``, when there is no terminal (output to a
+    file or a pipe) a line on stdout says how far the training is every
+    :data:`LINE_SECONDS`."""
     from tqdm.auto import tqdm
 
     bar = tqdm(desc=desc, unit=" outer it", leave=False, disable=None, initial=initial)
+    last = [time.monotonic()]
 
     def update(rec):
         bar.update(1)
         bar.set_postfix_str(f"max|Δu| {rec.max_du:.2e} → δu {tol:g}", refresh=False)
+        if lines and bar.disable and time.monotonic() - last[0] >= LINE_SECONDS:
+            last[0] = time.monotonic()
+            print(f"{desc}: outer iteration {rec.outer}, max|Δu| {rec.max_du:.2e} → δu "
+                  f"{tol:g}", flush=True)
     return bar, update

@@ -75,7 +75,7 @@ def run(args) -> int:
     cp = TrainingCheckpoint(checkpoint_path(out),
                             training_key(problem, settings, NAME, model=d.to_dict()),
                             args.restart, NAME)
-    bar, update = outer_bar(cp.kept, settings.tol_u)
+    bar, update = outer_bar(cp.kept, settings.tol_u, lines=True)
     try:
         ctl = cp.train(problem, settings, progress=update)
     finally:
