@@ -6,6 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ._checkpoint import TrainingCheckpoint, add_restart_argument, checkpoint_path, outer_bar
+from ._checkpoint import training_key
 from ._common import output_file
 from ._study import add_operating_point, add_study_argument, study_of
 
@@ -26,6 +28,7 @@ def add_parser(sub):
     p.add_argument("--output", "-o", type=output_file(".json"), default=None,
                    help="controller file (default: <study>-<load>-<upqc>.controller.json)")
     p.add_argument("--no-train", action="store_true", help="derive and check only")
+    add_restart_argument(p, "OUTPUT with the suffix .checkpoint.npz")
     p.set_defaults(func=run)
     return p
 
@@ -34,7 +37,7 @@ def run(args) -> int:
     """Run ``weakgrid design`` with the parsed ``args``; return the exit status."""
     from ..fileio import write_json_atomic
     from ..study.build import build_setup
-    from ..study.controllers import train_hji
+    from ..study.controllers import design_problem
     from ..study.engine import MODE_TOLERANCE, mode_check
 
     st = study_of(args)
@@ -63,8 +66,20 @@ def run(args) -> int:
           f"{verdict}")
     if args.no_train:
         return 0
-    problem, ctl = train_hji(st, d)
     out = args.output or Path(f"{st.name}-{setup.load}-{setup.upqc}.controller.json")
+    # the training resumes from its checkpoint beside the output, as `weakgrid train` does
+    problem = design_problem(st, d)
+    settings = problem.settings
+    print(f"\nHJI training: {problem.mesh.points.shape[0]} mesh points, "
+          f"{problem.basis.size} basis terms, δu = {settings.tol_u:g}")
+    cp = TrainingCheckpoint(checkpoint_path(out),
+                            training_key(problem, settings, NAME, model=d.to_dict()),
+                            args.restart, NAME)
+    bar, update = outer_bar(cp.kept, settings.tol_u, lines=True)
+    try:
+        ctl = cp.train(problem, settings, progress=update)
+    finally:
+        bar.close()
     ctl.save(out)
     write_json_atomic(out.with_suffix("").with_suffix(".derivation.json") if
                       out.name.endswith(".controller.json") else Path(str(out) +
@@ -72,6 +87,9 @@ def run(args) -> int:
                       {"derivation": der.to_dict(), "mode_check": {
                           k: (str(v) if isinstance(v, complex) else v) for k, v in chk.items()},
                        "study": st.source})
-    print(f"\nHJI: {ctl.iterations['outer']} outer iterations in {ctl.train_seconds:.2f} s; "
-          f"wrote {out}")
+    n = ctl.iterations["outer"]
+    print(f"HJI: {n} outer iterations"
+          + (f" ({n - cp.kept} now, {cp.kept} kept from the checkpoint)" if cp.kept else "")
+          + f" in {ctl.train_seconds:.2f} s; wrote {out}")
+    cp.discard()
     return 0

@@ -4,15 +4,14 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 from ..game.hji import closed_loop_spectral_radius
-from ..game.checkpoint import (CheckpointError, StaleCheckpointError, load_checkpoint,
-                               save_checkpoint)
 from ..game.errors import ParameterError
+from . import _checkpoint
+from ._checkpoint import CHECKPOINT_SECONDS, TrainingCheckpoint, add_restart_argument, outer_bar
 from ._common import (add_force_argument, add_problem_arguments, guard_training, output_file,
                       positive_float, problem_of)
 
@@ -38,9 +37,7 @@ def add_parser(sub):
     p.add_argument("--u-bound-shape", choices=("disk", "box"), default=None,
                    help="shape of --u-bound (default: the problem's, else disk)")
     p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
-    p.add_argument("--restart", action="store_true",
-                   help="start over, ignoring the checkpoint of an interrupted training "
-                        "(OUTPUT with the suffix .checkpoint.npz)")
+    add_restart_argument(p, "OUTPUT with the suffix .checkpoint.npz")
     add_force_argument(p)
     p.set_defaults(func=run)
     return p
@@ -81,12 +78,8 @@ def run(args) -> int:
     print(f"  solver  δu = {settings.tol_u:g}, δw = {settings.tol_w:g}")
     guard_training(problem, args.force)
     out = args.output or Path(f"{problem.name}.controller.json")
-    ckpt = checkpoint_path(out)
-    key = training_key(problem, settings)
-    start = None if args.restart else _load_start(ckpt, key)
-    if start is not None:
-        print(f"  resuming from the checkpoint {ckpt}: {start.outer} finished outer "
-              f"iteration(s) kept, continuing at iteration {start.outer + 1}")
+    cp = TrainingCheckpoint(checkpoint_path(out), training_key(problem, settings),
+                            args.restart, NAME)
     if not args.quiet:
         print("\n  outer  inner    max|Δu|     max|Δw| (last)   residual    min J     "
               "max eig Yw  min eig Yu" + ("  bound binds" if c.bound is not None else ""))
@@ -94,12 +87,10 @@ def run(args) -> int:
     from tqdm.auto import tqdm
 
     # the bar (stderr, only on a terminal) counts outer iterations and shows max|Δu| vs δu
-    bar = tqdm(desc="  training", unit=" outer it", leave=False, disable=None,
-               initial=start.outer if start is not None else 0)
+    bar, update = outer_bar(cp.kept, settings.tol_u)
 
     def progress(rec):
-        bar.update(1)
-        bar.set_postfix_str(f"max|Δu| {rec.max_du:.2e} → δu {settings.tol_u:g}", refresh=False)
+        update(rec)
         if not args.quiet:
             tqdm.write(f"  {rec.outer:5d}  {rec.inner:5d}  {rec.max_du:10.3e}  "
                        f"{rec.max_dw[-1]:12.3e}     {rec.residual:9.2e}  {rec.min_J:9.3g}  "
@@ -110,27 +101,8 @@ def run(args) -> int:
 
     # the finished outer iterations are saved at most every CHECKPOINT_SECONDS, and on an
     # interruption (Ctrl-C, SIGTERM) before the error boundary reports it
-    kept = {"state": None, "saved": start.outer if start is not None else 0,
-            "at": time.monotonic()}
-
-    def keep(state):
-        kept["state"] = state
-        if time.monotonic() - kept["at"] >= CHECKPOINT_SECONDS:
-            save_checkpoint(ckpt, state, key)
-            kept["saved"], kept["at"] = state.outer, time.monotonic()
-
     try:
-        ctl = problem.train(settings, progress=progress, start=start, checkpoint=keep)
-    except KeyboardInterrupt:
-        bar.close()
-        state = kept["state"]
-        if state is not None and state.outer > kept["saved"]:
-            save_checkpoint(ckpt, state, key)
-            kept["saved"] = state.outer
-        if kept["saved"]:
-            print(f"\n  kept {kept['saved']} finished outer iteration(s) in {ckpt}; re-run "
-                  "the same command to continue", flush=True)
-        raise
+        ctl = cp.train(problem, settings, progress)
     finally:
         bar.close()
     it = ctl.iterations
@@ -176,45 +148,22 @@ def run(args) -> int:
     print(f"    relative residual of the last fit: {ctl.history[-1].residual:.3e}")
     ctl.save(out)
     print(f"\n  wrote {out}")
-    if ckpt.exists():
-        ckpt.unlink()
+    cp.discard()
     return 0
 
 
 # ------------------------------------------------------------------ checkpoints
-CHECKPOINT_SECONDS = 1.0  # a training shorter than this writes no checkpoint unless stopped
+# (shared with design, gamma and verify: weakgrid.cli._checkpoint)
+__all__ = ["run", "add_parser", "checkpoint_path", "training_key", "CHECKPOINT_SECONDS"]
 
 
 def checkpoint_path(out: Path) -> Path:
     """The checkpoint of the training that writes ``out``: beside it, ``.checkpoint.npz``."""
-    return out.with_suffix(".checkpoint.npz")
+    return _checkpoint.checkpoint_path(out)
 
 
 def training_key(problem, settings) -> str:
     """A content hash of everything a training depends on: the problem file as read, the
     model, cost (with any bound), mesh, basis and solver settings after the command-line
     overrides, and the code (every source and data file of the package, with its version)."""
-    import hashlib
-
-    from ..sweep.cache import canonical_json, code_fingerprint
-
-    inputs = {"command": NAME, "problem": problem.raw, "name": problem.name,
-              "cost": problem.cost.to_dict(), "mesh": problem.mesh.to_dict(),
-              "basis": problem.basis.to_dict(), "settings": settings.to_dict()}
-    text = canonical_json({"inputs": inputs, "code": code_fingerprint()})
-    return hashlib.sha256(text.encode()).hexdigest()[:24]
-
-
-def _load_start(ckpt: Path, key: str):
-    """The state in the checkpoint ``ckpt`` if it is of these inputs, else None (said why)."""
-    if not ckpt.exists():
-        return None
-    try:
-        return load_checkpoint(ckpt, key)
-    except StaleCheckpointError:
-        print(f"  the checkpoint {ckpt} is of other inputs (the problem, the settings or the "
-              "code changed): starting over; it will be replaced")
-    except CheckpointError as exc:
-        print(f"weakgrid train: warning: {exc}: ignored, starting over (it will be replaced; "
-              "delete it to silence this warning)", file=sys.stderr, flush=True)
-    return None
+    return _checkpoint.training_key(problem, settings, NAME)

@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import numpy as np
 
 from ..fileio import write_json_atomic
+from ..game.checkpoint import load_dp_checkpoint, save_dp_checkpoint
 from ..game.dynamic_programming import DPSettings, solve_game_dp
 from ..game.errors import ParameterError
 from ..game.optimality import closed_loop_gap, default_starts, value_error
 from ..models import load_controller
+from ._checkpoint import (Keeper, TrainingCheckpoint, add_restart_argument, checkpoint_path,
+                          content_key, load_kept, say_kept, training_key)
 from ._common import (add_force_argument, add_problem_arguments, guard_dp, guard_training,
                       input_file, nonnegative_float, output_file, positive_float, positive_int,
                       problem_of, provenance)
@@ -55,6 +59,8 @@ def add_parser(sub):
     p.add_argument("--u-bound-shape", choices=("disk", "box"), default=None,
                    help="shape of --u-bound (default: the problem's, else disk)")
     p.add_argument("--report", type=output_file(".json"), default=None, help="write the report (JSON)")
+    add_restart_argument(p, "REPORT, else NAME.verify, with the suffixes "
+                            ".training.checkpoint.npz and .dp.checkpoint.npz")
     add_force_argument(p)
     p.set_defaults(func=run)
     return p
@@ -91,21 +97,60 @@ def run(args) -> int:
                                  f"{ {k: v for k, v in theirs.items() if k != 'source'} }) "
                                  f"than {problem.name}: pass the matching --preset/--config")
         print(f"  controller  {args.controller} (gamma = {ctl.cost.gamma:g})")
-    else:
-        ctl = problem.train()
-        print(f"  controller  trained now: {ctl.iterations['outer']} outer iterations, "
-              f"gamma = {ctl.cost.gamma:g}")
+    # checkpoints beside the report: the training (kept, once finished, until the DP is
+    # done) and the DP iterations (at most every CHECKPOINT_SECONDS and on an interruption)
+    base = args.report or Path(f"{problem.name}.verify.json")
+    train_cp = None
+    if not args.controller:
+        train_cp = TrainingCheckpoint(checkpoint_path(base, "training"),
+                                      training_key(problem, problem.settings, NAME),
+                                      args.restart, NAME, " of the training")
+        ctl = train_cp.train(problem, problem.settings)
+        train_cp.keeper.flush()  # the finished training: a re-run does not redo it
+        print(f"  controller  trained now: {ctl.iterations['outer']} outer iterations"
+              + (f" ({train_cp.kept} kept from the checkpoint)" if train_cp.kept else "")
+              + f", gamma = {ctl.cost.gamma:g}")
+    dp_ckpt = checkpoint_path(base, "dp")
+    dp_key = content_key({"command": NAME, "problem": problem.raw, "name": problem.name,
+                          "cost": ctl.cost.to_dict(),
+                          "lower": list(problem.mesh.lower), "upper": list(problem.mesh.upper),
+                          "dp": settings.to_dict()})
+    start = None if args.restart else load_kept(dp_ckpt, dp_key, load_dp_checkpoint, NAME)
     lo, hi = problem.mesh.lower, problem.mesh.upper
     print(f"  DP grid     {args.points} x {args.points} on {list(lo)} .. {list(hi)} "
           f"(margin {args.margin}), hold {args.hold_steps} step(s), {args.interpolation} "
           f"residual around the game-Riccati quadratic")
+    if start is not None:
+        print(f"  resuming the DP from the checkpoint {dp_ckpt}: {start.iteration} finished "
+              f"iteration(s) kept, continuing at iteration {start.iteration + 1}")
     print("\n  iteration  max|dV|/max V   max|dz|   bad-inertia nodes  seconds")
 
+    from tqdm.auto import tqdm
+
+    # the bar (stderr, only on a terminal) counts DP iterations against the cap
+    bar = tqdm(desc="  DP", unit=" it", total=settings.max_iterations, leave=False,
+               disable=None, initial=start.iteration if start is not None else 0)
+
     def progress(r):
+        bar.update(1)
+        bar.set_postfix_str(f"max|dV|/max V {r['max_rel_dV']:.2e} → {settings.tol:g}",
+                            refresh=False)
+        bar.clear()
         print(f"  {r['iteration']:9d}  {r['max_rel_dV']:13.3e}  {r['max_dz']:8.2e}  "
               f"{r['n_bad_inertia']:17d}  {r['seconds']:7.2f}", flush=True)
 
-    dp = solve_game_dp(problem.system, ctl.cost, lo, hi, settings, progress=progress)
+    keeper = Keeper(dp_ckpt, dp_key, save_dp_checkpoint, start, NAME)
+    try:
+        dp = solve_game_dp(problem.system, ctl.cost, lo, hi, settings, progress=progress,
+                           start=start, checkpoint=keeper.keep)
+    except KeyboardInterrupt:
+        bar.close()
+        saved = keeper.flush()
+        if saved is not None and saved.iteration:
+            say_kept(f"{saved.iteration} finished DP iteration(s)", dp_ckpt)
+        raise
+    finally:
+        bar.close()
     print(f"  DP {'converged' if dp.converged else 'NOT converged'} in {len(dp.history)} "
           f"iterations, {dp.seconds:.1f} s; lifting bias on the linearization "
           f"{_pct(dp.lifting_bias)}")
@@ -138,4 +183,7 @@ def run(args) -> int:
         write_json_atomic(args.report, {**rec, "dp": dp.to_dict(), "value_error": ve,
                                         "closed_loop": gap})
         print(f"\n  wrote {args.report}")
+    keeper.discard()
+    if train_cp is not None:
+        train_cp.discard()
     return 0

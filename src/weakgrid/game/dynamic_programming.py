@@ -468,7 +468,7 @@ class _Grid:
         return Z + step, int((~ok).sum())
 
 def solve_game_dp(system, cost, lower, upper, settings: DPSettings | None = None, *,
-                  progress=None) -> DPSolution:
+                  progress=None, start=None, checkpoint=None) -> DPSolution:
     """Solve the zero-sum game on a grid over the box ``[lower, upper]`` (see the module).
 
     Parameters
@@ -480,6 +480,13 @@ def solve_game_dp(system, cost, lower, upper, settings: DPSettings | None = None
     settings : DPSettings
     progress : callable, optional
         Called with each iteration's record (a dict).
+    start : DPState, optional
+        Continue from these finished iterations (a checkpoint of the same inputs,
+        :mod:`weakgrid.game.checkpoint`): the result is the same, bit for bit, as that
+        of a run that was never interrupted.
+    checkpoint : callable, optional
+        Called with the :class:`~weakgrid.game.checkpoint.DPState` after each
+        finished iteration (before ``progress``).
 
     Returns
     -------
@@ -538,10 +545,23 @@ def solve_game_dp(system, cost, lower, upper, settings: DPSettings | None = None
         Z[:, :system.n_controls] = cost.bound._interior(cost.bound.squash(
             Z[:, :system.n_controls]))
     history = []
-    r = grid.evaluate(Z)
-    Vold = grid.quad(X) + r
-    converged = False
-    for it in range(1, settings.max_iterations + 1):
+    converged, first, before = False, 1, 0.0
+    if start is None:
+        r = grid.evaluate(Z)
+        Vold = grid.quad(X) + r
+    else:
+        Z, r, Vold = (np.array(a, float) for a in (start.policy, start.residual, start.value))
+        if Z.shape != (grid.N, system.n_controls + system.n_disturbances) or \
+                r.shape != (grid.N,) or Vold.shape != (grid.N,):
+            raise ShapeError("checkpoint policy", Z.shape, f"({grid.N}, "
+                             f"{system.n_controls + system.n_disturbances}) for this grid "
+                             "and model: the checkpoint is of another problem")
+        history = [dict(h) for h in start.history]
+        first, before = int(start.iteration) + 1, float(start.seconds)
+        converged = bool(history) and history[-1]["max_rel_dV"] <= settings.tol
+    for it in range(first, settings.max_iterations + 1):
+        if converged:  # the checkpoint holds the converged iteration
+            break
         t1 = time.perf_counter()
         Znew, n_bad = grid.improve(Z.copy(), r, settings.newton_steps)
         r = grid.evaluate(Znew)
@@ -551,13 +571,18 @@ def solve_game_dp(system, cost, lower, upper, settings: DPSettings | None = None
         rec = {"iteration": it, "max_rel_dV": dV, "max_dz": dZ, "n_bad_inertia": n_bad,
                "min_V": float(V.min()), "seconds": time.perf_counter() - t1}
         history.append(rec)
+        Z, Vold = Znew, V
+        if checkpoint is not None:  # before progress: an iteration reported is one kept
+            from .checkpoint import DPState
+
+            checkpoint(DPState(it, Z, r, V, list(history),
+                               before + time.perf_counter() - t0))
         if progress is not None:
             progress(rec)
-        Z, Vold = Znew, V
         if dV <= settings.tol:
             converged = True
             break
     shape = tuple(settings.n_points)
     return DPSolution(system, cost, axes, S0, r.reshape(shape),
                       Z.reshape(shape + (Z.shape[1],)), settings, history, bias,
-                      time.perf_counter() - t0, converged)
+                      before + time.perf_counter() - t0, converged)

@@ -228,7 +228,9 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
                      solver: SolverSettings | None = None,
                      settings: SearchSettings | None = None, *,
                      problem: dict | None = None,
-                     progress: Callable[[GammaTrial], None] | None = None) -> GammaSearchResult:
+                     progress: Callable[[GammaTrial], None] | None = None,
+                     resume=None,
+                     checkpoint: Callable | None = None) -> GammaSearchResult:
     """Bisect for the smallest γ accepted by the HJI policy iteration (see the module).
 
     Parameters
@@ -240,7 +242,19 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
     problem : dict, optional
         Recorded in the controller file.
     progress : callable, optional
-        Called with each :class:`GammaTrial` as it is decided.
+        Called with each :class:`GammaTrial` as it is decided (not with the trials
+        taken from ``resume``).
+    resume : SearchState, optional
+        Continue an interrupted search of the same inputs
+        (:mod:`weakgrid.game.checkpoint`): its decided trials are replayed, not run
+        again, and the trial that was running continues its training; the result is
+        the same (γ*, bracket, history, controller weights) as that of a search that
+        was never interrupted.
+    checkpoint : callable, optional
+        ``checkpoint(state, finished)`` with a :class:`~weakgrid.game.checkpoint.SearchState`
+        after each decided trial and after each failed start of a trial
+        (``finished=True``: a unit of work is finished, save it now) and after each
+        finished outer iteration of a trial's training (``finished=False``).
 
     Returns
     -------
@@ -250,7 +264,10 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
     ------
     ConvergenceError
         No accepted γ was found while doubling from ``cost.gamma``.
+    CheckpointError
+        ``resume`` does not fit this search.
     """
+    from .checkpoint import CheckpointError, RunningTrial, SearchState
     from .errors import ConvergenceError
 
     solver = solver or SolverSettings()
@@ -260,6 +277,32 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
     g_lin = attenuation_limit(A, B, E, cost.Q, cost.R, cost.P, rtol=min(1e-8, settings.rtol))
     history: list[GammaTrial] = []
     best = {"gamma": None, "controller": None}
+
+    def cost_at(gamma):
+        return GameCost(cost.Q, cost.R, cost.P, float(gamma), cost.bound)
+
+    replay = list(resume.trials) if resume is not None else []
+    running = resume.running if resume is not None else None
+    kept = resume.best if resume is not None else None
+    if isinstance(kept, dict):  # the record of a controller: rebuilt on these very objects
+        kept = _controller_of(kept, system, basis, cost_at)
+
+    def replayed(gamma):
+        """The decided trial at ``gamma`` from ``resume`` (None when there is none left)."""
+        if not replay:
+            return None
+        rec = replay.pop(0)
+        if rec.gamma != float(gamma):
+            raise CheckpointError("(resume)", f"its trial {len(history) + 1} is at gamma = "
+                                  f"{rec.gamma!r}, this search tries {float(gamma)!r}: "
+                                  "start over (--restart)")
+        ctl = kept if (rec.accepted and kept is not None
+                       and kept.cost.gamma == rec.gamma) else None
+        return rec, ctl
+
+    def save(decided, current=None):
+        if checkpoint is not None:
+            checkpoint(SearchState(list(history), best["controller"], current), decided)
 
     def policy_for(start, gamma):
         if start == "continuation":
@@ -275,44 +318,80 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
         return initial_policy
 
     def trial(gamma):
+        nonlocal running
+        done = replayed(gamma)
+        if done is not None:
+            return done
         t1 = time.perf_counter()
-        c = GameCost(cost.Q, cost.R, cost.P, float(gamma), cost.bound)
-        reasons = []
+        c = cost_at(gamma)
+        reasons, before, go_on, spent = [], None, None, 0.0
+        if running is not None:
+            if running.gamma != float(gamma) or running.start not in settings.starts:
+                raise CheckpointError("(resume)", f"the running trial is at gamma = "
+                                      f"{running.gamma!r} ({running.start}), this search "
+                                      f"tries {float(gamma)!r}: start over (--restart)")
+            reasons, before = list(running.reasons), running.start
+            go_on, spent = running.training, running.seconds
+            running = None
+
+        def failed(start, why):
+            """Record why ``start`` failed; save that the next start is due."""
+            reasons.append(f"[{start}] {why}")
+            nxt = settings.starts[settings.starts.index(start) + 1:]
+            if nxt:
+                save(True, RunningTrial(float(gamma), nxt[0], list(reasons),
+                                        spent + time.perf_counter() - t1, None))
         for start in settings.starts:
+            if before is not None:  # resumed: the starts before this one failed already
+                if start != before:
+                    continue
+                before = None
             pol = policy_for(start, gamma)
             if pol is None:
                 continue
+
+            def keep(state, start=start):
+                save(False, RunningTrial(float(gamma), start, list(reasons),
+                                         spent + time.perf_counter() - t1, state))
             try:
-                ctl = solve_hji(system, basis, c, mesh, pol, solver, problem=problem)
+                ctl = solve_hji(system, basis, c, mesh, pol, solver, problem=problem,
+                                start=go_on, checkpoint=keep)
             except WeakgridError as exc:
-                reasons.append(f"[{start}] {type(exc).__name__}: {_short(exc)}")
+                failed(start, f"{type(exc).__name__}: {_short(exc)}")
                 continue
+            finally:
+                go_on = None
             eu, ew = ctl.block_eigenvalues(mesh.points)
             if not (ew.max() < 0 and eu.min() > 0):
-                reasons.append(f"[{start}] Yw not ≺ 0 or Yu not ≻ 0 on the mesh "
-                               f"(max eig Yw {ew.max():.3g}, min eig Yu {eu.min():.3g})")
+                failed(start, f"Yw not ≺ 0 or Yu not ≻ 0 on the mesh (max eig Yw "
+                              f"{ew.max():.3g}, min eig Yu {eu.min():.3g})")
                 continue
             ok, final, why = worst_case_rollout_check(
                 ctl, mesh, settings.rollout_steps, settings.escape_factor,
                 settings.return_fraction)
             if not ok:
-                reasons.append(f"[{start}] {why}")
+                failed(start, why)
                 continue
             rec = GammaTrial(float(gamma), True, f"[{start}] converged, Yw ≺ 0 on the mesh, "
                              f"worst-case closed loop {why}", start, ctl.iterations["outer"],
                              max(ctl.iterations["inner"]), float(ew.max()), final,
-                             time.perf_counter() - t1)
+                             spent + time.perf_counter() - t1)
             return rec, ctl
         rec = GammaTrial(float(gamma), False, "; ".join(reasons) or "no start available",
-                         seconds=time.perf_counter() - t1)
+                         seconds=spent + time.perf_counter() - t1)
         return rec, None
 
     def record(rec, ctl):
+        new = len(history) >= n_replay
         history.append(rec)
-        if progress is not None:
-            progress(rec)
         if rec.accepted and (best["gamma"] is None or rec.gamma < best["gamma"]):
             best["gamma"], best["controller"] = rec.gamma, ctl
+        if new:
+            save(True)
+            if progress is not None:
+                progress(rec)
+
+    n_replay = len(replay)
 
     # upper end: the problem's gamma, doubled until accepted
     hi = max(float(cost.gamma), g_lin * (1 + 2 * settings.rtol))
@@ -340,6 +419,9 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
             hi = mid
         else:
             lo = mid
+    if replay or running is not None:
+        raise CheckpointError("(resume)", "it holds more trials than this search makes: "
+                              "start over (--restart)")
     ctl = best["controller"]
     ctl.problem["gamma_search"] = {"gamma_star": hi, "bracket": [lo, hi],
                                    "linear_limit": g_lin, "settings": settings.to_dict()}
@@ -348,6 +430,21 @@ def search_min_gamma(system, basis, cost: GameCost, mesh, initial_policy,
 
 
 _MAX_DOUBLINGS = 10
+
+
+def _controller_of(record, system, basis, cost_at):
+    """The controller of a record (``to_dict()``) on the search's own system and basis
+    (so that its u* is the same, bit for bit, as the one trained in this process)."""
+    from .controller import GameController
+    from .hji import IterationRecord
+
+    hist = [IterationRecord(**{**h, "weights": np.asarray(h["weights"], float)})
+            for h in record.get("history", [])]
+    return GameController(system, basis, np.asarray(record["weights"], float),
+                          cost_at(record["problem"]["cost"]["gamma"]),
+                          problem=record["problem"], history=hist,
+                          train_seconds=record["train_seconds"],
+                          iterations=record["iterations"])
 
 
 class _SaddleControl:
