@@ -37,9 +37,11 @@ __all__ = ["run_sweep", "execute", "SweepInterrupted", "results_table", "open_cl
 #: Dask settings of the LocalCluster that :func:`open_client` starts. Each worker runs one
 #: CPU-bound run at a time on its own core, and each of Dask's periodic callbacks wakes a
 #: thread that takes the GIL from that run; the scheduler and the nannies live in this
-#: process, which shares the same cores. Measured on case-1 runs (benchmarks/bench_sweep.py,
-#: 1 worker): with Dask's defaults the worker's other threads took 6 % of the CPU time of its
-#: runs and this process 2.7 % of a core; with these, 0.5 % and 0.5 %.
+#: process, which shares the same cores. Measured on case-1 runs of ≈ 1 s (2026-11-26, on the
+#: shared 2-core machine): with Dask's defaults the workers' other threads took 6 % (1 worker)
+#: to 9-10 % (2 workers, benchmarks/bench_sweep.py) of the CPU time of their runs and this
+#: process 2.7-2.9 % of a core; with these, 0.5 % and 1.3-1.5 % (of which ≈ 4 ms of CPU per
+#: task, in the worker and in this process alike), and 0.5-1 % of a core.
 LOCAL_CLUSTER_CONFIG = {
     # one run per worker: with the default 1.1, a worker of one thread holds a second run
     # in its queue, which can end a sweep with that worker busy and the other idle
