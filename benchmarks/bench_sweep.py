@@ -32,19 +32,34 @@ measured too, each of them independent of the ratio:
   its last run to the end of the last run on any worker (the tail, where one worker idles
   while the other finishes); and the sweep's time outside the task stream (submission,
   collecting the results, the table);
-* the pickled size of one task (function and input);
+* the pickled size of one task (function and input), and Dask's cost of one task (submit,
+  run, result, cache write: 200 no-op runs through the same engine on the same cluster);
 * the peer of the Dask sweep: the same runs in a plain pool of 2 processes
   (``concurrent.futures``, no Dask, no cache, warm) — its runs' CPU time against the serial
   runs' is the cost of running two simulations at once on this machine (shared caches and
-  memory), which no engine removes.
+  memory), which no engine removes;
+* CPU accounting: the core-seconds of the serial loop against those of the parallel sweep
+  (the runs, Dask's threads, this process, the workers' idle time from the task stream):
+  the ratio they project on 2 otherwise idle cores (time waiting for a core not counted).
 
-Measured 2026-11-26 on the shared machine (load ≈ 3.5-4.5 from other sessions, so the
-ratios are low and noisy), before → after this benchmark's engine changes (see
-``weakgrid.sweep.engine.LOCAL_CLUSTER_CONFIG`` and ``run_sweep(cost=...)``): the workers'
-Dask threads took 6 % of the CPU time of the runs → 0.5 %, this process 2.7 % of a core →
-0.5 % (a 1-worker cluster running 4 runs, measured as above); the tail (last run's end on one
-worker to the last on the other) 1.9 s of a 23-s sweep → see the printed numbers (each worker
-now holds one run at a time and the costliest start first).
+Measured 2026-11-26 on the shared machine (other sessions' load 2-5 on the 2 cores, so the
+ratios themselves are noisy: 0.75x-1.72x), the engine before (``--dask-defaults``) → after
+(``weakgrid.sweep.engine.LOCAL_CLUSTER_CONFIG``, ``run_sweep(cost=...)``), warm:
+
+* the workers' Dask threads: 5.4-9.7 % of the runs' CPU time → 1.0-1.5 % (the statistical
+  profiler, 20-ms event-loop ticks, the 0.1-s memory and 0.5-s system monitors);
+* this process (scheduler, nannies, client, cache): 2.9-4.3 % of a core → 0.9-1.1 %;
+* the tail: up to 1.9 s of a 23-s sweep with a worker holding two runs → a worker holds one
+  run at a time, the costliest first (0-0.3 s when the machine was quiet; under load a run's
+  wall time varies and so does the tail); the gaps between runs: 1-2 ms → 2-10 ms each (a
+  scheduler round trip per run now);
+* the runs' CPU time on the workers: x1.06-1.12 the serial runs' → x1.05-1.09, the same as in
+  the plain pool measured beside it (x0.99-1.10): what is left is two simulations at once on
+  this machine, not Dask;
+* Dask's cost per task: 1.5-2.3 ms of a worker's CPU and 2.5-3.4 ms of this process's (with
+  the cache write), against ≈ 1 s runs: no batching needed;
+* CPU accounting: 1.75x → 1.83x warm, 1.61x → 1.95x cold. The one
+  warm ratio measured while the machine was quiet, before: 1.72x (plain pool 1.96x).
 
 Run:  PYTHONPATH=src python benchmarks/bench_sweep.py [n_ratings] [--dask-defaults]
 
@@ -158,6 +173,23 @@ def components(client, pts, cache_dir, cost):
             "task_bytes": task}
 
 
+def _noop(inputs):
+    return {"i": inputs["i"]}
+
+
+def per_task(client, cache_dir, n=200):
+    """Dask's (and the cache's) cost of one task: ``n`` no-op runs through :func:`run_sweep`
+    on ``client``. Returns (wall, CPU of the workers, CPU of this process) per task [s]."""
+    from weakgrid.sweep import Point
+
+    pts = [Point({"i": i}, {"i": i}) for i in range(n)]
+    wpids = list(client.run(os.getpid).values())
+    w0, m0, t0 = _cpu_of(wpids), time.process_time(), time.perf_counter()
+    run_sweep(pts, _noop, cache_dir=cache_dir, client=client, progress=False)
+    return ((time.perf_counter() - t0) / n, (_cpu_of(wpids) - w0) / n,
+            (time.process_time() - m0) / n)
+
+
 def _serial(pts, cache_dir):
     m0, t0 = time.process_time(), time.perf_counter()
     table = run_sweep(pts, run_point, cache_dir=cache_dir, workers=0, progress=False)
@@ -205,13 +237,18 @@ def _report(label, ser, par):
           f"(scheduler, nannies, client, cache): {par['main_cpu']:.2f} s "
           f"({par['main_cpu'] / par['t']:.1%} of a core; serial loop outside the runs: "
           f"{ser['main_cpu'] - s_cpu:.2f} s)")
+    idle = sum(w["gaps"] + w["tail"] + w["lead"] for w in par["per_worker"])
+    core_s = p_cpu + (par["workers_cpu"] - p_cpu) + par["main_cpu"] + idle
+    print(f"  CPU accounting: the serial loop used {ser['main_cpu']:.2f} core-s, the sweep on 2 "
+          f"workers {core_s:.2f} (runs, Dask threads, this process, idle workers {idle:.2f}) "
+          f"-> {2 * ser['main_cpu'] / core_s:.2f}x on 2 otherwise idle cores (a projection: "
+          f"waiting for a core not counted, idle time as measured now)")
     for w in par["per_worker"]:
         print(f"  {w['worker']}: {w['runs']} runs, busy {w['busy']:.2f} s, gaps between runs "
               f"{w['gaps']:.3f} s (max {w['gap_max'] * 1e3:.0f} ms), first run after "
               f"{w['lead']:.2f} s, idle at the end {w['tail']:.2f} s")
     print(f"  sweep {par['t']:.2f} s: before the first run {par['lead']:.2f} s, after the last "
-          f"{par['end']:.2f} s; one task pickled {par['task_bytes'] / 1024:.1f} KiB; "
-          f"{n} runs, 2 client-scheduler messages each (submit, result)")
+          f"{par['end']:.2f} s; one task pickled {par['task_bytes'] / 1024:.1f} KiB")
 
 
 def main(n_ratings=8, dask_defaults=False):
@@ -236,6 +273,7 @@ def main(n_ratings=8, dask_defaults=False):
             t_cold = time.perf_counter() - t0
             client.run(_warm, warm)
             par = components(client, pts, f"{tmp}/par", cost)
+            task_wall, task_wcpu, task_mcpu = per_task(client, f"{tmp}/noop")
         t_pool, pool_cpu = plain_pool(pts, warm)
         serial_cold = _serial(pts, f"{tmp}/serial-cold")
         _warm(warm)
@@ -255,6 +293,9 @@ def main(n_ratings=8, dask_defaults=False):
           f"{sum(pool_cpu):.2f} s (x{sum(pool_cpu) / s_cpu:.3f} the serial runs': two runs at "
           f"once on this machine); the warm Dask sweep reaches {t_pool / par['t']:.0%} of its "
           f"throughput")
+    print(f"Dask's cost of a task (200 no-op runs on the same cluster: submit, run, result, "
+          f"cache write): {task_wall * 1e3:.1f} ms wall, {task_wcpu * 1e3:.1f} ms of the "
+          f"workers' CPU, {task_mcpu * 1e3:.1f} ms of this process's CPU")
     _report("warm", serial, par)
     _report("cold", serial_cold, cold)
     avail = machine_parallelism()
