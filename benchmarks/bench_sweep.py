@@ -53,9 +53,10 @@ ratios themselves are noisy: 0.75x-1.72x), the engine before (``--dask-defaults`
   run at a time, the costliest first (0-0.3 s when the machine was quiet; under load a run's
   wall time varies and so does the tail); the gaps between runs: 1-2 ms → 2-10 ms each (a
   scheduler round trip per run now);
-* the runs' CPU time on the workers: x1.06-1.12 the serial runs' → x1.05-1.09, the same as in
-  the plain pool measured beside it (x0.99-1.10): what is left is two simulations at once on
-  this machine, not Dask;
+* the runs' CPU time on the workers against the serial runs': x1.06-1.12 (median x1.11 of 4
+  measurements) → x1.00-1.18 (median x1.05 of 8; the x1.18 at load 5), as in the plain pool
+  measured beside it (x0.99-1.10, median x1.06 of 6): what is left is two simulations at
+  once on this machine, not Dask (in a 1-worker cluster a run takes the serial CPU time);
 * Dask's cost per task: 1.5-2.3 ms of a worker's CPU and 2.5-3.4 ms of this process's (with
   the cache write), against ≈ 1 s runs: no batching needed;
 * CPU accounting: 1.75x → 1.83x warm, 1.61x → 1.95x cold. The one

@@ -40,8 +40,8 @@ __all__ = ["run_sweep", "execute", "SweepInterrupted", "results_table", "open_cl
 #: process, which shares the same cores. Measured on case-1 runs of ≈ 1 s (2026-11-26, on the
 #: shared 2-core machine): with Dask's defaults the workers' other threads took 6 % (1 worker)
 #: to 9-10 % (2 workers, benchmarks/bench_sweep.py) of the CPU time of their runs and this
-#: process 2.7-2.9 % of a core; with these, 0.5 % and 1.3-1.5 % (of which ≈ 4 ms of CPU per
-#: task, in the worker and in this process alike), and 0.5-1 % of a core.
+#: process 2.7-4.3 % of a core; with these, 0.5 % (1 worker) and 0.7-1.5 % (2 workers; ≈ 2 ms
+#: of a worker's CPU per task), and 0.5-1.3 % of a core.
 LOCAL_CLUSTER_CONFIG = {
     # one run per worker: with the default 1.1, a worker of one thread holds a second run
     # in its queue, which can end a sweep with that worker busy and the other idle
