@@ -39,7 +39,8 @@ measured too, each of them independent of the ratio:
   runs' is the cost of running two simulations at once on this machine (shared caches and
   memory), which no engine removes;
 * CPU accounting: the core-seconds of the serial loop against those of the parallel sweep
-  (the runs, Dask's threads, this process, the workers' idle time from the task stream):
+  (the runs, Dask's threads, this process, the workers' idle time from the task stream;
+  cold: the cluster's start on both cores):
   the ratio they project on 2 otherwise idle cores (time waiting for a core not counted).
 
 Measured 2026-11-26 on the shared machine (other sessions' load 2-5 on the 2 cores, so the
@@ -59,7 +60,8 @@ ratios themselves are noisy: 0.75x-1.72x), the engine before (``--dask-defaults`
   once on this machine, not Dask (in a 1-worker cluster a run takes the serial CPU time);
 * Dask's cost per task: 1.5-2.3 ms of a worker's CPU and 2.5-3.4 ms of this process's (with
   the cache write), against ≈ 1 s runs: no batching needed;
-* CPU accounting: 1.75x → 1.83x warm, 1.61x → 1.95x cold. The one
+* CPU accounting: 1.75x → 1.83x warm, 1.61x → 1.95x cold (those cold figures without the
+  cluster's start, 1.1-2.8 s, which now counts on both cores). The one
   warm ratio measured while the machine was quiet, before: 1.72x (plain pool 1.96x).
 
 Run:  PYTHONPATH=src python benchmarks/bench_sweep.py [n_ratings] [--dask-defaults]
@@ -223,7 +225,7 @@ def plain_pool(pts, warm):
         return time.perf_counter() - t0, cpu
 
 
-def _report(label, ser, par):
+def _report(label, ser, par, start=0.0):
     n = len(ser["table"])
     s_cpu, p_cpu = sum(ser["runs_cpu"]), sum(par["runs_cpu"])
     s_wall, p_wall = ser["table"]["wall_s"].sum(), par["table"]["wall_s"].sum()
@@ -239,9 +241,10 @@ def _report(label, ser, par):
           f"({par['main_cpu'] / par['t']:.1%} of a core; serial loop outside the runs: "
           f"{ser['main_cpu'] - s_cpu:.2f} s)")
     idle = sum(w["gaps"] + w["tail"] + w["lead"] for w in par["per_worker"])
-    core_s = p_cpu + (par["workers_cpu"] - p_cpu) + par["main_cpu"] + idle
+    core_s = p_cpu + (par["workers_cpu"] - p_cpu) + par["main_cpu"] + idle + 2 * start
     print(f"  CPU accounting: the serial loop used {ser['main_cpu']:.2f} core-s, the sweep on 2 "
-          f"workers {core_s:.2f} (runs, Dask threads, this process, idle workers {idle:.2f}) "
+          f"workers {core_s:.2f} (runs, Dask threads, this process, idle workers {idle:.2f}"
+          + (f", the cluster's start on both cores {2 * start:.2f}" if start else "") + ") "
           f"-> {2 * ser['main_cpu'] / core_s:.2f}x on 2 otherwise idle cores (a projection: "
           f"waiting for a core not counted, idle time as measured now)")
     for w in par["per_worker"]:
@@ -298,7 +301,7 @@ def main(n_ratings=8, dask_defaults=False):
           f"cache write): {task_wall * 1e3:.1f} ms wall, {task_wcpu * 1e3:.1f} ms of the "
           f"workers' CPU, {task_mcpu * 1e3:.1f} ms of this process's CPU")
     _report("warm", serial, par)
-    _report("cold", serial_cold, cold)
+    _report("cold", serial_cold, cold, start=t_up)
     avail = machine_parallelism()
     print(f"the machine's parallel speed-up for 2 processes right now (a CPU loop): {avail:.2f}x"
           f" -> the warm sweep reaches {serial['t'] / par['t'] / avail:.0%} of what the machine "
