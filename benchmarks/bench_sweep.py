@@ -47,22 +47,23 @@ Measured 2026-11-26 on the shared machine (other sessions' load 2-5 on the 2 cor
 ratios themselves are noisy: 0.75x-1.72x), the engine before (``--dask-defaults``) → after
 (``weakgrid.sweep.engine.LOCAL_CLUSTER_CONFIG``, ``run_sweep(cost=...)``), warm:
 
-* the workers' Dask threads: 5.4-9.7 % of the runs' CPU time → 1.0-1.5 % (the statistical
+* the workers' Dask threads: 5.4-9.7 % of the runs' CPU time → 0.7-1.5 % (the statistical
   profiler, 20-ms event-loop ticks, the 0.1-s memory and 0.5-s system monitors);
-* this process (scheduler, nannies, client, cache): 2.9-4.3 % of a core → 0.9-1.1 %;
+* this process (scheduler, nannies, client, cache): 2.9-4.3 % of a core → 0.9-1.3 %;
 * the tail: up to 1.9 s of a 23-s sweep with a worker holding two runs → a worker holds one
-  run at a time, the costliest first (0-0.3 s when the machine was quiet; under load a run's
-  wall time varies and so does the tail); the gaps between runs: 1-2 ms → 2-10 ms each (a
+  run at a time, the costliest first (0-0.6 s in 8 sweeps, 1.5 s once at load 3: under load
+  a run's wall time varies and so does the tail); the gaps between runs: 1-2 ms → 2-10 ms each (a
   scheduler round trip per run now);
 * the runs' CPU time on the workers against the serial runs': x1.06-1.12 (median x1.11 of 4
-  measurements) → x1.00-1.18 (median x1.05 of 8; the x1.18 at load 5), as in the plain pool
-  measured beside it (x0.99-1.10, median x1.06 of 6): what is left is two simulations at
+  measurements) → x1.00-1.18 (median x1.06 of 10; the x1.18 at load 5), as in the plain pool
+  measured beside it (x0.99-1.15, median x1.07 of 7): what is left is two simulations at
   once on this machine, not Dask (in a 1-worker cluster a run takes the serial CPU time);
 * Dask's cost per task: 1.5-2.3 ms of a worker's CPU and 2.5-3.4 ms of this process's (with
   the cache write), against ≈ 1 s runs: no batching needed;
-* CPU accounting: 1.75x → 1.83x warm, 1.61x → 1.95x cold (those cold figures without the
-  cluster's start, 1.1-2.8 s, which now counts on both cores). The one
-  warm ratio measured while the machine was quiet, before: 1.72x (plain pool 1.96x).
+* CPU accounting: 1.75x → 1.81-1.83x warm; cold 1.61x → 1.95x without the cluster's start,
+  1.60x with it (it now counts on both cores: 1.1-3.1 s; a 24-run sweep does not amortize
+  it). The one warm ratio measured while the machine was quiet, before: 1.72x (plain pool
+  1.96x); after: none (another session's load came back during each run).
 
 Run:  PYTHONPATH=src python benchmarks/bench_sweep.py [n_ratings] [--dask-defaults]
 
