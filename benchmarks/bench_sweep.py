@@ -73,6 +73,7 @@ order (the engine before the changes above), for a comparison on the same machin
 
 from __future__ import annotations
 
+import itertools
 import os
 import statistics
 import sys
@@ -148,7 +149,7 @@ def _stream(tasks, t_start, t_end):
     out = []
     for w, v in sorted(by.items()):
         v.sort()
-        gaps = [b[0] - a[1] for a, b in zip(v, v[1:])]
+        gaps = [b[0] - a[1] for a, b in itertools.pairwise(v)]
         out.append({"worker": w, "runs": len(v), "busy": sum(e - s for s, e in v),
                     "gaps": sum(gaps), "gap_max": max(gaps, default=0.0),
                     "lead": v[0][0] - t_start, "tail": last - v[-1][1]})
@@ -227,7 +228,6 @@ def plain_pool(pts, warm):
 
 
 def _report(label, ser, par, start=0.0):
-    n = len(ser["table"])
     s_cpu, p_cpu = sum(ser["runs_cpu"]), sum(par["runs_cpu"])
     s_wall, p_wall = ser["table"]["wall_s"].sum(), par["table"]["wall_s"].sum()
     ratio = [p / s for p, s in zip(par["runs_cpu"], ser["runs_cpu"])]
@@ -259,7 +259,7 @@ def _report(label, ser, par, start=0.0):
 def main(n_ratings=8, dask_defaults=False):
     cost = run_cost
     if dask_defaults:
-        import weakgrid.sweep.engine as engine
+        from weakgrid.sweep import engine
 
         engine.LOCAL_CLUSTER_CONFIG = {}
         cost = None
