@@ -92,6 +92,29 @@ def test_sweep_points_of_a_shipped_study():
     assert len(quick) < len(pts) and all(q.params["dt_factor"] == 1.0 for q in quick)
 
 
+def test_run_cost_ranks_longer_runs_first():
+    """The cost that orders a sweep's runs grows with the simulated time, the fault's duration
+    and a halved step (twice the steps), and not with what does not change the work."""
+    from weakgrid.study.sweep_estimate import run_cost
+
+    st = load_study("case1-weak-grid")
+    pts = sweep_points(st)
+    base = next(p for p in pts if p.params["dt_factor"] == 1.0)
+    half = next(p for p in pts if p.params["dt_factor"] == 0.5)
+    c = run_cost(base.inputs)
+    assert run_cost(half.inputs) == pytest.approx(2 * run_cost(dict(half.inputs, dt_factor=1.0)),
+                                                  rel=1e-3)
+    assert run_cost(dict(base.inputs, t_end=2 * base.inputs["t_end"])) > c
+    by_fault = {}
+    for p in pts:
+        if p.params["dt_factor"] == 1.0:
+            by_fault.setdefault(p.params["scenarios.c1-high-conv.events.0.t_off"], set()).add(
+                run_cost(p.inputs))
+    assert all(len(v) == 1 for v in by_fault.values())   # the rating, the load: same cost
+    costs = [by_fault[t].pop() for t in sorted(by_fault)]
+    assert costs == sorted(costs) and costs[0] < costs[-1]
+
+
 @pytest.mark.parametrize("path, word", [("upqc.ratin", "ratin"),
                                         ("scenarios.nope.load", "nope")])
 def test_bad_sweep_axis_names_the_field(path, word):

@@ -116,6 +116,56 @@ def test_local_cluster_and_scheduler_address_give_the_default_table(tmp_path):
         pd.testing.assert_frame_equal(_tab(t), _tab(serial))
 
 
+def stamped_run(inputs):
+    """A run that says when it started (one worker: runs start in the order it takes them)."""
+    t = time.perf_counter()
+    time.sleep(0.05)
+    return {"started": t, "cpu_busy": sum(i * i for i in range(200_000))}
+
+
+def test_costliest_runs_start_first_on_a_cluster(tmp_path):
+    from weakgrid.sweep import open_client
+
+    ratings = [0.3, 0.1, 0.5, 0.2, 0.4, 0.05]
+    pts = expand(BASE, {"upqc.rating": ratings})
+    with open_client(None, 1) as client:
+        t = run_sweep(pts, stamped_run, cache_dir=tmp_path / "c", client=client,
+                      progress=False, cost=lambda inp: inp["upqc"]["rating"])
+    assert list(t["upqc.rating"]) == ratings       # the table keeps the sweep's order
+    started = t.sort_values("started")["upqc.rating"].tolist()
+    assert started == sorted(ratings, reverse=True)
+
+
+def test_local_cluster_workers_take_one_run_at_a_time_without_the_profiler(tmp_path):
+    """Dask's settings for CPU-bound runs reach the scheduler and the worker processes."""
+    import dask
+
+    from weakgrid.sweep import open_client
+
+    def worker_config():
+        return [dask.config.get("distributed.worker.profile.enabled"),
+                dask.config.get("distributed.admin.tick.interval")]
+
+    with open_client(None, 2) as client:
+        assert client.run_on_scheduler(lambda dask_scheduler: dask_scheduler.WORKER_SATURATION) \
+            == 1.0
+        assert list(client.run(worker_config).values()) == [[False, "1s"]] * 2
+        # the worker's other threads: the event loop and its periodic callbacks only
+        assert all(client.run(lambda dask_worker: "profile" not in
+                              dask_worker.periodic_callbacks).values())
+    assert dask.config.get("distributed.worker.profile.enabled") is True  # not left set here
+
+
+def test_record_keeps_the_cpu_time_of_the_run(tmp_path):
+    from weakgrid.sweep import ResultCache
+
+    pts = expand(BASE, {"upqc.rating": [0.1]})
+    t = run_sweep(pts, stamped_run, cache_dir=tmp_path / "c", workers=0, progress=False)
+    rec = ResultCache(tmp_path / "c").get(t["key"][0])
+    assert 0 < rec["cpu_s"] < rec["wall_s"]        # the sleep counts in the wall time only
+    assert rec["wall_s"] >= 0.05
+
+
 SCRIPT = textwrap.dedent('''
     import sys, time, os
     from weakgrid.sweep import expand, run_sweep, SweepInterrupted

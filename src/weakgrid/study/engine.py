@@ -35,7 +35,7 @@ from .report import write_html, write_tables
 from ..sweep import open_client, run_sweep
 from .runner import Run, RunRecord, run_scenario
 from .sweep import run_point, sweep_points
-from .sweep_estimate import estimate_sweep
+from .sweep_estimate import estimate_sweep, run_cost
 from .sweep_maps import draw_maps, map_summaries
 
 __all__ = ["run_studies", "mode_check", "MODE_TOLERANCE"]
@@ -261,7 +261,7 @@ def run_studies(studies, output, quick=False, log=print, title=None, progress=Tr
                                workers, scheduler=scheduler, points=pts).line("maps"))
             sweep_table = run_sweep(pts, run_point, cache_dir=out / "sweep-cache",
                                     workers=0 if serial else None, client=client,
-                                    progress=progress, log=log,
+                                    progress=progress, log=log, cost=run_cost,
                                     table_path=out / f"sweep{'-quick' if quick else ''}.parquet",
                                     desc="maps")
     map_list = []

@@ -251,10 +251,12 @@ def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
     The cache (``<output>/cache`` unless given) keeps every finished run: an interrupted
     sweep resumes, a repeated one runs nothing.
     """
+    from .sweep_estimate import run_cost
+
     out = Path(output)
     out.mkdir(parents=True, exist_ok=True)
     pts = sweep_points(study, quick)
     return run_sweep(pts, run_point, cache_dir=cache_dir or out / "cache", scheduler=scheduler,
-                     workers=workers, progress=progress, log=log,
+                     workers=workers, progress=progress, log=log, cost=run_cost,
                      table_path=out / f"{study.name}-sweep{'-quick' if quick else ''}.parquet",
                      desc=f"sweep {study.name}")

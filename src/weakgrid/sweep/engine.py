@@ -2,7 +2,12 @@
 
 Every point is one task. Tasks run on a :class:`distributed.LocalCluster` (one
 single-threaded worker process per core by default) or on an existing cluster
-given by its scheduler address. A finished run is written to the cache as soon
+given by its scheduler address. Given an estimate of each run's cost, the
+costliest runs start first (a long run started last keeps one worker busy while
+the others idle); a LocalCluster holds one run per worker at a time (the next
+waits on the scheduler, not behind a running one) and keeps Dask's own
+monitoring, which shares the workers' cores, to a minimum
+(:data:`LOCAL_CLUSTER_CONFIG`). A finished run is written to the cache as soon
 as it arrives, so an interrupted sweep (Ctrl-C, SIGTERM) loses nothing and a
 repeated one runs nothing. A run that raises is a row with ``status = "failed"``
 and its cause, never the end of the sweep.
@@ -26,7 +31,32 @@ from ..fileio import replace_atomic
 from ..game.errors import ParameterError, WeakgridError
 from .cache import ResultCache, run_key
 
-__all__ = ["run_sweep", "execute", "SweepInterrupted", "results_table", "open_client"]
+__all__ = ["run_sweep", "execute", "SweepInterrupted", "results_table", "open_client",
+           "LOCAL_CLUSTER_CONFIG"]
+
+#: Dask settings of the LocalCluster that :func:`open_client` starts. Each worker runs one
+#: CPU-bound run at a time on its own core, and each of Dask's periodic callbacks wakes a
+#: thread that takes the GIL from that run; the scheduler and the nannies live in this
+#: process, which shares the same cores. Measured on case-1 runs of ≈ 1 s (2026-11-26, on the
+#: shared 2-core machine): with Dask's defaults the workers' other threads took 6 % (1 worker)
+#: to 9-10 % (2 workers, benchmarks/bench_sweep.py) of the CPU time of their runs and this
+#: process 2.7-4.3 % of a core; with these, 0.5 % (1 worker) and 0.7-1.5 % (2 workers; ≈ 2 ms
+#: of a worker's CPU per task), and 0.5-1.3 % of a core.
+LOCAL_CLUSTER_CONFIG = {
+    # one run per worker: with the default 1.1, a worker of one thread holds a second run
+    # in its queue, which can end a sweep with that worker busy and the other idle
+    "distributed.scheduler.worker-saturation": 1.0,
+    # the statistical profiler samples the running task every 10 ms, for the dashboard
+    # (which is off): ≈ 3 % of the worker's CPU
+    "distributed.worker.profile.enabled": False,
+    # the event loops' latency check (a log line beyond 3 s), default every 20 ms in the
+    # scheduler, each nanny and each worker
+    "distributed.admin.tick.interval": "1s",
+    # CPU/memory/network series for the dashboard (default 0.5 s)
+    "distributed.admin.system-monitor.interval": "2s",
+    # the memory limits (pause, spill, restart) checked every 0.5 s, not 0.1 s
+    "distributed.worker.memory.monitor-interval": "500ms",
+}
 
 
 class SweepInterrupted(WeakgridError, KeyboardInterrupt):
@@ -51,8 +81,10 @@ def execute(run, inputs: dict, key: str) -> dict:
     ``run(inputs)`` returns a dict of metrics, or ``(metrics, signals)`` with signals a
     DataFrame. Metrics may carry ``status`` ("ok"/"failed") and ``failure`` (its cause)
     when the run failed without raising (e.g. a simulation that lost synchronism).
+    The record keeps the run's wall time ``wall_s`` and the CPU time of the thread that ran
+    it, ``cpu_s`` [s] (``wall_s`` above ``cpu_s``: the run waited for a core).
     """
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.thread_time()
     signals = None
     try:
         out = run(inputs)
@@ -68,9 +100,9 @@ def execute(run, inputs: dict, key: str) -> dict:
         kind = type(exc).__name__
         tb = traceback.format_exc(limit=-3)
         metrics["traceback_tail"] = tb[-2000:]
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.thread_time() - c0
     rec = {"key": key, "status": status, "failure": failure, "failure_kind": kind,
-           "wall_s": wall, "metrics": metrics, "weakgrid_version": __version__}
+           "wall_s": wall, "cpu_s": cpu, "metrics": metrics, "weakgrid_version": __version__}
     return {"record": rec, "signals": signals}
 
 
@@ -102,8 +134,9 @@ def _sigterm_as_interrupt():
 def open_client(scheduler=None, workers=None):
     """A ``distributed.Client`` for the block: of the cluster at ``scheduler``
     (``tcp://host:port``), else of a new LocalCluster with ``workers`` single-threaded
-    worker processes (default: one per core), closed at the end. One cluster can serve
-    several sweeps (pass the client to :func:`run_sweep`)."""
+    worker processes (default: one per core) and :data:`LOCAL_CLUSTER_CONFIG`, closed at
+    the end. One cluster can serve several sweeps (pass the client to :func:`run_sweep`)."""
+    import dask
     from distributed import Client, LocalCluster
 
     if scheduler:
@@ -117,8 +150,9 @@ def open_client(scheduler=None, workers=None):
     # the workers' own logs stay quiet: a run's failure is a row of the table, and an interrupt
     # (SIGINT/SIGTERM) must not print the workers' shutdown tracebacks (heartbeats to a closing
     # scheduler); a lost worker still reaches the client as an exception
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.CRITICAL)
+    with dask.config.set(LOCAL_CLUSTER_CONFIG):  # the workers get this config at their start
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.CRITICAL)
     client = Client(cluster)
     try:
         yield client
@@ -158,9 +192,22 @@ def results_table(points, records) -> pd.DataFrame:
     return df
 
 
+def _priorities(todo, cost):
+    """Dask priorities (higher runs first): by decreasing ``cost``, ties in the given order."""
+    n = len(todo)
+    if cost is None:
+        return [n - i for i in range(n)]
+    est = [float(cost(p.inputs)) for p, _ in todo]
+    order = sorted(range(n), key=lambda i: -est[i] if math.isfinite(est[i]) else 0.0)
+    prio = [0] * n
+    for rank, i in enumerate(order):
+        prio[i] = n - rank
+    return prio
+
+
 def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
               workers: int | None = None, progress: bool = True, table_path=None,
-              desc: str = "sweep", log=None, client=None) -> pd.DataFrame:
+              desc: str = "sweep", log=None, client=None, cost=None) -> pd.DataFrame:
     """Run every point (skipping those already cached) and return the result table.
 
     Parameters
@@ -186,6 +233,10 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
         Receives one-line messages (start, interruption).
     client : distributed.Client, optional
         An open client to run on (the caller's cluster; ``scheduler``/``workers`` ignored).
+    cost : callable, optional
+        ``cost(inputs) -> float``, an estimate of a run's cost (any unit): on a cluster the
+        costliest runs start first, so that the sweep does not end with one worker on a long
+        run and the others idle. Default: the points' order.
 
     Returns
     -------
@@ -230,8 +281,13 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
                 ctx = contextlib.nullcontext(client) if client is not None else \
                     open_client(scheduler, workers)
                 with ctx as cl:
+                    # submitted costliest first, each with its priority (Dask starts a
+                    # task at once on an idle worker, and runs a queue by priority)
+                    prio = _priorities(todo_unique, cost)
                     futs = [cl.submit(execute, run, p.inputs, k, key=f"weakgrid-run-{k}",
-                                          pure=False) for p, k in todo_unique]
+                                      pure=False, priority=pr)
+                            for pr, (p, k) in sorted(zip(prio, todo_unique),
+                                                     key=lambda x: -x[0])]
                     try:
                         for fut in as_completed(futs):
                             res = fut.result()
