@@ -6,7 +6,8 @@ Before machine currents accumulated on shared buses, the network residual at t =
 case without its IEEEX1 exciters (the .dyr records of IEEEX1 removed): GENROU + GENCLS +
 TGOV1. With them, a fault at shared bus 23 drives nine IEEEX1 regulators to their
 ceiling VRMAX*Vt, which follows the collapsed terminal voltage in weakgrid (IEEE 421.5)
-and stays at its initial value in ANDES 2.0: 1.15e-4 pu and 0.78 deg apart at 1/120 s.
+while ANDES 2.0's IEEEX1 applies the constant VRMAX: 1.15e-4 pu and 0.78 deg apart at
+1/120 s (``from_andes(..., conventions="andes")`` reproduces ANDES's IEEEX1).
 The full case (IEEEX1 included) matches ANDES within 5.5e-6 pu with the census fault
 at a load bus (benchmarks/andes_case_census.json).
 """

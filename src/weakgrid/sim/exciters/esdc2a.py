@@ -19,8 +19,9 @@ here the sensed voltage passes through ``TR`` as in the standard. They agree
 for ``TR = 0``. The flag ``TR_used = 0`` reproduces ANDES (the lag state stays, its
 output unused); the ANDES importer sets it with ``from_andes(..., conventions="andes")``.
 Effect on ANDES's ``kundur_esdc2a`` (census fault): 9.5e-5 pu of speed with the
-standard, XXX pu with ``TR_used = 0``. ANDES's ceiling ``VRMAX*Vt`` does follow ``Vt``
-(a ``VarService`` re-evaluated at every Newton iteration), as here.
+standard, 1.4e-5 pu with ``TR_used = 0``. ANDES's ceiling ``VRMAX*Vt`` does follow ``Vt``
+(a ``VarService`` re-evaluated at every Newton iteration; in that case its regulators sit
+on ``7.3*Vt`` during the fault), as here.
 """
 
 from __future__ import annotations
