@@ -58,6 +58,7 @@ ANDES_CONVENTIONS = {
     "EXAC1": {"TR_used": 0.0},    # the summing junction takes the unfiltered voltage (TR unused)
     "ESDC2A": {"TR_used": 0.0},   # idem
     "IEEEX1": {"VR_Vt": 0.0},     # regulator limits VRMAX, VRMIN, not times Vt
+    "EXST1": {"VR_limited": 0.0},  # output limit tested on the rate feedback (in effect never acts)
 }
 CONVENTIONS = ("standard", "andes")
 
