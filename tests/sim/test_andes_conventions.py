@@ -8,7 +8,9 @@ that a peer comparison isolates real differences:
 * EXAC1, ESDC2A: ``TR_used = 0`` -- ANDES's summing junction takes the unfiltered bus voltage
   (its sensing lag is computed but unused);
 * IEEEX1: ``VR_Vt = 0`` -- ANDES's anti-windup limiter keeps the constant bounds ``VRMAX``,
-  ``VRMIN`` (not ``VRMAX*Vt``).
+  ``VRMIN`` (not ``VRMAX*Vt``);
+* EXST1: ``VR_limited = 0`` -- ANDES tests its output limits on the rate-feedback signal, so
+  the regulator output passes unlimited (and feeds the rate feedback).
 
 The census inputs these departures made mismatch (ANDES's census fault: three-phase at the
 bus of the first load, 1.0-1.05 s; 5 s at 1/120 s in both tools), measured 2026-11-26:
@@ -35,6 +37,8 @@ import numpy as np
 import pytest
 
 andes = pytest.importorskip("andes")
+
+from kundur_variants import kundur_variant  # noqa: E402
 
 from weakgrid.sim.errors import DataError  # noqa: E402
 from weakgrid.sim.exciters.exac1 import EXAC1  # noqa: E402
@@ -73,7 +77,7 @@ def test_flags_accept_only_0_or_1():
     assert validate("EXAC1 'x'", EXAC1.params, {"TR_used": 0})["TR_used"] == 0
     with pytest.raises(DataError, match="TR_used"):
         validate("EXAC1 'x'", EXAC1.params, {"TR_used": 0.5})
-    assert set(ANDES_CONVENTIONS) == {"EXAC1", "ESDC2A", "IEEEX1"}
+    assert set(ANDES_CONVENTIONS) == {"EXAC1", "ESDC2A", "IEEEX1", "EXST1"}
 
 
 CENSUS = {
@@ -124,3 +128,33 @@ def test_held_regulator_released_when_the_fault_clears():
     assert vr[k0] == pytest.approx(ceiling_before, abs=1e-6)   # held at the ceiling at clearing
     after = vr[k0:k0 + 6]
     assert np.all(np.diff(after) < 0), f"VR after clearing: {after}"
+
+
+@pytest.mark.slow
+def test_exst1_output_ceiling_as_andes(tmp_path):
+    """Kundur with an EXST1 on machine 3 whose output ceiling ``VRMAX - KC*XadIfd`` (3.1 pu) is
+    reached during a 150-ms fault at bus 8. ANDES's regulator output passes it (up to 6.95 pu):
+    with the standard EXST1 the tools differ by 2.2e-3 pu / 10 deg; with ``VR_limited = 0``
+    by 2.5e-5 pu at 1/120 s and 5.3e-6 pu at 1/480 s (the kundur family's ANDES step error,
+    see ``test_andes_standard_cases.py::test_kundur_gap_is_andes_step_error``)."""
+    ex = dict(TR=0.02, VIMAX=0.2, VIMIN=0, TC=1, TB=1, KA=50, TA=0.05, VRMAX=3.5, VRMIN=-3, KC=0.2,
+              KF=0.1, TF=1)
+    path = kundur_variant(tmp_path / "exst1.xlsx", exciters={3: ("EXST1", ex)})
+    fault, tf = (8, 1.0, 1.15), 3.0
+    a = run_andes_ss(load_case(path, fault=fault), tf, H)
+    w_std = run_weakgrid_ss(load_case(path, fault=fault), tf, H)
+    w_anc = run_weakgrid_ss(load_case(path, fault=fault), tf, H, conventions="andes")
+    assert a["ok"] and w_std["ok"] and w_anc["ok"]
+    name = w_std["system"].components["EXST1"].names[0]
+    assert np.max(w_std["res"][f"{name}.vout"]) < 3.2 < np.max(w_anc["res"][f"{name}.vout"])  # ceiling reached
+    dw_s, dd_s = compare_named(a, w_std)
+    dw_a, dd_a = compare_named(a, w_anc)
+    print(f"EXST1 at its ceiling: standard {dw_s:.3g} pu / {dd_s:.3g} deg; ANDES conventions {dw_a:.3g} pu")
+    assert dw_s > 1e-3 and dd_s > 5
+    assert dw_a < 5e-5 and dd_a < ANGLE_TOL
+    h4 = H / 4
+    a4 = run_andes_ss(load_case(path, fault=fault), tf, h4)
+    w4 = run_weakgrid_ss(load_case(path, fault=fault), tf, h4, conventions="andes")
+    dw4, dd4 = compare_named(a4, w4)
+    print(f"... at 1/480 s: {dw4:.3g} pu / {dd4:.3g} deg")
+    assert dw4 < SPEED_TOL and dd4 < ANGLE_TOL
