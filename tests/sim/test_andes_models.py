@@ -16,9 +16,10 @@ Data notes (differences of ANDES 2.0 from the standard diagrams, documented in
 the model files): ANDES's EXAC1 and ESDC2A ignore the sensing lag ``TR`` (so
 ``TR = 0`` here); its EXST1 output ceiling never acts (so the EXST1 ceiling
 ``VRMAX - KC*XadIfd`` is kept out of reach; its input limiter ``VIMAX`` is
-driven); its IEEEX1 and ESDC2A ceilings ``VRMAX*Vt`` stay at their initial value
-instead of following ``Vt`` (so they are kept out of reach in the peer cases, and
-the moving ceiling is checked on its own in ``test_voltage_dependent_ceiling``).
+driven); its IEEEX1 limiter keeps the constant bounds ``VRMAX``, ``VRMIN`` instead of
+``VRMAX*Vt`` (so that ceiling is kept out of reach in the peer cases, and the moving
+ceiling is checked on its own in ``test_voltage_dependent_ceiling``; the importer's
+``conventions="andes"`` reproduces these departures, ``test_andes_conventions.py``).
 
 IEEET1 with its regulator limit active (KA = 60, VRMAX = 3, VRMIN = 0.5, 150-ms
 fault) differs from ANDES by 1.9e-4 pu of speed: ANDES integrates the regulator
@@ -29,7 +30,7 @@ without limits: nominal cases). Case A's limit case (ESST3A, EXST1, IEEEG1,
 IEESGO, TG2, TGOV1N at their limits) differed by 0.8-1.1e-4 pu, not shrinking with
 the step: switching its limits on one at a time, then its raised gains one at a
 time, isolated it to IEEEX1 alone (KA = 60: VR reached its moving ceiling VRMAX*Vt
-during the fault, which ANDES freezes at its initial value; 9.6e-5 pu at h, 1.1e-4
+during the fault, which ANDES keeps at the constant VRMAX; 9.6e-5 pu at h, 1.1e-4
 at h/2). With that ceiling out of reach, as in the other peer cases, case A's limit
 case is 1.3e-5 pu at h and 5.1e-6 pu at h/2 (ANDES's own change 9.9e-6 pu,
 weakgrid's 7.5e-6 pu).
@@ -63,7 +64,7 @@ def _case_a(limits):
                            XL=0.01, VGMAX=4, THETAP=0, TM=0.1, VMMAX=1, VMMIN=0.1)),
         2: ("EXST1", dict(TR=0.02, VIMAX=0.2 if not limits else 0.02, VIMIN=0 if not limits else -0.05,
                           TC=1, TB=1, KA=50 * k, TA=0.05, VRMAX=12, VRMIN=-3, KC=0.2, KF=0.1, TF=1)),
-        # IEEEX1's ceiling VRMAX*Vt is kept out of reach (ANDES freezes it at its initial value;
+        # IEEEX1's ceiling VRMAX*Vt is kept out of reach (ANDES applies the constant VRMAX;
         # the moving ceiling is checked in test_voltage_dependent_ceiling): with KA = 60 and
         # VRMAX = 50, VR reached 50*Vt during the fault and that alone made case A's limit gap
         3: ("IEEEX1", dict(TR=0.02, TA=0.02, TC=1, TB=1, TE=0.83, TF1=1.246, KF1=0.0754, KA=20 * k,

@@ -521,10 +521,7 @@ class Simulator:
                     self.frozen[new_lo] = -1
                     guess = z
                     continue
-                # release held states whose derivative points back inside
-                fl = f1[li]
-                rel = ((self.frozen > 0) & (fl < 0)) | ((self.frozen < 0) & (fl > 0))
-                self.frozen[rel] = 0
+                self._release_held(f1)
             # nonlinear correction to the predictor, extrapolated to the next step
             self._corr = z - self._pred if guess is None else None
             self._corr_h = h
@@ -536,6 +533,14 @@ class Simulator:
                 self.sys.accept(self.t, ctx)
             self.stats["steps"] += 1
             return h
+
+    def _release_held(self, f):
+        """Release held states whose derivative ``f`` (of the whole state vector) points back inside."""
+        li = self.sys.lim_idx
+        if len(li) and self.frozen.any():
+            fl = f[li]
+            rel = ((self.frozen > 0) & (fl < 0)) | ((self.frozen < 0) & (fl > 0))
+            self.frozen[rel] = 0
 
     # -------------------------------------------------------------------- run
     def _check(self):
@@ -662,6 +667,10 @@ class Simulator:
                             self._jump = self.z[self.nx:] - y_before
                             self._jump_t = self.t
                         self._f = F[:self.nx].copy()
+                        # a held state whose input fell inside its limit at the event (a fault
+                        # cleared: Vt and with it the drive of a regulator drop back) is released
+                        # now; held, it would follow a limit that moves with the event (VRMAX*Vt)
+                        self._release_held(self._f)
                         if sys._accepting:
                             sys.accept(self.t, self._ctx)
                         rec.add(self.t, self.z, self._ctx)

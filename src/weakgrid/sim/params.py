@@ -38,7 +38,8 @@ class Param:
     info : str
         One-line description.
     rule : str
-        ``"pos"`` (> 0), ``"nonneg"`` (>= 0), ``"nonzero"`` or ``""`` (any finite value).
+        ``"pos"`` (> 0), ``"nonneg"`` (>= 0), ``"nonzero"``, ``"flag"`` (0 or 1) or ``""`` (any
+        finite value).
     base : str
         ``""``, ``"z"``, ``"power"`` or ``"ipower"`` (see module docstring).
     """
@@ -55,6 +56,7 @@ _RULE_TEXT = {
     "pos": ("must be > 0", "give a positive value"),
     "nonneg": ("must be >= 0", "give a value >= 0 (0 bypasses the block where allowed)"),
     "nonzero": ("must be non-zero", "give a non-zero value"),
+    "flag": ("must be 0 or 1", "give 0 or 1"),
 }
 
 
@@ -92,7 +94,7 @@ def validate(element: str, params: tuple[Param, ...], values: dict) -> dict:
         if not math.isfinite(v):
             raise DataError(element, p.name, v, f"must be finite ({p.info}, {p.unit})")
         if p.rule:
-            ok = {"pos": v > 0, "nonneg": v >= 0, "nonzero": v != 0}[p.rule]
+            ok = {"pos": v > 0, "nonneg": v >= 0, "nonzero": v != 0, "flag": v in (0.0, 1.0)}[p.rule]
             if not ok:
                 what, fix = _RULE_TEXT[p.rule]
                 raise DataError(element, p.name, v, f"{p.info or p.name} [{p.unit}] {what}; {fix}")

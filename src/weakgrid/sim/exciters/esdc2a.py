@@ -3,7 +3,8 @@
 Block diagram (pu, times in s)::
 
     v --[Lag 1/(1+sTR)]--> LG
-    vi = vref - LG - WF + vs                             (vs: PSS output)
+    vsen = LG if TR_used else v                          (sensed voltage; TR_used = 0: ANDES 2.0)
+    vi = vref - vsen - WF + vs                           (vs: PSS output)
     vi --[LeadLag (1+sTC)/(1+sTB)]--> LL
     LL --[Lag KA/(1+sTA), non-windup VRMIN*Vt..VRMAX*Vt]--> VR   (ceiling scales with Vt)
     TE dEfd/dt = VR - (KE*Efd + Efd*SE(Efd))             (DC exciter, quadratic saturation)
@@ -15,11 +16,17 @@ absent, as in ANDES); ``Switch`` is accepted and unused (as in PSS/E).
 Difference from ANDES 2.0 (documented, not copied): ANDES feeds the unfiltered
 bus voltage to the summing junction (its ``TR`` lag is computed but unused);
 here the sensed voltage passes through ``TR`` as in the standard. They agree
-for ``TR = 0``. ANDES also keeps the ceiling at its initial value ``VRMAX*Vt0``
-instead of following ``Vt``.
+for ``TR = 0``. The flag ``TR_used = 0`` reproduces ANDES (the lag state stays, its
+output unused); the ANDES importer sets it with ``from_andes(..., conventions="andes")``.
+Effect on ANDES's ``kundur_esdc2a`` (census fault): 9.5e-5 pu of speed with the
+standard, 1.4e-5 pu with ``TR_used = 0``. ANDES's ceiling ``VRMAX*Vt`` does follow ``Vt``
+(a ``VarService`` re-evaluated at every Newton iteration; in that case its regulators sit
+on ``7.3*Vt`` during the fault), as here.
 """
 
 from __future__ import annotations
+
+import numpy as np
 
 from ..blocks import Lag, LagNonWindup, LeadLag, Washout
 from ..control_base import MachineControl
@@ -46,6 +53,8 @@ class ESDC2A(MachineControl):
         Param("KF", 0.1, "pu", "rate feedback gain", "nonneg"),
         Param("TF1", 1.0, "s", "rate feedback time constant", "pos"),
         Param("Switch", 0.0, "-", "unused (PSS/E)", ""),
+        Param("TR_used", 1.0, "-", "1: the sensed voltage passes through TR (IEEE 421.5); "
+              "0: the unfiltered voltage enters the summing junction (ANDES 2.0)", "flag"),
         Param("E1", 0.0, "pu", "first saturation point", "nonneg"),
         Param("SE1", 0.0, "pu", "saturation at E1", "nonneg"),
         Param("E2", 0.0, "pu", "second saturation point", "nonneg"),
@@ -63,6 +72,7 @@ class ESDC2A(MachineControl):
         self.LA = LagNonWindup(p["KA"], p["TA"], p["VRMIN"], self._vrmax)
         self.EX = DCExciter(p["KE"], p["TE"], p["E1"], p["SE1"], p["E2"], p["SE2"])
         self.WF = Washout(p["KF"], p["TF1"])
+        self._lagged = p["TR_used"] > 0
 
     def limits(self):
         v0 = self._vt0
@@ -91,7 +101,8 @@ class ESDC2A(MachineControl):
         lg, ll, vr, efd, wf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
         v = s["Vt"][..., m]
-        vi = self.vref0 - self.LG.output(lg, v) - self.WF.output(wf, efd) + s["vs"][..., m]
+        sensed = np.where(self._lagged, self.LG.output(lg, v), v)
+        vi = self.vref0 - sensed - self.WF.output(wf, efd) + s["vs"][..., m]
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LL.deriv(ll, vi)

@@ -3,7 +3,8 @@
 Block diagram (pu, times in s)::
 
     v --[Lag 1/(1+sTR)]--> LG
-    vi = vref - LG - WF + vs                              (vs: PSS output)
+    vsen = LG if TR_used else v                           (sensed voltage; TR_used = 0: ANDES 2.0)
+    vi = vref - vsen - WF + vs                            (vs: PSS output)
     vi --[LeadLag (1+sTC)/(1+sTB)]--> LL
     LL --[Lag KA/(1+sTA), non-windup VRMIN..VRMAX]--> VR
     VFE = KE*VE + VE*SE(VE) + KD*XadIfd                   (alternator demagnetization)
@@ -15,8 +16,12 @@ At initialization ``VE`` solves ``VE*FEX(KC*XadIfd/VE) = vf0`` (monotone in
 ``VE``; solved by bisection).
 
 Difference from ANDES 2.0 (documented, not copied): ANDES feeds the unfiltered
-bus voltage to the summing junction (its ``TR`` lag is unused); here the sensed
-voltage passes through ``TR`` as in the standard. They agree for ``TR = 0``.
+bus voltage to the summing junction (its ``TR`` lag is computed but unused); here the
+sensed voltage passes through ``TR`` as in the standard. They agree for ``TR = 0``.
+The flag ``TR_used = 0`` reproduces ANDES (the lag state stays, its output unused); the
+ANDES importer sets it with ``from_andes(..., conventions="andes")``. Effect on ANDES's
+``ieee14_exac1`` (census fault): 2.0e-5 pu of speed / 0.15 deg with the standard,
+1.2e-5 pu / 0.034 deg with ``TR_used = 0`` (the gap of ANDES's ieee14 base case).
 """
 
 from __future__ import annotations
@@ -55,6 +60,8 @@ class EXAC1(MachineControl):
         Param("KC", 0.1, "pu", "rectifier loading factor", "nonneg"),
         Param("KD", 0.0, "pu", "demagnetizing factor", "nonneg"),
         Param("KE", 1.0, "pu", "exciter constant", ""),
+        Param("TR_used", 1.0, "-", "1: the sensed voltage passes through TR (IEEE 421.5); "
+              "0: the unfiltered voltage enters the summing junction (ANDES 2.0)", "flag"),
     ) + SATURATION_PARAMS
     states = ("LG", "LL", "VR", "VE", "WF")
     outputs = ("vi", "VFE", "vout")
@@ -67,6 +74,7 @@ class EXAC1(MachineControl):
         self.LA = LagNonWindup(p["KA"], p["TA"], p["VRMIN"], p["VRMAX"])
         self.EX = DCExciter(p["KE"], p["TE"], p["E1"], p["SE1"], p["E2"], p["SE2"])
         self.WF = Washout(p["KF"], p["TF"])
+        self._lagged = p["TR_used"] > 0
 
     def limits(self):
         return [(self.idx("VR"), self.p["VRMIN"], self.p["VRMAX"])]
@@ -99,7 +107,8 @@ class EXAC1(MachineControl):
         v = s["Vt"][..., m]
         xad = s["XadIfd"][..., m]
         vfe = self.EX.vfe(ve) + p["KD"] * xad
-        vi = self.vref0 - self.LG.output(lg, v) - self.WF.output(wf, vfe) + s["vs"][..., m]
+        sensed = np.where(self._lagged, self.LG.output(lg, v), v)
+        vi = self.vref0 - sensed - self.WF.output(wf, vfe) + s["vs"][..., m]
         efd = _efd(ve, p["KC"], xad)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)

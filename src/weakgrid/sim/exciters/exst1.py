@@ -7,17 +7,21 @@ Block diagram (pu, times in s)::
     vil = clip(vi, VIMIN, VIMAX)
     vil --[LeadLag (1+sTC)/(1+sTB)]--> LL
     LL  --[Lag KA/(1+sTA)]--> VR
-    Efd = clip(VR, VRMIN - KC*XadIfd, VRMAX - KC*XadIfd)   (field-current dependent ceiling)
-    Efd --[Washout s*KF/(1+sTF)]--> WF                     (rate feedback)
+    lo, hi = VRMIN - KC*XadIfd, VRMAX - KC*XadIfd         (field-current dependent limits)
+    VR_limited = 1:  Efd = clip(VR, lo, hi);  Efd --[Washout s*KF/(1+sTF)]--> WF   (standard)
+    VR_limited = 0:  VR --[Washout s*KF/(1+sTF)]--> WF;  Efd = VR unless WF is beyond lo..hi,
+                     then that bound                                               (ANDES 2.0)
 
 Difference from ANDES 2.0 (documented, not copied): ANDES applies the output
-limiter to the rate-feedback signal instead of the regulator output (its ceiling
-is never reached) and feeds back the regulator output; here both follow the
-standard diagram. They agree whenever the output limiter is inactive.
+limiter's test to the rate-feedback signal instead of the regulator output (so its
+ceiling is in effect never reached) and feeds back the regulator output; here both
+follow the standard diagram. They agree whenever the output limiter is inactive.
+``VR_limited = 0`` reproduces ANDES (set by ``from_andes(..., conventions="andes")``).
 """
 
 from __future__ import annotations
 
+import numpy as np
 
 from ..blocks import Lag, LeadLag, Washout, hard_limit
 from ..control_base import MachineControl
@@ -43,6 +47,9 @@ class EXST1(MachineControl):
         Param("KC", 0.2, "pu", "rectifier loading factor", "nonneg"),
         Param("KF", 0.1, "pu", "rate feedback gain", "nonneg"),
         Param("TF", 1.0, "s", "rate feedback time constant", "pos"),
+        Param("VR_limited", 1.0, "-", "1: the output limits act on the regulator output, which the "
+              "rate feedback takes (IEEE); 0: ANDES 2.0's EXST1 (limit test on the rate feedback, "
+              "which takes the unlimited regulator output)", "flag"),
     )
     states = ("LG", "LL", "VR", "WF")
     outputs = ("vi", "vout")
@@ -54,6 +61,7 @@ class EXST1(MachineControl):
         self.LL = LeadLag(p["TC"], p["TB"])
         self.LR = Lag(p["KA"], p["TA"])
         self.WF = Washout(p["KF"], p["TF"])
+        self._std = p["VR_limited"] > 0
 
     def init(self, system, x, sig):
         p = self.p
@@ -73,14 +81,17 @@ class EXST1(MachineControl):
         s = ctx.sig
         v = s["Vt"][..., m]
         xad = s["XadIfd"][..., m]
-        efd = hard_limit(vr, p["VRMIN"] - p["KC"] * xad, p["VRMAX"] - p["KC"] * xad)
-        vi = self.vref0 - self.LG.output(lg, v) - self.WF.output(wf, efd) + s["vs"][..., m]
+        lo, hi = p["VRMIN"] - p["KC"] * xad, p["VRMAX"] - p["KC"] * xad
+        fb_in = np.where(self._std, hard_limit(vr, lo, hi), vr)        # rate feedback input
+        wfy = self.WF.output(wf, fb_in)
+        efd = np.where(self._std, fb_in, np.where(wfy > hi, hi, np.where(wfy < lo, lo, vr)))
+        vi = self.vref0 - self.LG.output(lg, v) - wfy + s["vs"][..., m]
         vil = hard_limit(vi, p["VIMIN"], p["VIMAX"])
         y = self.LL.output(ll, vil)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LL.deriv(ll, vil)
         f[..., self._sls[2]] = self.LR.deriv(vr, y)
-        f[..., self._sls[3]] = self.WF.deriv(wf, efd)
+        f[..., self._sls[3]] = self.WF.deriv(wf, fb_in)
         s["vf"][..., m] = efd
         ctx.out["EXST1.vi"], ctx.out["EXST1.vout"] = vi, efd

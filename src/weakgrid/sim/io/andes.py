@@ -24,6 +24,12 @@ PSS/E data: ``andes.load(raw, addfile=dyr, setup=False)`` parses a ``.raw`` +
 Islands: every island of the in-service network (at t = 0) must hold a slack
 (reference) bus; an island without one is refused naming its buses.
 
+Conventions: ``from_andes(ss, conventions="standard")`` (the default) builds every model
+as its standard (IEEE 421.5 / PSS/E) block diagram. ``conventions="andes"`` reproduces
+where ANDES 2.0 departs from it (see :data:`ANDES_CONVENTIONS`), so that a comparison with
+ANDES isolates real differences; each departure is a flag parameter of the weakgrid model,
+documented in its module, and listed in ``system.import_notes``.
+
 ANDES is an optional dependency and is not imported by this module; pass the
 loaded ``andes.System``.
 """
@@ -45,6 +51,16 @@ _SUPPORTED = _NETWORK | _IGNORED   # plus the registry (see _supported())
 def _supported():
     return _SUPPORTED | set(_registry())
 
+
+#: Where ANDES 2.0 departs from the standard diagram: model -> {flag parameter: value that
+#: reproduces ANDES}; applied by ``from_andes(..., conventions="andes")``.
+ANDES_CONVENTIONS = {
+    "EXAC1": {"TR_used": 0.0},    # the summing junction takes the unfiltered voltage (TR unused)
+    "ESDC2A": {"TR_used": 0.0},   # idem
+    "IEEEX1": {"VR_Vt": 0.0},     # regulator limits VRMAX, VRMIN, not times Vt
+    "EXST1": {"VR_limited": 0.0},  # output limit tested on the rate feedback (in effect never acts)
+}
+CONVENTIONS = ("standard", "andes")
 
 _MACHINE_FIELDS = {
     "GENCLS": ("Sn", "Vn", "fn", "D", "M", "ra", "xd1"),
@@ -143,7 +159,7 @@ def _check_islands(case, bus_names):
     return ncomp
 
 
-def from_andes(ss, include_events: bool = True):
+def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
     """Build a weakgrid :class:`System` and its event list from an ANDES system.
 
     Parameters
@@ -154,6 +170,11 @@ def from_andes(ss, include_events: bool = True):
         (``andes.load(raw, addfile=dyr, setup=False)``).
     include_events : bool
         Convert ANDES ``Toggle`` (line) and ``Fault`` devices into weakgrid events.
+    conventions : {"standard", "andes"}
+        ``"standard"``: models follow their standard block diagrams. ``"andes"``: models
+        reproduce ANDES 2.0's departures from them (:data:`ANDES_CONVENTIONS`; e.g. EXAC1
+        and ESDC2A without their sensing lag, IEEEX1 with constant regulator limits), for
+        peer comparisons.
 
     Returns
     -------
@@ -163,9 +184,14 @@ def from_andes(ss, include_events: bool = True):
     events : list
         weakgrid events equivalent to the case's own timed events.
     """
+    if conventions not in CONVENTIONS:
+        raise DataError("from_andes", "conventions", conventions,
+                        f"must be one of {CONVENTIONS}: 'standard' (IEEE/PSS/E block diagrams) or "
+                        "'andes' (ANDES 2.0's departures from them, for peer comparisons)")
     check_supported(ss)
     reg = _registry()
     notes = []
+    applied = {}
     for name in sorted(_IGNORED - {"Area", "Summary"}):
         if name in ss.models and ss.models[name].n:
             notes.append(f"{name} ({ss.models[name].n}): measurement-only, ignored")
@@ -302,6 +328,9 @@ def from_andes(ss, include_events: bool = True):
                     extra["machine2"] = syn_name[m.syn2.v[k]]   # cross-compound: LP machine
                 if kind == "exciter":
                     avr_syn[m.idx.v[k]] = syn
+                if conventions == "andes" and mname in ANDES_CONVENTIONS:
+                    params.update(ANDES_CONVENTIONS[mname])
+                    applied[mname] = applied.get(mname, 0) + 1
                 add[kind](mname, name, syn, **extra, **params)
     # devices that are not machine controls (renewables, loads): their own importers
     dev_name = {}
@@ -360,7 +389,12 @@ def from_andes(ss, include_events: bool = True):
                                     rf=float(_raw(fl, "rf")[k]), xf=float(_raw(fl, "xf")[k])))
     system.andes_bus_id = {b: pos[b] + 1 for b in bidx}
     system.andes_line_row = {ix: k for k, ix in enumerate(line.idx.v)}
+    for mname, n in sorted(applied.items()):
+        flags = ", ".join(f"{f} = {v:g}" for f, v in ANDES_CONVENTIONS[mname].items())
+        notes.append(f"{mname} ({n}): ANDES 2.0 conventions, {flags}")
     system.import_notes = notes
+    system.conventions = conventions
+    system.conventions_applied = dict(applied)   # model -> number of devices changed
     return system, events
 
 

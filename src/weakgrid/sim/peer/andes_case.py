@@ -109,12 +109,15 @@ def run_andes_ss(ss, tf, h, tol=1e-8):
             "names": names, "wall": wall, "ok": bool(ss.exit_code == 0), "ss": ss}
 
 
-def run_weakgrid_ss(ss, tf, h, tol=1e-8, **kw):
-    """Import ``ss`` (not set up) into weakgrid with its events and simulate at step ``h``."""
+def run_weakgrid_ss(ss, tf, h, tol=1e-8, conventions="standard", **kw):
+    """Import ``ss`` (not set up) into weakgrid with its events and simulate at step ``h``.
+
+    ``conventions="andes"`` imports with ANDES 2.0's departures from the standard models
+    (:data:`weakgrid.sim.io.andes.ANDES_CONVENTIONS`)."""
     from ..integrate import Simulator
     from ..io.andes import from_andes
 
-    system, events = from_andes(ss)
+    system, events = from_andes(ss, conventions=conventions)
     system.setup()
     sim = Simulator(system, dt=h, tol=tol, **kw)
     t0 = time.perf_counter()

@@ -80,26 +80,31 @@ def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1
             "ok": bool(ss.exit_code == 0)}
 
 
-def build_weakgrid(case, fault=None, disable_toggles=False, add=(), edit=(), addfile=None):
-    """The same case imported into weakgrid through ANDES's loader; returns ``(system, events, machine names)``."""
+def build_weakgrid(case, fault=None, disable_toggles=False, add=(), edit=(), addfile=None,
+                   conventions="standard"):
+    """The same case imported into weakgrid through ANDES's loader; returns ``(system, events, machine names)``.
+
+    ``conventions``: ``"standard"`` or ``"andes"`` (see :func:`weakgrid.sim.io.andes.from_andes`)."""
     from ..events import Fault
     from ..io.andes import from_andes
 
     ss = load_andes(case, None, disable_toggles, add, edit, addfile)
-    system, events = from_andes(ss)
+    system, events = from_andes(ss, conventions=conventions)
     if fault is not None:
         bus, tf, tc = fault
         events.append(Fault(system.andes_bus_id[bus], tf, tc))
     return system, events, list(system.machine_names)
 
 
-def run_weakgrid(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, add=(), edit=(), addfile=None, **kw):
+def run_weakgrid(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1e-8, add=(), edit=(), addfile=None,
+                 conventions="standard", **kw):
     """Simulate the case in weakgrid with step ``h``; same outputs as :func:`run_andes`.
 
-    ``tol=None`` uses the simulator's default (step-scaled) Newton tolerance."""
+    ``tol=None`` uses the simulator's default (step-scaled) Newton tolerance; ``conventions``
+    as in :func:`build_weakgrid`."""
     from ..integrate import Simulator
 
-    system, events, names = build_weakgrid(case, fault, disable_toggles, add, edit, addfile)
+    system, events, names = build_weakgrid(case, fault, disable_toggles, add, edit, addfile, conventions)
     system.setup()
     sim = Simulator(system, dt=h, tol=tol, **kw)
     t0 = time.perf_counter()
