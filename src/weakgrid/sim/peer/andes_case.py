@@ -80,9 +80,46 @@ def machine_names(ss):
     return out
 
 
-def run_andes_ss(ss, tf, h, tol=1e-8):
-    """Set up, solve the power flow and simulate ``ss`` in ANDES at the fixed step ``h``."""
+def hold_andes_step(tds):
+    """Make ANDES keep its step at ``config.tstep`` after every converged step.
+
+    With ``fixt = 1`` ANDES's step is only an upper bound: after a step that needed more
+    than 6 Newton iterations its step control shortens the next one (by 5 %, by half
+    above 15) and lets it regrow by 10 % a step. This wraps the step control of the
+    integration method that ``tds`` creates (in ``TDS.set_method``, called again by
+    ``TDS.init``) so that ``deltat`` returns to ``tstep`` after each converged step. The
+    points ANDES puts 1e-4 s before and after each event and the shortening of a step
+    that would pass an event are kept, and so is the handling of a failed step
+    (``shrinkt``). Only this ``tds`` object is changed.
+    """
+    set_method = tds.set_method
+
+    def set_method_held(name="trapezoid"):
+        set_method(name)
+        calc_h = tds.method.calc_h
+
+        def calc_h_held(t):
+            calc_h(t)
+            if t.converged and t.config.fixt:
+                t.deltat = t.config.tstep
+
+        tds.method.calc_h = calc_h_held
+
+    tds.set_method = set_method_held
+    set_method_held(tds.config.method)
+
+
+def run_andes_ss(ss, tf, h, tol=1e-8, hold_step=False, configure=None):
+    """Set up, solve the power flow and simulate ``ss`` in ANDES at the fixed step ``h``.
+
+    ``hold_step=True``: a truly fixed step (:func:`hold_andes_step`); by default ANDES may
+    shorten its step after slow Newton convergence. ``configure(ss)`` is called after the
+    setup (e.g. to set a model's or a routine's config)."""
     ss.setup()
+    if hold_step:
+        hold_andes_step(ss.TDS)
+    if configure is not None:
+        configure(ss)
     ss.PFlow.config.tol = 1e-11
     ss.PFlow.run()
     if not ss.PFlow.converged:

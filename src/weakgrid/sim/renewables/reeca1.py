@@ -41,8 +41,12 @@ Conventions (those of ANDES 2.0, checked against it in ``tests/sim/test_reeca1_p
   held value is the one of the last *accepted* point outside a dip (ANDES holds the value of
   the Newton iterate at which its flag switched, which can differ when the voltage jumps from
   below Vdip to above Vup in one step; see ``tests/sim/test_reeca1_peer.py``).
-* ``Ipmax`` is held for Thld2 at its value at the end of the dip (WECC); ANDES 2.0 holds an
-  older value (its pre-dip one in the peer case). It binds in neither peer case.
+* ``Ipmax`` is held for Thld2 at its value at the end of the dip (WECC). ANDES 2.0 evaluates
+  its dip flags at every Newton iterate, and the first iterate after a fault clearing starts
+  from the restored pre-fault voltage (inside the normal band): its hold starts there, with
+  the pre-fault Ipmax, and stays on while the dip goes on. With P priority this lifts ANDES's
+  Ipmax from VDL2 (4.2 pu) to Imax for the first 20 ms after clearing in the peer case
+  (``test_reeca1_peer.py::test_limits_case``).
 * The flag combinations follow ANDES's diagram, including its initial references:
   ``Qref0 = q0`` with ``QFLAG = 0``, ``Vref1 - v0`` with ``QFLAG = 1``.
 * ANDES adds ``Ipcmd0/LVG0 - Ipcmd0`` to the active current command so that the converter

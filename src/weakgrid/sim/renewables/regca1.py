@@ -22,7 +22,9 @@ Limits follow ANDES: the rate limits bound ``T dx/dt``; the upper limit LVPL of 
 an anti-windup limit that moves with ``S2``: a state that crosses it is *reset* to it and held
 there while its input pushes up (the integrator's non-windup limits, refreshed at every Newton
 iterate through :meth:`limit_values`), as ANDES's ``AntiWindup`` resets the state. The output
-is the state. (Holding the state where it was when the limit first bound, and clipping only
+is the state, so it never exceeds LVPL. (ANDES resets only a state whose derivative is >= 0:
+a state above a falling LVPL that decreases towards a smaller Ipcmd stays above the limit
+there, e.g. 5.4 pu against LVPL = 0.34 pu in ``tests/sim/test_reeca1_peer.py``'s limit case.) (Holding the state where it was when the limit first bound, and clipping only
 the output, leaves the state far above a limit that fell in a fault; when LVPL switches off
 at ``Brkpt`` the output then jumps back to the state, and the step cannot converge.)
 """
