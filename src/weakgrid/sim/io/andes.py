@@ -123,16 +123,97 @@ def _params(cls, m, k):
     return {f: float(_raw(m, f)[k]) for f in fields}
 
 
+def psse_branch_sn(ss):
+    """Power base ``Sn`` [MVA] of each ANDES ``Line``'s ``r``, ``x``, ``b``, as the data mean it.
+
+    In a PSS/E ``.raw`` file the impedances of non-transformer branches are per unit on the
+    system base ``SBASE``, but ANDES 2.0's PSS/E parser leaves their ``Sn`` at the ``Line``
+    default of 100 MVA, so with ``SBASE != 100`` ANDES scales them by ``SBASE/100`` (the
+    ``nordic44`` case, ``SBASE`` = 1000 MVA: lines ten times too long, no power flow).
+    For a case read from PSS/E (``ss.files.input_format == "psse"``) every non-transformer
+    branch (``trans == 0``) is read on the system base ``ss.config.mva``; other inputs and
+    transformers keep their ``Sn``.
+
+    Returns
+    -------
+    Sn : ndarray
+        Base of each line [MVA].
+    rebased : list
+        ANDES idx of the lines whose ``Sn`` differed from the system base and were rebased.
+    """
+    line = ss.Line
+    Sn = _raw(line, "Sn").copy()
+    files = getattr(ss, "files", None)
+    if line.n == 0 or getattr(files, "input_format", None) != "psse":
+        return Sn, []
+    Sb = float(ss.config.mva)
+    fix = (_raw(line, "trans") == 0) & (Sn != Sb)
+    Sn[fix] = Sb
+    return Sn, [line.idx.v[k] for k in np.nonzero(fix)[0]]
+
+
+def _psse_note(n, Sb):
+    return (f"PSS/E data: {n} non-transformer branches read on the system base {Sb:g} MVA "
+            "(ANDES 2.0's parser leaves their Sn at 100 MVA)")
+
+
+def fix_psse_branch_base(ss):
+    """Give the non-transformer branches of a PSS/E case read by ANDES their true base.
+
+    Sets ``Sn`` = system base on the ANDES ``Line`` devices that :func:`psse_branch_sn`
+    rebases, so that ANDES itself (e.g. a peer run) sees the data as :func:`from_andes`
+    reads them. Call it on a system loaded with ``setup=False``, before ``ss.setup()``.
+
+    Returns
+    -------
+    list of str
+        A note for :attr:`System.import_notes` (empty if nothing changed).
+    """
+    Sn, rebased = psse_branch_sn(ss)
+    if not rebased:
+        return []
+    pos = {ix: k for k, ix in enumerate(ss.Line.idx.v)}
+    for ix in rebased:
+        ss.Line.Sn.v[pos[ix]] = float(Sn[pos[ix]])
+    return [_psse_note(len(rebased), float(ss.config.mva))]
+
+
+def psse_dyr_dropped(ss):
+    """PSS/E dynamic models of the case's ``.dyr`` that ANDES's parser did not read.
+
+    ANDES reads a ``.dyr`` record only for the models its PSS/E table
+    (``andes/io/psse-dyr.yaml``) knows and drops the others with a log warning; the case
+    would then run without them (e.g. ``nordic44``: 12 ``IEEET2`` exciters and 53 ``STAB2A``
+    stabilizers). Returns ``{model: number of records}``; empty for other inputs.
+    """
+    dyr = getattr(ss, "dyr_dict", None) or {}
+    if not dyr:
+        return {}
+    import os
+
+    import yaml
+    from andes.io import psse
+
+    with open(os.path.join(os.path.dirname(psse.__file__), "psse-dyr.yaml")) as f:
+        known = yaml.safe_load(f) or {}
+    return {m: len(df) for m, df in dyr.items() if m not in known}
+
+
 def check_supported(ss):
     """Raise one :class:`DataError` listing every ANDES model with in-service devices weakgrid lacks."""
     sup = _supported()
     missing = {name: _in_service(mdl) for name, mdl in ss.models.items()
                if name not in sup and _in_service(mdl) > 0}
+    dropped = psse_dyr_dropped(ss)
+    missing.update(dropped)
     if missing:
-        lst = ", ".join(f"{k} ({v})" for k, v in sorted(missing.items()))
+        lst = ", ".join(f"{k} ({v}{', in the .dyr, not read by ANDES' if k in dropped else ''})"
+                        for k, v in sorted(missing.items()))
         raise DataError("ANDES case", "models", sorted(missing),
                         f"models not supported by weakgrid.sim (in-service devices): {lst}. "
-                        f"Supported: {sorted(sup)}. Set their u = 0 or remove them")
+                        f"Supported: {sorted(sup)}. Set their u = 0 or remove them"
+                        + (" (models ANDES does not read: delete their records from the .dyr to "
+                           "run the case without them)" if dropped else ""))
 
 
 def _check_islands(case, bus_names):
@@ -256,9 +337,12 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
             G.append(row)
     line = ss.Line
     L = np.zeros((line.n, 13))
+    line_sn, rebased = psse_branch_sn(ss)
+    if rebased:
+        notes.append(_psse_note(len(rebased), Sb))
     for k in range(line.n):
         i, j = pos[line.bus1.v[k]], pos[line.bus2.v[k]]
-        Sn, Vn1 = _raw(line, "Sn")[k], _raw(line, "Vn1")[k]
+        Sn, Vn1 = line_sn[k], _raw(line, "Vn1")[k]
         zc = (Vn1 ** 2 / Sn) / (Vn_bus[i] ** 2 / Sb)
         g, g1, g2 = _raw(line, "g")[k], _raw(line, "g1")[k], _raw(line, "g2")[k]
         b, b1, b2 = _raw(line, "b")[k], _raw(line, "b1")[k], _raw(line, "b2")[k]

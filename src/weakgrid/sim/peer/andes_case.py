@@ -3,9 +3,11 @@
 Generalizes :mod:`weakgrid.sim.peer.andes_runs` (stock cases by name, one machine
 model) to any case file: machines of every model are matched by name
 (``"<model>_<idx>"``, the names :func:`weakgrid.sim.io.andes.from_andes` gives),
-the case's own timed events can be replaced by one three-phase fault, and the
-ANDES system can be modified before both tools read it (``modify(ss)``), so the
-two simulators always see the same data. ANDES (GPL) is imported, never copied.
+the case's own timed events can be replaced by one three-phase fault, PSS/E branch
+data get their true base in ANDES's copy too
+(:func:`weakgrid.sim.io.andes.fix_psse_branch_base`), and the ANDES system can be
+modified before both tools read it (``modify(ss)``), so the two simulators always see
+the same data. ANDES (GPL) is imported, never copied.
 """
 
 from __future__ import annotations
@@ -47,6 +49,10 @@ def load_case(path, addfile=None, fault=None, keep_events=False, modify=None):
     ss = andes.load(path, addfile=addfile, setup=False, no_output=True, default_config=True)
     if ss is None:
         raise RuntimeError(f"ANDES could not parse {path}")
+    # PSS/E branches on the system base in ANDES too, as weakgrid reads them (SBASE != 100)
+    from ..io.andes import fix_psse_branch_base
+
+    fix_psse_branch_base(ss)
     if not keep_events:
         for ev in ("Toggle", "Fault", "Alter"):
             if ev in ss.models:
