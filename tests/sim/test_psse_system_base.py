@@ -14,9 +14,9 @@ pytestmark = pytest.mark.andes
 
 andes = pytest.importorskip("andes")
 
-from weakgrid.sim.errors import DataError  # noqa: E402
-from weakgrid.sim.io.andes import fix_psse_branch_base, from_andes  # noqa: E402
-from weakgrid.sim.network import BR_B, BR_R, BR_X, F_BUS, T_BUS  # noqa: E402
+from weakgrid.sim.errors import DataError
+from weakgrid.sim.io.andes import fix_psse_branch_base, from_andes
+from weakgrid.sim.network import BR_B, BR_R, BR_X, F_BUS, T_BUS
 
 RAW = "nordic44/N44_BC.raw"
 
