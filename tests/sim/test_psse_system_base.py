@@ -74,3 +74,10 @@ def test_dyr_models_andes_cannot_read_are_listed():
     assert e.value.field == "models"
     assert {"IEEET2", "STAB2A"} <= set(e.value.value)
     assert "not read by ANDES" in str(e.value)
+
+
+def test_fix_after_setup_is_refused():
+    ss = _load()
+    ss.setup()
+    with pytest.raises(DataError, match="before ss.setup"):
+        fix_psse_branch_base(ss)

@@ -172,6 +172,10 @@ def fix_psse_branch_base(ss):
     Sn, rebased = psse_branch_sn(ss)
     if not rebased:
         return []
+    if getattr(ss, "is_setup", False):
+        raise DataError("ANDES system", "is_setup", True,
+                        "rebase the PSS/E branches before ss.setup(): load with andes.load(..., "
+                        "setup=False), call fix_psse_branch_base(ss), then ss.setup()")
     pos = {ix: k for k, ix in enumerate(ss.Line.idx.v)}
     for ix in rebased:
         ss.Line.Sn.v[pos[ix]] = float(Sn[pos[ix]])
