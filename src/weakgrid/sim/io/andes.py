@@ -19,7 +19,10 @@ powers and inertias by ``Sn/Sb``). PQ loads become constant impedances in the
 time domain, as with ANDES's default ``p2z = q2z = 1``.
 
 PSS/E data: ``andes.load(raw, addfile=dyr, setup=False)`` parses a ``.raw`` +
-``.dyr`` pair into the same ANDES models, which this module then imports.
+``.dyr`` pair into the same ANDES models, which this module then imports. Two gaps of
+ANDES 2.0's parser are handled here: non-transformer branches are read on the system base
+(:func:`psse_branch_sn`; the parser leaves them at 100 MVA), and ``.dyr`` models the parser
+drops are listed among the unsupported models (:func:`psse_dyr_dropped`).
 
 Islands: every island of the in-service network (at t = 0) must hold a slack
 (reference) bus; an island without one is refused naming its buses.
