@@ -21,6 +21,14 @@ time domain, as with ANDES's default ``p2z = q2z = 1``.
 PSS/E data: ``andes.load(raw, addfile=dyr, setup=False)`` parses a ``.raw`` +
 ``.dyr`` pair into the same ANDES models, which this module then imports.
 
+Static generators without a dynamic model: a ``Slack`` or ``PV`` that no in-service machine or
+converter replaces keeps its power-flow equations in ANDES's time-domain simulation. weakgrid
+does the same (``static_gens="ideal"``, the default): a Slack becomes an
+:class:`~weakgrid.sim.sources.InfiniteBus` (ideal voltage source: fixed voltage and angle,
+infinite inertia), a PV a :class:`~weakgrid.sim.sources.PVSource` (constant P at constant |V|,
+no inertia), each with a note in ``system.import_notes``; ``static_gens="refuse"`` refuses
+the case instead, naming them.
+
 Islands: every island of the in-service network (at t = 0) must hold a slack
 (reference) bus; an island without one is refused naming its buses.
 
@@ -159,7 +167,7 @@ def _check_islands(case, bus_names):
     return ncomp
 
 
-def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
+def from_andes(ss, include_events: bool = True, conventions: str = "standard", static_gens: str = "ideal"):
     """Build a weakgrid :class:`System` and its event list from an ANDES system.
 
     Parameters
@@ -175,6 +183,10 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
         reproduce ANDES 2.0's departures from them (:data:`ANDES_CONVENTIONS`; e.g. EXAC1
         and ESDC2A without their sensing lag, IEEEX1 with constant regulator limits), for
         peer comparisons.
+    static_gens : {"ideal", "refuse"}
+        What to do with an in-service ``Slack``/``PV`` that no dynamic model replaces:
+        ``"ideal"`` simulates it as ANDES does (an ideal source, see the module docstring;
+        noted in ``system.import_notes``), ``"refuse"`` raises :class:`DataError` naming them.
 
     Returns
     -------
@@ -188,6 +200,9 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
         raise DataError("from_andes", "conventions", conventions,
                         f"must be one of {CONVENTIONS}: 'standard' (IEEE/PSS/E block diagrams) or "
                         "'andes' (ANDES 2.0's departures from them, for peer comparisons)")
+    if static_gens not in ("ideal", "refuse"):
+        raise DataError("from_andes", "static_gens", static_gens,
+                        "use 'ideal' (simulate them as ANDES does) or 'refuse'")
     check_supported(ss)
     reg = _registry()
     notes = []
@@ -197,6 +212,12 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
             notes.append(f"{name} ({ss.models[name].n}): measurement-only, ignored")
     Sb = float(ss.config.mva)
     bus = ss.Bus
+    off = [b for b, u in zip(bus.idx.v, _raw(bus, "u")) if u <= 0]
+    if off:   # ANDES disconnects such a bus and everything on it; weakgrid cannot drop a bus yet
+        raise DataError("ANDES Bus", "u", off,
+                        f"the buses {off} are out of service (u = 0); ANDES disconnects them with every "
+                        "line and device on them. Remove those buses and their devices from the case "
+                        "(weakgrid does not drop buses)")
     nb = bus.n
     bidx = list(bus.idx.v)
     pos = {b: i for i, b in enumerate(bidx)}
@@ -358,10 +379,21 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
     used = {lk["gen"] for c in system.components.values() for lk in c.links if "gen" in lk}
     bare = [f"{mname} {ix} (bus {m.bus.v[k]})" for mname in ("Slack", "PV") for m in [ss.models[mname]]
             for k, ix in enumerate(m.idx.v) if _raw(m, "u")[k] > 0 and gen_row[ix] not in used]
-    if bare:
+    if bare and static_gens == "refuse":
         raise DataError("ANDES case", "StaticGen", bare,
                         f"the static generators {bare} have no in-service dynamic model (machine or "
                         "converter); add one or set their u = 0")
+    if bare:   # as ANDES: their power-flow equations stay in the time domain (weakgrid.sim.sources)
+        for mname, src in (("Slack", "InfiniteBus"), ("PV", "PVSource")):
+            m = ss.models[mname]
+            for k, ix in enumerate(m.idx.v):
+                if _raw(m, "u")[k] > 0 and gen_row[ix] not in used:
+                    system._component(src, "device").add(f"{mname}_{ix}", {"gen": gen_row[ix]}, {})
+                    what = ("an ideal voltage source (infinite bus: fixed voltage and angle, infinite "
+                            "inertia, unlimited current)" if mname == "Slack" else
+                            "a constant-P, constant-|V| source (no inertia, unlimited reactive power)")
+                    notes.append(f"{mname} {ix} (bus {m.bus.v[k]}): no dynamic model; simulated as ANDES "
+                                 f"does, as {what} ({src})")
     events = []
     if include_events:
         lpos = {ix: k for k, ix in enumerate(line.idx.v)}
