@@ -13,8 +13,20 @@ therefore switches GENROU 3 and its controls off in both tools, and faults bus 9
 next to the infinite bus). Measured (h = 1/120 s, 10 s): island-2 machine speed 4.4e-6 pu,
 absolute angle 0.038 deg (the infinite bus fixes the angle frame); island 1 undisturbed in both.
 
-``ieee14_conn`` is refused for another reason, now named: its bus 15 (with PV 6) is out of
-service (u = 0), which ANDES handles by disconnecting the bus.
+``ieee14_conn`` (refused before with the same message for PV 6) is another case: its bus 15
+(with PV 6, a load, a shunt and line 14-15) is out of service (u = 0). ANDES disconnects such a
+bus (its line goes out of service, its voltage is frozen, nothing on it reaches the grid);
+weakgrid now drops it with everything on it, with notes. Measured (fault at bus 2, 10 s,
+1/120 s): 1.1e-5 pu, 0.023 deg, as ieee14_full (ANDES's step error, see
+test_andes_standard_cases).
+
+The PV source is also checked on ``ieee14_full`` with GENROU_5 (a synchronous condenser on
+PV 5, bus 8) and its controls switched off in both tools: 1.1e-5 pu, 0.024 deg (ieee14_full's
+own gap); it holds its P and |V| through the fault.
+
+In both peer runs ANDES's exit code flags its initialization: it checks the residual of the
+switched-off governor too (an out-of-service device); its grid starts in equilibrium all the
+same, which the tests check.
 """
 
 import numpy as np
@@ -24,7 +36,8 @@ andes = pytest.importorskip("andes")
 
 from weakgrid.sim.errors import DataError  # noqa: E402
 from weakgrid.sim.io.andes import from_andes  # noqa: E402
-from weakgrid.sim.peer.andes_case import interp_to, load_case, run_andes_ss, run_weakgrid_ss  # noqa: E402
+from weakgrid.sim.peer.andes_case import (compare_named, interp_to, load_case, run_andes_ss,  # noqa: E402
+                                          run_weakgrid_ss)
 
 pytestmark = pytest.mark.andes
 
@@ -42,19 +55,34 @@ def test_bare_slack_imports_as_infinite_bus(path):
         from_andes(load_case(path), static_gens="refuse")
 
 
-def test_off_bus_is_named():
-    with pytest.raises(DataError, match=r"buses \[15\] are out of service"):
-        from_andes(load_case("ieee14/ieee14_conn.xlsx"))
+def test_out_of_service_bus_dropped_with_its_devices():
+    system, _ = from_andes(load_case("ieee14/ieee14_conn.xlsx"))
+    notes = " | ".join(system.import_notes)
+    for what in ("Bus [15]: out of service", "PV 6: on an out-of-service bus", "PQ PQ_12", "Line Line_21"):
+        assert what in notes
+    assert system.network.nb == 14 and 15 not in system.andes_bus_id
+    assert "Line_21" not in system.andes_line_row and system.network.branch.shape[0] == 20
+    system.setup()
 
 
-def _gen3_off(ss):
-    """GENROU 3 (whose static generator PV 3 is off) and its controls out of service."""
-    ss.GENROU.u.v[list(ss.GENROU.idx.v).index(3)] = 0
-    for m in ss.models.values():
-        if m.n and "syn" in m.params:
-            for k, s in enumerate(m.syn.v):
-                if s == 3:
-                    m.u.v[k] = 0
+def _machine_off(idx):
+    """``modify`` for load_case: machine ``idx`` and its controls out of service."""
+    def modify(ss):
+        ss.GENROU.u.v[list(ss.GENROU.idx.v).index(idx)] = 0
+        for m in ss.models.values():
+            if m.n and "syn" in m.params:
+                for k, s in enumerate(m.syn.v):
+                    if s == idx:
+                        m.u.v[k] = 0
+    return modify
+
+
+_gen3_off = _machine_off(3)
+
+
+def _started_in_equilibrium(a):
+    pre = a["t"] < 0.99
+    return np.max(np.abs(a["omega"][pre] - 1)) < 1e-9
 
 
 @pytest.mark.slow
@@ -65,9 +93,7 @@ def test_kundur_islands_infinite_bus_matches_andes():
     a = run_andes_ss(load_case(*case, fault=(9, 1.0, 1.05), modify=_gen3_off), tf, H)
     # ANDES's exit code flags its initialization: it checks the residual of the switched-off
     # TGOV1 3 too (7.56, an out-of-service device). Its grid starts in equilibrium all the same:
-    assert w["ok"] and a["t"][-1] == pytest.approx(tf)
-    pre = a["t"] < 0.99
-    assert np.max(np.abs(a["omega"][pre] - 1)) < 1e-9
+    assert w["ok"] and a["t"][-1] == pytest.approx(tf) and _started_in_equilibrium(a)
     assert sorted(a["names"]) == sorted(w["names"]) == ["GENROU_1", "GENROU_2", "GENROU_4"]
     tg = np.linspace(0, tf, 4001)
     A = {k: interp_to(tg, a["t"], a[k]) for k in ("omega", "delta")}
@@ -81,4 +107,35 @@ def test_kundur_islands_infinite_bus_matches_andes():
           f"infinite bus P {P.min():.3f}..{P.max():.3f} pu")
     assert swing > 1e-3                       # the fault is felt in the island of the infinite bus
     assert P.max() - P.min() > 1.0            # ... and the infinite bus supplies it
+    assert dw < 2e-5 and dd < 0.5
+
+
+@pytest.mark.slow
+def test_ieee14_conn_matches_andes():
+    tf = 10.0
+    w = run_weakgrid_ss(load_case("ieee14/ieee14_conn.xlsx", fault="auto"), tf, H)
+    a = run_andes_ss(load_case("ieee14/ieee14_conn.xlsx", fault="auto"), tf, H)
+    assert a["ok"] and w["ok"] and a["t"][-1] == pytest.approx(tf)
+    assert sorted(a["names"]) == sorted(w["names"]) and len(a["names"]) == 5
+    dw, dd = compare_named(a, w)
+    print(f"ieee14_conn: speed {dw:.3g} pu, relative angle {dd:.3g} deg")
+    assert dw < 2e-5 and dd < 0.5
+
+
+@pytest.mark.slow
+def test_pv_source_matches_andes():
+    tf, case = 10.0, "ieee14/ieee14_full.xlsx"
+    w = run_weakgrid_ss(load_case(case, fault="auto", modify=_machine_off("GENROU_5")), tf, H)
+    a = run_andes_ss(load_case(case, fault="auto", modify=_machine_off("GENROU_5")), tf, H)
+    assert w["ok"] and a["t"][-1] == pytest.approx(tf) and _started_in_equilibrium(a)
+    assert any("PV 5" in n and "PVSource" in n for n in w["system"].import_notes)
+    assert sorted(a["names"]) == sorted(w["names"]) and len(a["names"]) == 4
+    res, system = w["res"], w["system"]
+    b = system.andes_bus_id[8]
+    v = np.abs(res[f"bus{b}.Vr"] + 1j * res[f"bus{b}.Vi"])
+    P = res["PV_5.P"]
+    assert np.ptp(v) < 1e-6 and np.ptp(P) < 1e-6          # holds |V| and P (to the Newton tolerance)
+    assert P[0] == pytest.approx(system.components["PVSource"].p0[0], abs=1e-12)
+    dw, dd = compare_named(a, w)
+    print(f"PV source: speed {dw:.3g} pu, relative angle {dd:.3g} deg")
     assert dw < 2e-5 and dd < 0.5
