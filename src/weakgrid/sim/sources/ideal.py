@@ -62,6 +62,7 @@ class _BusConstraint(Component):
                                 f"bus {system.network.bus_ids[b]} already held by {seen[b]}; "
                                 "give a bus at most one ideal source")
             seen[b] = self.element(i)
+        self.__dict__.pop("k", None)
         for c in system.components.values():
             if c is not self and isinstance(c, _BusConstraint):
                 for i, b in enumerate(self.bus):
