@@ -29,8 +29,12 @@ infinite inertia), a PV a :class:`~weakgrid.sim.sources.PVSource` (constant P at
 no inertia), each with a note in ``system.import_notes``; ``static_gens="refuse"`` refuses
 the case instead, naming them.
 
+Out-of-service buses (``Bus.u = 0``) are dropped with every line and device on them, with
+notes (ANDES disconnects them: their lines go out of service, their voltages are frozen).
+
 Islands: every island of the in-service network (at t = 0) must hold a slack
-(reference) bus; an island without one is refused naming its buses.
+(reference) bus; an island without one is refused naming its buses. An island's reference is
+its slack: the machine that replaces it, or, without one, an ideal source (above).
 
 Conventions: ``from_andes(ss, conventions="standard")`` (the default) builds every model
 as its standard (IEEE 421.5 / PSS/E) block diagram. ``conventions="andes"`` reproduces
