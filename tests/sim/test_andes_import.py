@@ -58,9 +58,10 @@ def test_machine_of_out_of_service_generator_skipped():
 
 
 def test_static_generator_without_dynamic_model_refused_by_name():
-    # kundur_islands: a second Slack (idx 5, bus 3) whose machine sits on an out-of-service PV
+    # kundur_islands: a second Slack (idx 5, bus 3) whose machine sits on an out-of-service PV;
+    # accepted by default as an infinite bus (test_andes_static_gens), refused on request
     with pytest.raises(DataError, match="Slack 5") as e:
-        from_andes(load_case("kundur/kundur_islands.xlsx", keep_events=True))
+        from_andes(load_case("kundur/kundur_islands.xlsx", keep_events=True), static_gens="refuse")
     assert "no in-service dynamic model" in str(e.value)
 
 

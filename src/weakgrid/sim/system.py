@@ -88,6 +88,7 @@ def _registry():
     from .pss import IEEEST
     from .loads import ZIP
     from .renewables import PVD1, REECA1, REECB1, REGCA1, REPCA1
+    from .sources import InfiniteBus, PVSource
 
     from .exciters import ESDC2A, ESST3A, EXAC1, EXST1, IEEET1, IEEEX1
     from .governors import IEEEG1, IEESGO, TG2, TGOV1N
@@ -96,7 +97,8 @@ def _registry():
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
                                     IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT)
-            + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ZIP)}
+            + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ZIP)
+            + (InfiniteBus, PVSource)}
 
 
 class System:

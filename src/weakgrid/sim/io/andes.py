@@ -24,8 +24,20 @@ ANDES 2.0's parser are handled here: non-transformer branches are read on the sy
 (:func:`psse_branch_sn`; the parser leaves them at 100 MVA), and ``.dyr`` models the parser
 drops are listed among the unsupported models (:func:`psse_dyr_dropped`).
 
+Static generators without a dynamic model: a ``Slack`` or ``PV`` that no in-service machine or
+converter replaces keeps its power-flow equations in ANDES's time-domain simulation. weakgrid
+does the same (``static_gens="ideal"``, the default): a Slack becomes an
+:class:`~weakgrid.sim.sources.InfiniteBus` (ideal voltage source: fixed voltage and angle,
+infinite inertia), a PV a :class:`~weakgrid.sim.sources.PVSource` (constant P at constant |V|,
+no inertia), each with a note in ``system.import_notes``; ``static_gens="refuse"`` refuses
+the case instead, naming them.
+
+Out-of-service buses (``Bus.u = 0``) are dropped with every line and device on them, with
+notes (ANDES disconnects them: their lines go out of service, their voltages are frozen).
+
 Islands: every island of the in-service network (at t = 0) must hold a slack
-(reference) bus; an island without one is refused naming its buses.
+(reference) bus; an island without one is refused naming its buses. An island's reference is
+its slack: the machine that replaces it, or, without one, an ideal source (above).
 
 Conventions: ``from_andes(ss, conventions="standard")`` (the default) builds every model
 as its standard (IEEE 421.5 / PSS/E) block diagram. ``conventions="andes"`` reproduces
@@ -247,7 +259,7 @@ def _check_islands(case, bus_names):
     return ncomp
 
 
-def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
+def from_andes(ss, include_events: bool = True, conventions: str = "standard", static_gens: str = "ideal"):
     """Build a weakgrid :class:`System` and its event list from an ANDES system.
 
     Parameters
@@ -263,6 +275,10 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
         reproduce ANDES 2.0's departures from them (:data:`ANDES_CONVENTIONS`; e.g. EXAC1
         and ESDC2A without their sensing lag, IEEEX1 with constant regulator limits), for
         peer comparisons.
+    static_gens : {"ideal", "refuse"}
+        What to do with an in-service ``Slack``/``PV`` that no dynamic model replaces:
+        ``"ideal"`` simulates it as ANDES does (an ideal source, see the module docstring;
+        noted in ``system.import_notes``), ``"refuse"`` raises :class:`DataError` naming them.
 
     Returns
     -------
@@ -276,6 +292,9 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
         raise DataError("from_andes", "conventions", conventions,
                         f"must be one of {CONVENTIONS}: 'standard' (IEEE/PSS/E block diagrams) or "
                         "'andes' (ANDES 2.0's departures from them, for peer comparisons)")
+    if static_gens not in ("ideal", "refuse"):
+        raise DataError("from_andes", "static_gens", static_gens,
+                        "use 'ideal' (simulate them as ANDES does) or 'refuse'")
     check_supported(ss)
     reg = _registry()
     notes = []
@@ -285,30 +304,44 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
             notes.append(f"{name} ({ss.models[name].n}): measurement-only, ignored")
     Sb = float(ss.config.mva)
     bus = ss.Bus
-    nb = bus.n
-    bidx = list(bus.idx.v)
+    # out-of-service buses (u = 0) are dropped with every line and device on them: ANDES
+    # disconnects them (their lines go out of service, their equations are frozen)
+    on_bus = _raw(bus, "u") > 0
+    off = [b for b, u in zip(bus.idx.v, on_bus) if not u]
+    if off:
+        notes.append(f"Bus {off}: out of service (u = 0); dropped with every line and device on them")
+    nb = int(on_bus.sum())
+    bidx = [b for b, u in zip(bus.idx.v, on_bus) if u]
     pos = {b: i for i, b in enumerate(bidx)}
-    Vn_bus = _raw(bus, "Vn")
+    Vn_bus = _raw(bus, "Vn")[on_bus]
     B = np.zeros((nb, 13))
     B[:, 0] = np.arange(1, nb + 1)
     B[:, 1] = 1
     B[:, 6] = 1
-    B[:, 7] = _raw(bus, "v0")
-    B[:, 8] = np.degrees(_raw(bus, "a0"))
+    B[:, 7] = _raw(bus, "v0")[on_bus]
+    B[:, 8] = np.degrees(_raw(bus, "a0")[on_bus])
     B[:, 9] = Vn_bus
     B[:, 10] = 1
-    B[:, 11] = _raw(bus, "vmax")
-    B[:, 12] = _raw(bus, "vmin")
+    B[:, 11] = _raw(bus, "vmax")[on_bus]
+    B[:, 12] = _raw(bus, "vmin")[on_bus]
+
+    def on_off_bus(m, k, *fields):
+        if all(getattr(m, f).v[k] in pos for f in fields):
+            return False
+        if _raw(m, "u")[k] > 0:
+            notes.append(f"{m.class_name} {m.idx.v[k]}: on an out-of-service bus, dropped")
+        return True
+
     pq = ss.PQ
     for k in range(pq.n):
-        if _raw(pq, "u")[k] > 0:
+        if _raw(pq, "u")[k] > 0 and not on_off_bus(pq, k, "bus"):
             i = pos[pq.bus.v[k]]
             B[i, 2] += _raw(pq, "p0")[k] * Sb
             B[i, 3] += _raw(pq, "q0")[k] * Sb
     if "Shunt" in ss.models:
         sh = ss.Shunt
         for k in range(sh.n):
-            if _raw(sh, "u")[k] > 0:
+            if _raw(sh, "u")[k] > 0 and not on_off_bus(sh, k, "bus"):
                 i = pos[sh.bus.v[k]]
                 Sn, Vn = _raw(sh, "Sn")[k], _raw(sh, "Vn")[k]
                 # b [pu on (Sn, Vn)] -> system base at the bus voltage: x (Sn/Sb) (Vb/Vn)^2 (as ANDES)
@@ -320,6 +353,9 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
     for mname, btype in (("Slack", 3), ("PV", 2)):
         m = ss.models[mname]
         for k in range(m.n):
+            if on_off_bus(m, k, "bus"):
+                gen_row[m.idx.v[k]] = None   # its machine or converter is skipped
+                continue
             i = pos[m.bus.v[k]]
             u = _raw(m, "u")[k]
             if u > 0:
@@ -347,7 +383,12 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
     line_sn, rebased = psse_branch_sn(ss)
     if rebased:
         notes.append(_psse_note(len(rebased), Sb))
+    lrow = {}   # ANDES Line idx -> row of L (lines on out-of-service buses have none)
     for k in range(line.n):
+        if on_off_bus(line, k, "bus1", "bus2"):
+            continue
+        kk = len(lrow)
+        lrow[line.idx.v[k]] = kk
         i, j = pos[line.bus1.v[k]], pos[line.bus2.v[k]]
         Sn, Vn1 = line_sn[k], _raw(line, "Vn1")[k]
         zc = (Vn1 ** 2 / Sn) / (Vn_bus[i] ** 2 / Sb)
@@ -358,9 +399,10 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
         if b1 != b2:
             raise DataError(f"ANDES Line {line.idx.v[k]}", "b1", b1, "asymmetric line charging (b1 != b2) unsupported")
         tap = _raw(line, "tap")[k]
-        L[k, :] = [i + 1, j + 1, _raw(line, "r")[k] * zc, _raw(line, "x")[k] * zc, (b + b1 + b2) / zc,
+        L[kk, :] = [i + 1, j + 1, _raw(line, "r")[k] * zc, _raw(line, "x")[k] * zc, (b + b1 + b2) / zc,
                    0, 0, 0, 0 if tap == 1 else tap, np.degrees(_raw(line, "phi")[k]),
                    1 if _raw(line, "u")[k] > 0 else 0, -360, 360]
+    L = L[:len(lrow)]
     case = {"baseMVA": Sb, "bus": B, "gen": np.array(G), "branch": L}
     _check_islands(case, bidx)
     fn = 60.0
@@ -383,7 +425,7 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
                 if _raw(m, fld)[k] != 1:
                     raise DataError(f"ANDES {mname} {m.idx.v[k]}", fld, _raw(m, fld)[k],
                                     "only one machine per static generator (gamma = 1) is supported")
-            if G[gen_row[m.gen.v[k]]][7] <= 0:
+            if gen_row[m.gen.v[k]] is None or G[gen_row[m.gen.v[k]]][7] <= 0:
                 notes.append(f"{mname} {m.idx.v[k]}: its static generator {m.gen.v[k]} is out of service, skipped")
                 continue
             name = f"{mname}_{m.idx.v[k]}"
@@ -436,7 +478,7 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
                 notes.append(f"{dev}: out of service (u = 0), skipped")
                 continue
             link = cls.andes_link(m, k, gen_row=gen_row, pos=pos, dev_name=dev_name, Sb=Sb, ss=ss)
-            if link is None:
+            if link is None or ("gen" in link and link["gen"] is None):
                 notes.append(f"{dev}: the device it controls is out of service, skipped")
                 continue
             name = f"{mname}_{m.idx.v[k]}"
@@ -448,38 +490,53 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard"):
     # every in-service static generator needs a dynamic model (machine or converter)
     used = {lk["gen"] for c in system.components.values() for lk in c.links if "gen" in lk}
     bare = [f"{mname} {ix} (bus {m.bus.v[k]})" for mname in ("Slack", "PV") for m in [ss.models[mname]]
-            for k, ix in enumerate(m.idx.v) if _raw(m, "u")[k] > 0 and gen_row[ix] not in used]
-    if bare:
+            for k, ix in enumerate(m.idx.v) if _raw(m, "u")[k] > 0 and gen_row[ix] not in used | {None}]
+    if bare and static_gens == "refuse":
         raise DataError("ANDES case", "StaticGen", bare,
                         f"the static generators {bare} have no in-service dynamic model (machine or "
                         "converter); add one or set their u = 0")
+    if bare:   # as ANDES: their power-flow equations stay in the time domain (weakgrid.sim.sources)
+        for mname, src in (("Slack", "InfiniteBus"), ("PV", "PVSource")):
+            m = ss.models[mname]
+            for k, ix in enumerate(m.idx.v):
+                if _raw(m, "u")[k] > 0 and gen_row[ix] not in used | {None}:
+                    system._component(src, "device").add(f"{mname}_{ix}", {"gen": gen_row[ix]}, {})
+                    what = ("an ideal voltage source (infinite bus: fixed voltage and angle, infinite "
+                            "inertia, unlimited current)" if mname == "Slack" else
+                            "a constant-P, constant-|V| source (no inertia, unlimited reactive power)")
+                    notes.append(f"{mname} {ix} (bus {m.bus.v[k]}): no dynamic model; simulated as ANDES "
+                                 f"does, as {what} ({src})")
     events = []
     if include_events:
-        lpos = {ix: k for k, ix in enumerate(line.idx.v)}
+        lpos = lrow
+        lu = {ix: _raw(line, "u")[k] > 0 for k, ix in enumerate(line.idx.v)}
         if "Toggle" in ss.models:
             tg = ss.Toggle
             # a Toggle flips the line's status (open -> close -> open ...): replay them in time
             # order from each line's initial status, so that a trip followed by a toggle recloses
-            status = {k: bool(_raw(line, "u")[k] > 0) for k in range(line.n)}
+            status = {r: bool(lu[ix]) for ix, r in lrow.items()}
             order = sorted(range(tg.n), key=lambda k: float(_raw(tg, "t")[k]))
             for k in order:
                 if _raw(tg, "u")[k] <= 0:
                     continue
                 if tg.model.v[k] != "Line":
                     raise DataError(f"ANDES Toggle {tg.idx.v[k]}", "model", tg.model.v[k], "only Line toggles supported")
+                if tg.dev.v[k] not in lpos:
+                    notes.append(f"Toggle {tg.idx.v[k]}: its line {tg.dev.v[k]} is on an out-of-service bus, ignored")
+                    continue
                 row = lpos[tg.dev.v[k]]
                 status[row] = not status[row]
                 events.append(LineTrip(row, float(_raw(tg, "t")[k]), close=status[row]))
         if "Fault" in ss.models:
             fl = ss.Fault
             for k in range(fl.n):
-                if _raw(fl, "u")[k] <= 0:
+                if _raw(fl, "u")[k] <= 0 or on_off_bus(fl, k, "bus"):
                     continue
                 tc = float(_raw(fl, "tc")[k])
                 events.append(Fault(pos[fl.bus.v[k]] + 1, float(_raw(fl, "tf")[k]), tc if tc > 0 else None,
                                     rf=float(_raw(fl, "rf")[k]), xf=float(_raw(fl, "xf")[k])))
     system.andes_bus_id = {b: pos[b] + 1 for b in bidx}
-    system.andes_line_row = {ix: k for k, ix in enumerate(line.idx.v)}
+    system.andes_line_row = dict(lrow)
     for mname, n in sorted(applied.items()):
         flags = ", ".join(f"{f} = {v:g}" for f, v in ANDES_CONVENTIONS[mname].items())
         notes.append(f"{mname} ({n}): ANDES 2.0 conventions, {flags}")

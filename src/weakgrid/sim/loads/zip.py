@@ -43,7 +43,7 @@ class ZIP(Component):
         """Link of ANDES ZIP ``k``: the bus and powers of the PQ load it replaces (None if off)."""
         pq = ss.PQ
         j = list(pq.idx.v).index(m.pq.v[k])
-        if pq.u.v[j] <= 0:
+        if pq.u.v[j] <= 0 or pq.bus.v[j] not in pos:   # off, or on an out-of-service bus
             return None
         # ``vin`` (input values) exists only after ANDES's setup; before it, ``v`` holds them
         p0 = float(pq.p0.v[j] if getattr(pq.p0, "vin", None) is None else pq.p0.vin[j])

@@ -148,8 +148,12 @@ def run_andes_ss(ss, tf, h, tol=1e-8, hold_step=False, configure=None):
                 om.append(mdl.omega.a[k])
                 de.append(mdl.delta.a[k])
                 names.append(f"{m}_{ix}")
-    return {"t": np.asarray(ts.t), "omega": np.asarray(ts.x[:, om]), "delta": np.asarray(ts.x[:, de]),
-            "names": names, "wall": wall, "ok": bool(ss.exit_code == 0), "ss": ss}
+    out = {"t": np.asarray(ts.t), "omega": np.asarray(ts.x[:, om]), "delta": np.asarray(ts.x[:, de]),
+           "names": names, "wall": wall, "ok": bool(ss.exit_code == 0), "ss": ss}
+    if not out["ok"]:
+        out["error"] = (f"ANDES exit code {ss.exit_code} (its run reached t = {float(ss.dae.t):.3g} s of {tf:g}; "
+                        "see its log, e.g. a failed TDS initialization check)")
+    return out
 
 
 def run_weakgrid_ss(ss, tf, h, tol=1e-8, conventions="standard", **kw):
