@@ -63,7 +63,8 @@ ratios themselves are noisy: 0.75x-1.72x), the engine before (``--dask-defaults`
 * CPU accounting: 1.75x → 1.81-1.83x warm; cold 1.61x → 1.95x without the cluster's start,
   1.60x with it (it now counts on both cores: 1.1-3.1 s; a 24-run sweep does not amortize
   it). The one warm ratio measured while the machine was quiet, before: 1.72x (plain pool
-  1.96x); after: none (another session's load came back during each run).
+  1.96x); after, on the idle machine (load average ~1): 24 runs 2.01x warm, 1.74x cold; 96 runs
+  (``bench_sweep.py 32``) 1.96x warm, 1.89x cold; the plain pool 2.02-2.03x.
 
 Run:  PYTHONPATH=src python benchmarks/bench_sweep.py [n_ratings] [--dask-defaults]
 
