@@ -28,7 +28,7 @@ Static generators without a dynamic model: a ``Slack`` or ``PV`` that no in-serv
 converter replaces keeps its power-flow equations in ANDES's time-domain simulation. weakgrid
 does the same (``static_gens="ideal"``, the default): a Slack becomes an
 :class:`~weakgrid.sim.sources.InfiniteBus` (ideal voltage source: fixed voltage and angle,
-infinite inertia), a PV a :class:`~weakgrid.sim.sources.PVSource` (constant P at constant |V|,
+infinite inertia), a PV a :class:`~weakgrid.sim.sources.PVSource` (constant P at constant ``|V|``,
 no inertia), each with a note in ``system.import_notes``; ``static_gens="refuse"`` refuses
 the case instead, naming them.
 
