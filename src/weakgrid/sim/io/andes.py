@@ -489,23 +489,22 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
             dev_name[(mname, m.idx.v[k])] = name
     # every in-service static generator needs a dynamic model (machine or converter)
     used = {lk["gen"] for c in system.components.values() for lk in c.links if "gen" in lk}
-    bare = [f"{mname} {ix} (bus {m.bus.v[k]})" for mname in ("Slack", "PV") for m in [ss.models[mname]]
+    bare = [(mname, ix, m.bus.v[k]) for mname in ("Slack", "PV") for m in [ss.models[mname]]
             for k, ix in enumerate(m.idx.v) if _raw(m, "u")[k] > 0 and gen_row[ix] not in used | {None}]
     if bare and static_gens == "refuse":
-        raise DataError("ANDES case", "StaticGen", bare,
-                        f"the static generators {bare} have no in-service dynamic model (machine or "
+        names = [f"{mname} {ix} (bus {b})" for mname, ix, b in bare]
+        raise DataError("ANDES case", "StaticGen", names,
+                        f"the static generators {names} have no in-service dynamic model (machine or "
                         "converter); add one or set their u = 0")
-    if bare:   # as ANDES: their power-flow equations stay in the time domain (weakgrid.sim.sources)
-        for mname, src in (("Slack", "InfiniteBus"), ("PV", "PVSource")):
-            m = ss.models[mname]
-            for k, ix in enumerate(m.idx.v):
-                if _raw(m, "u")[k] > 0 and gen_row[ix] not in used | {None}:
-                    system._component(src, "device").add(f"{mname}_{ix}", {"gen": gen_row[ix]}, {})
-                    what = ("an ideal voltage source (infinite bus: fixed voltage and angle, infinite "
-                            "inertia, unlimited current)" if mname == "Slack" else
-                            "a constant-P, constant-|V| source (no inertia, unlimited reactive power)")
-                    notes.append(f"{mname} {ix} (bus {m.bus.v[k]}): no dynamic model; simulated as ANDES "
-                                 f"does, as {what} ({src})")
+    # as ANDES: their power-flow equations stay in the time domain (weakgrid.sim.sources)
+    for mname, ix, b in bare:
+        src = "InfiniteBus" if mname == "Slack" else "PVSource"
+        system._component(src, "device").add_source(f"{mname}_{ix}", gen_row[ix])
+        what = ("an ideal voltage source (infinite bus: fixed voltage and angle, infinite "
+                "inertia, unlimited current)" if mname == "Slack" else
+                "a constant-P, constant-|V| source (no inertia, unlimited reactive power)")
+        notes.append(f"{mname} {ix} (bus {b}): no dynamic model; simulated as ANDES does, as "
+                     f"{what} ({src})")
     events = []
     if include_events:
         lpos = lrow

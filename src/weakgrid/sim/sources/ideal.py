@@ -48,10 +48,6 @@ class _BusConstraint(Component):
         self.add(name, {"gen": gen}, {})
         return name
 
-    @classmethod
-    def andes_link(cls, m, k, gen_row, **_):
-        return {"gen": gen_row[m.idx.v[k]]}
-
     def setup(self, system):
         super().setup(system)
         self.resolve_gen_rows(system)
