@@ -10,8 +10,8 @@ import numpy as np
 
 from ..game.hji import closed_loop_spectral_radius
 from ..game.errors import ParameterError
-from . import _checkpoint
-from ._checkpoint import CHECKPOINT_SECONDS, TrainingCheckpoint, add_restart_argument, outer_bar
+from ._checkpoint import (CHECKPOINT_SECONDS, TrainingCheckpoint, add_restart_argument,
+                          checkpoint_path, outer_bar, training_key)
 from ._common import (add_force_argument, add_problem_arguments, guard_training, output_file,
                       positive_float, problem_of)
 
@@ -156,14 +156,3 @@ def run(args) -> int:
 # (shared with design, gamma and verify: weakgrid.cli._checkpoint)
 __all__ = ["run", "add_parser", "checkpoint_path", "training_key", "CHECKPOINT_SECONDS"]
 
-
-def checkpoint_path(out: Path) -> Path:
-    """The checkpoint of the training that writes ``out``: beside it, ``.checkpoint.npz``."""
-    return _checkpoint.checkpoint_path(out)
-
-
-def training_key(problem, settings) -> str:
-    """A content hash of everything a training depends on: the problem file as read, the
-    model, cost (with any bound), mesh, basis and solver settings after the command-line
-    overrides, and the code (every source and data file of the package, with its version)."""
-    return _checkpoint.training_key(problem, settings, NAME)
