@@ -41,11 +41,16 @@ def test_every_registered_model_is_accepted_hygov():
     assert np.max(np.abs(F)) < 1e-6
 
 
-def test_measurement_models_ignored_with_a_note():
-    ss = load_case("kundur/kundur_coi.xlsx")
-    assert ss.COI.n > 0
+@pytest.mark.parametrize("case, model", [("kundur/kundur_coi.xlsx", "COI"),
+                                         ("kundur/kundur_freq.xlsx", "BusROCOF"),
+                                         ("ieee14/ieee14_freqdiv.xlsx", "FreqDiv"),
+                                         ("ieee14/ieee14_pll1.xlsx", "PLL1")])
+def test_measurement_models_ignored_with_a_note(case, model):
+    ss = load_case(case)
+    assert ss.models[model].n > 0
     system, _ = from_andes(ss)
-    assert any(n.startswith("COI") for n in system.import_notes)
+    assert any(n.startswith(f"{model} ({ss.models[model].n}): measurement-only")
+               for n in system.import_notes)
 
 
 def test_machine_of_out_of_service_generator_skipped():

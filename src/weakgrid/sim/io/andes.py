@@ -7,7 +7,7 @@ renewables — REGCA1 with its controls REECA1/REECB1 and REPCA1, PVD1 —, ZIP 
 parameters are read by their ANDES names), and the
 events ``Toggle`` (of a ``Line``: each toggle flips the line's status, so
 a second toggle recloses it) and ``Fault``. Measurement-only models
-(``BusFreq``, ``COI``, ``PMU``, ``ACEc``) and bookkeeping (``Area``,
+(``BusFreq``, ``BusROCOF``, ``FreqDiv``, ``PLL1``, ``PLL2``, ``COI``, ``PMU``, ``ACEc``) and bookkeeping (``Area``,
 ``Summary``) are ignored with a note in ``system.import_notes``: they feed no
 signal back into the grid models weakgrid has. Any other model with
 in-service devices raises one :class:`~weakgrid.sim.errors.DataError` that
@@ -59,7 +59,7 @@ from ..system import System, _registry
 
 _NETWORK = {"Bus", "Line", "PQ", "Shunt", "PV", "Slack", "Toggle", "Fault"}
 #: models ignored on import (measurements and bookkeeping; nothing in the grid reads them)
-_IGNORED = {"Area", "Summary", "BusFreq", "COI", "PMU", "ACEc"}
+_IGNORED = {"Area", "Summary", "BusFreq", "BusROCOF", "FreqDiv", "PLL1", "PLL2", "COI", "PMU", "ACEc"}
 _SUPPORTED = _NETWORK | _IGNORED   # plus the registry (see _supported())
 
 
