@@ -108,3 +108,22 @@ def test_zip_loads_of_a_case_not_set_up():
     with pytest.raises(DataError, match="kpp.*sum to 100") as e:
         system.setup()
     assert "= 90 %" in str(e.value)
+
+
+def test_ieeevc_links_to_the_machine_of_its_exciter():
+    # ANDES 2.0 fails to initialize this case (its exciters' input starts at the bus voltage);
+    # weakgrid's initial point includes the compensation and solves the DAE
+    ss = load_case("ieee14/ieee14_ieeevc2.xlsx")
+    avr_syn = {}
+    for name in ("IEEET1", "ESST3A"):
+        avr_syn.update(zip(ss.models[name].idx.v, ss.models[name].syn.v))
+    system, _ = from_andes(ss, conventions="andes")
+    vc = system.components["IEEEVC"]
+    assert vc.names == [f"IEEEVC_{i}" for i in ss.IEEEVC.idx.v]
+    assert [lk["machine"] for lk in vc.links] == [f"GENROU_{avr_syn[a]}" for a in ss.IEEEVC.avr.v]
+    assert [v["on_Sb"] for v in vc._values] == [1.0, 1.0]
+    system.setup()
+    F, _ = system.residual(0.0, system.z0)
+    assert np.max(np.abs(F)) < 1e-6
+    m = vc.mach
+    assert np.all(np.abs(system.sig_defaults["Ecomp0"][m] - system.sig_defaults["Vt0"][m]) > 0.02)

@@ -44,7 +44,7 @@ class Context:
         Output: current injected into each bus by the devices [pu].
     sig : dict of ndarray
         Machine-indexed signals (``omega``, ``delta``, ``Pe``, ``Qe``, ``Vt``,
-        ``XadIfd``, ``vf``, ``tm``, ``vs``) and other shared signals.
+        ``XadIfd``, ``vf``, ``tm``, ``vs``, ``Ecomp``) and other shared signals.
     out : dict of ndarray
         Recorded outputs, keyed ``"<Type>.<output>"``.
     """

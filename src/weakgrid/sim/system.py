@@ -26,7 +26,7 @@ from .errors import DataError
 from .network import Network
 
 SIGNALS = ("omega", "delta", "Pe", "Qe", "Vt", "theta", "XadIfd", "vf", "tm", "vs",
-           "vf0", "tm0", "Pe0", "Qe0", "delta0", "Vt0", "theta0")
+           "vf0", "tm0", "Pe0", "Qe0", "delta0", "Vt0", "theta0", "Ecomp", "Ecomp0")
 
 
 #: systems with at most this many buses keep a dense copy of the network matrix for the residual
@@ -90,13 +90,13 @@ def _registry():
     from .renewables import PVD1, REECA1, REECB1, REGCA1, REPCA1
     from .sources import InfiniteBus, PVSource
 
-    from .exciters import ESDC2A, ESST3A, EXAC1, EXST1, IEEET1, IEEEX1
+    from .exciters import ESDC2A, ESST3A, EXAC1, EXST1, IEEET1, IEEEVC, IEEEX1
     from .governors import IEEEG1, IEESGO, TG2, TGOV1N
     from .pss import ST2CUT
 
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
-                                    IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT)
+                                    IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT, IEEEVC)
             + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ZIP)
             + (InfiniteBus, PVSource)}
 
@@ -180,6 +180,10 @@ class System:
         return self._add_control("governor", model, name, machine, params,
                                  None if machine2 is None else {"machine2": machine2})
 
+    def add_compensator(self, model: str, name: str, machine: str, **params):
+        """Add a voltage compensator (IEEEVC) changing the input voltage of ``machine``'s exciter."""
+        return self._add_control("compensator", model, name, machine, params)
+
     def add_pss(self, model: str, name: str, machine: str, **params):
         """Add a power system stabilizer whose output enters the exciter of ``machine``."""
         return self._add_control("pss", model, name, machine, params)
@@ -230,6 +234,7 @@ class System:
         s["Qe"][m] = s["Qe0"][m] = Qe
         s["delta"][m] = s["delta0"][m] = delta
         s["Vt"][m] = s["Vt0"][m] = np.abs(V)
+        s["Ecomp"][m] = s["Ecomp0"][m] = np.abs(V)   # exciter input; a compensator (IEEEVC) changes it
         s["theta"][m] = s["theta0"][m] = np.angle(V)
         s["omega"][m] = 1.0
 
@@ -288,7 +293,7 @@ class System:
         self.nb = net.nb
         self.N = self.nx + 2 * self.nb
         x0 = np.zeros(self.nx)
-        for kind in ("machine", "device", "pss", "exciter", "governor"):
+        for kind in ("machine", "device", "compensator", "pss", "exciter", "governor"):
             for c in self.comps:
                 if c.kind == kind:
                     c.init(self, x0, self.sig_defaults)

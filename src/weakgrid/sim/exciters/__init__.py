@@ -6,7 +6,8 @@ from .exac1 import EXAC1
 from .exdc2 import EXDC2
 from .exst1 import EXST1
 from .ieeet1 import IEEET1
+from .ieeevc import IEEEVC
 from .ieeex1 import IEEEX1
 from .sexs import SEXS
 
-__all__ = ["EXDC2", "SEXS", "ESST3A", "EXST1", "IEEEX1", "IEEET1", "EXAC1", "ESDC2A"]
+__all__ = ["EXDC2", "SEXS", "ESST3A", "EXST1", "IEEEX1", "IEEET1", "EXAC1", "ESDC2A", "IEEEVC"]

@@ -80,12 +80,12 @@ class ESDC2A(MachineControl):
 
     def limit_values(self, ctx):
         """Current regulator limits ``(VRMIN*Vt, VRMAX*Vt)``."""
-        v = ctx.sig["Vt"][self.mach]
+        v = ctx.sig["Ecomp"][self.mach]
         return self.p["VRMIN"] * v, self._vrmax * v
 
     def init(self, system, x, sig):
         m = self.mach
-        vf0, v = sig["vf0"][m], sig["Vt0"][m]
+        vf0, v = sig["vf0"][m], sig["Ecomp0"][m]
         self._vt0 = v.copy()
         vr0 = self.EX.vr0(vf0)
         vi0 = vr0 / self.p["KA"]
@@ -100,7 +100,7 @@ class ESDC2A(MachineControl):
         m = self._mi
         lg, ll, vr, efd, wf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Vt"][..., m]
+        v = s["Ecomp"][..., m]
         sensed = np.where(self._lagged, self.LG.output(lg, v), v)
         vi = self.vref0 - sensed - self.WF.output(wf, efd) + s["vs"][..., m]
         f = ctx.f

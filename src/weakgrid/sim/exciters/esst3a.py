@@ -94,8 +94,8 @@ class ESST3A(MachineControl):
     def init(self, system, x, sig):
         p = self.p
         m = self.mach
-        vf0, v = sig["vf0"][m], sig["Vt0"][m]
-        V = v * np.exp(1j * sig["theta0"][m])
+        vf0, v = sig["vf0"][m], sig["Ecomp0"][m]
+        V = sig["Vt0"][m] * np.exp(1j * sig["theta0"][m])      # terminal phasor (for VE)
         It = np.conj((sig["Pe0"][m] + 1j * sig["Qe0"][m]) / V)
         VE0 = np.abs(self.KPC * V + 1j * (p["KI"] + self.KPC * p["XL"]) * It)
         VB0 = self._vb(VE0, sig["XadIfd"][m])
@@ -113,7 +113,7 @@ class ESST3A(MachineControl):
         m = self._mi
         lg, ll, vr, vm = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Vt"][..., m]
+        v = s["Ecomp"][..., m]
         vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
         vil = hard_limit(vi, p["VIMIN"], p["VIMAX"])
         va = self.LL.output(ll, vil)

@@ -82,7 +82,7 @@ class EXAC1(MachineControl):
     def init(self, system, x, sig):
         p = self.p
         m = self.mach
-        vf0, v, xad = sig["vf0"][m], sig["Vt0"][m], sig["XadIfd"][m]
+        vf0, v, xad = sig["vf0"][m], sig["Ecomp0"][m], sig["XadIfd"][m]
         lo = np.asarray(vf0, float).copy()                 # Efd <= VE
         hi = vf0 + 2.0 * p["KC"] * np.abs(xad) + 1.0         # FEX = 0 beyond IN = 1
         for _ in range(200):
@@ -104,7 +104,7 @@ class EXAC1(MachineControl):
         m = self._mi
         lg, ll, vr, ve, wf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Vt"][..., m]
+        v = s["Ecomp"][..., m]
         xad = s["XadIfd"][..., m]
         vfe = self.EX.vfe(ve) + p["KD"] * xad
         sensed = np.where(self._lagged, self.LG.output(lg, v), v)

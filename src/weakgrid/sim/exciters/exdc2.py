@@ -72,7 +72,7 @@ class EXDC2(MachineControl):
     def init(self, system, x, sig):
         p = self.p
         vf0 = sig["vf0"][self.mach]
-        v = sig["Vt0"][self.mach]
+        v = sig["Ecomp0"][self.mach]
         with np.errstate(divide="ignore", invalid="ignore"):
             Se0 = np.where(vf0 > self.SA, self.SB * (self.SA - vf0) ** 2 / vf0, 0.0)
         vr0 = (p["KE"] + Se0) * vf0
@@ -90,7 +90,7 @@ class EXDC2(MachineControl):
         m = self._mi
         sls = self._sls
         ls, ll, vr, vp, w = x[..., sls[0]], x[..., sls[1]], x[..., sls[2]], x[..., sls[3]], x[..., sls[4]]
-        v = ctx.sig["Vt"][..., m]
+        v = ctx.sig["Ecomp"][..., m]
         omega = ctx.sig["omega"][..., m]
         W = self.W.output(w, vp)
         vi = self.vref0 - self.LS.output(ls, v) - W + ctx.sig["vs"][..., m]

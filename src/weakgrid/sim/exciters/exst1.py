@@ -66,7 +66,7 @@ class EXST1(MachineControl):
     def init(self, system, x, sig):
         p = self.p
         m = self.mach
-        vf0, v = sig["vf0"][m], sig["Vt0"][m]
+        vf0, v = sig["vf0"][m], sig["Ecomp0"][m]
         vi0 = vf0 / p["KA"]
         self.vref0 = v + vi0
         x[self.sl(0)] = self.LG.init(v)
@@ -79,7 +79,7 @@ class EXST1(MachineControl):
         m = self._mi
         lg, ll, vr, wf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Vt"][..., m]
+        v = s["Ecomp"][..., m]
         xad = s["XadIfd"][..., m]
         lo, hi = p["VRMIN"] - p["KC"] * xad, p["VRMAX"] - p["KC"] * xad
         fb_in = np.where(self._std, hard_limit(vr, lo, hi), vr)        # rate feedback input

@@ -55,7 +55,7 @@ class IEEET1(MachineControl):
 
     def init(self, system, x, sig):
         m = self.mach
-        vf0, v = sig["vf0"][m], sig["Vt0"][m]
+        vf0, v = sig["vf0"][m], sig["Ecomp0"][m]
         vr0 = self.EX.vr0(vf0)
         self.vref0 = v + vr0 / self.p["KA"]
         x[self.sl(0)] = self.LG.init(v)
@@ -67,7 +67,7 @@ class IEEET1(MachineControl):
         m = self._mi
         lg, vr, efd, wf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Vt"][..., m]
+        v = s["Ecomp"][..., m]
         vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)

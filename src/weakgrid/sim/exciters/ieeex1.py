@@ -50,9 +50,9 @@ class IEEEX1(EXDC2):
 
     def limit_values(self, ctx):
         """Current regulator limits ``(VRMIN*Vt, VRMAX*Vt)`` (one entry per instance)."""
-        k = self._scale(ctx.sig["Vt"][self.mach])
+        k = self._scale(ctx.sig["Ecomp"][self.mach])
         return self.p["VRMIN"] * k, self.p["VRMAX"] * k
 
     def init(self, system, x, sig):
         super().init(system, x, sig)
-        self._vt0 = sig["Vt0"][self.mach].copy()
+        self._vt0 = sig["Ecomp0"][self.mach].copy()

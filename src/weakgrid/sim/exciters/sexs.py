@@ -50,14 +50,14 @@ class SEXS(MachineControl):
     def init(self, system, x, sig):
         vf0 = sig["vf0"][self.mach]
         vi0 = vf0 / self.p["K"]
-        self.vref0 = sig["Vt0"][self.mach] + vi0
+        self.vref0 = sig["Ecomp0"][self.mach] + vi0
         x[self.sl(0)] = self.LL.init(vi0)
         x[self.sl(1)] = vf0
 
     def compute(self, ctx):
         m = self.mach
         ll, law = ctx.x[..., self._sls[0]], ctx.x[..., self._sls[1]]
-        vi = self.vref0 - ctx.sig["Vt"][..., m] + ctx.sig["vs"][..., m]
+        vi = self.vref0 - ctx.sig["Ecomp"][..., m] + ctx.sig["vs"][..., m]
         y = self.LL.output(ll, vi)
         ctx.f[..., self._sls[0]] = self.LL.deriv(ll, vi)
         ctx.f[..., self._sls[1]] = self.LAW.deriv(law, y)

@@ -74,6 +74,7 @@ ANDES_CONVENTIONS = {
     "ESDC2A": {"TR_used": 0.0},   # idem
     "IEEEX1": {"VR_Vt": 0.0},     # regulator limits VRMAX, VRMIN, not times Vt
     "EXST1": {"VR_limited": 0.0},  # output limit tested on the rate feedback (in effect never acts)
+    "IEEEVC": {"on_Sb": 1.0},     # rc, xc on the system base (its IEEEVC has no Sn)
 }
 CONVENTIONS = ("standard", "andes")
 
@@ -102,6 +103,7 @@ _CONTROL_FIELDS = {
     "IEESGO": ("Tn", "wref0", "T1", "T2", "T3", "T4", "T5", "T6", "K1", "K2", "K3", "PMAX", "PMIN"),
     "TG2": ("Tn", "wref0", "R", "pmax", "pmin", "dbl", "dbu", "dbc", "T1", "T2"),
     "TGOV1N": ("Tn", "wref0", "R", "VMAX", "VMIN", "T1", "T2", "T3", "Dt"),
+    "IEEEVC": ("rc", "xc"),
     "ST2CUT": ("MODE", "MODE2", "K1", "K2", "T1", "T2", "T3", "T4", "T5", "T6", "T7", "T8", "T9", "T10",
                "LSMAX", "LSMIN", "VCU", "VCL"),
 }
@@ -431,10 +433,11 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
             name = f"{mname}_{m.idx.v[k]}"
             system.add_machine(mname, name, gen_row[m.gen.v[k]], **_params(cls, m, k))
             syn_name[m.idx.v[k]] = name
-    # machine controls: exciters and governors link to `syn`, stabilizers to `avr`
+    # machine controls: exciters and governors link to `syn`, stabilizers and compensators to `avr`
     avr_syn = {}
-    add = {"exciter": system.add_exciter, "governor": system.add_governor, "pss": system.add_pss}
-    for kind in ("exciter", "governor", "pss"):
+    add = {"exciter": system.add_exciter, "governor": system.add_governor, "pss": system.add_pss,
+           "compensator": system.add_compensator}
+    for kind in ("exciter", "governor", "pss", "compensator"):
         for mname, cls in reg.items():
             m = ss.models.get(mname)
             if cls.kind != kind or m is None:
@@ -444,7 +447,7 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
                 if _raw(m, "u")[k] <= 0:
                     notes.append(f"{dev}: out of service (u = 0), skipped")
                     continue
-                syn = avr_syn.get(m.avr.v[k]) if kind == "pss" else syn_name.get(m.syn.v[k])
+                syn = avr_syn.get(m.avr.v[k]) if kind in ("pss", "compensator") else syn_name.get(m.syn.v[k])
                 if syn is None:
                     notes.append(f"{dev}: its machine is out of service, skipped")
                     continue

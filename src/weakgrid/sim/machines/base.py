@@ -27,7 +27,8 @@ class SyncMachine(Component):
 
     Signals published (machine-indexed): ``omega``, ``delta``, ``Pe``, ``Qe``,
     ``Vt`` (terminal voltage magnitude), ``theta`` (terminal voltage angle),
-    ``XadIfd``; defaults for ``vf`` and ``tm`` are the initial values (used when
+    ``XadIfd``, ``Ecomp`` (the exciters' input voltage: ``Vt`` unless a compensator such
+    as IEEEVC changes it); defaults for ``vf`` and ``tm`` are the initial values (used when
     no exciter/governor is attached).
     """
 
@@ -80,6 +81,6 @@ class SyncMachine(Component):
         sig["delta"][..., m] = delta
         sig["Pe"][..., m] = Pe
         sig["Qe"][..., m] = Qe
-        sig["Vt"][..., m] = np.abs(V)
+        sig["Vt"][..., m] = sig["Ecomp"][..., m] = np.abs(V)
         sig["theta"][..., m] = np.angle(V)
         sig["XadIfd"][..., m] = XadIfd
