@@ -42,6 +42,7 @@ from kundur_variants import kundur_variant  # noqa: E402
 
 from weakgrid.sim.errors import DataError  # noqa: E402
 from weakgrid.sim.exciters.exac1 import EXAC1  # noqa: E402
+from weakgrid.sim.system import _registry  # noqa: E402
 from weakgrid.sim.io.andes import ANDES_CONVENTIONS, from_andes  # noqa: E402
 from weakgrid.sim.params import validate  # noqa: E402
 from weakgrid.sim.peer.andes_case import compare_named, load_case, run_andes_ss, run_weakgrid_ss  # noqa: E402
@@ -77,7 +78,13 @@ def test_flags_accept_only_0_or_1():
     assert validate("EXAC1 'x'", EXAC1.params, {"TR_used": 0})["TR_used"] == 0
     with pytest.raises(DataError, match="TR_used"):
         validate("EXAC1 'x'", EXAC1.params, {"TR_used": 0.5})
-    assert set(ANDES_CONVENTIONS) == {"EXAC1", "ESDC2A", "IEEEX1", "EXST1"}
+    # every convention is a 0/1 flag parameter of its model, whose default is the standard
+    reg = _registry()
+    for model, flags in ANDES_CONVENTIONS.items():
+        params = {p.name: p for p in reg[model].params}
+        for name, value in flags.items():
+            assert params[name].rule == "flag" and value in (0.0, 1.0)
+            assert params[name].default != value
 
 
 CENSUS = {
