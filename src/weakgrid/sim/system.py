@@ -87,7 +87,7 @@ def _registry():
     from .machines import GENCLS, GENROU
     from .pss import IEEEST
     from .loads import ZIP
-    from .renewables import PVD1, REECA1, REECB1, REGCA1, REPCA1
+    from .renewables import ESD1, PVD1, REECA1, REECB1, REGCA1, REPCA1
     from .sources import InfiniteBus, PVSource
 
     from .exciters import ESDC2A, ESST3A, EXAC1, EXST1, IEEET1, IEEEVC, IEEEX1
@@ -97,7 +97,7 @@ def _registry():
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
                                     IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT, IEEEVC)
-            + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ZIP)
+            + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ESD1, ZIP)
             + (InfiniteBus, PVSource)}
 
 
@@ -330,7 +330,9 @@ class System:
         Limits first: each non-windup limited state must start inside ``[lower, upper]``
         (to 1e-9), else the integrator would clamp it at t = 0+ and the grid would drift
         with no event. Then the residual ``F(0, z0) = [f; g]``: every state derivative
-        and every bus current mismatch must be below ``tol``.
+        and every bus current mismatch must be below ``tol`` (except the derivatives of the
+        states a component lists in ``integrating_states``, which move at a steady state:
+        a storage's state of charge).
 
         ``tol = 1e-6`` pu: the power flow is solved to 1e-9 MVA and the models initialize
         in closed form, so a consistent initial point has residuals of ~1e-10; any real
@@ -380,11 +382,15 @@ class System:
             k = int(np.nonzero(~np.isfinite(F))[0][0])
             raise DataError("initial point", self.var_name(k), float(F[k]),
                             "the initialization produced a non-finite residual; check this element's data")
-        worst_x = float(np.max(np.abs(F[:nx]))) if nx else 0.0
+        Fx = F[:nx].copy()
+        for c in self.comps:   # states that integrate at a steady state (a storage's SOC)
+            for st in getattr(c, "integrating_states", ()):
+                Fx[c.idx(st)] = 0.0
+        worst_x = float(np.max(np.abs(Fx))) if nx else 0.0
         mis = np.abs(F[nx:nx + self.nb] + 1j * F[nx + self.nb:])
         worst_g = float(mis.max()) if self.nb else 0.0
         if worst_x > tol:
-            k = int(np.argmax(np.abs(F[:nx])))
+            k = int(np.argmax(np.abs(Fx)))
             raise DataError(f"initial point: state {self.var_name(k)}", "derivative", float(F[k]),
                             f"the initialization does not solve the DAE (|dx/dt| = {abs(F[k]):.3g} > "
                             f"{tol:g}); check this device's data and its link to the power flow")

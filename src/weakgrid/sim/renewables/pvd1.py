@@ -91,14 +91,20 @@ class PVD1(Component):
         """Link of ANDES PVD1 ``k``: its static generator row, with its BusFreq constants."""
         return {"gen": gen_row[m.gen.v[k]], "busf": m.busf.v[k]}
 
+    #: names of the frequency-measurement constants (the BusFreq's ``Tf``, ``Tw``)
+    freq_params = ("Tf", "Tw")
+
     @classmethod
     def andes_params(cls, m, k, ss, values):
         """Add ``Tf``, ``Tw`` of the BusFreq device named in ``busf`` (ANDES defaults otherwise)."""
         bf = m.busf.v[k]
+        tf, tw = cls.freq_params
         if bf is not None and "BusFreq" in ss.models and bf in list(ss.BusFreq.idx.v):
             j = list(ss.BusFreq.idx.v).index(bf)
-            values["Tf"] = float(ss.BusFreq.Tf.v[j])
-            values["Tw"] = float(ss.BusFreq.Tw.v[j])
+            values[tf] = float(ss.BusFreq.Tf.v[j])
+            values[tw] = float(ss.BusFreq.Tw.v[j])
+        else:
+            values.pop(tf, None)   # an ANDES field of the same name is not the BusFreq's
         return values
 
     def add_pvd1(self, name, gen, **params):
@@ -124,8 +130,9 @@ class PVD1(Component):
                 p[prm.name] = p[prm.name] * c
         self._uniq = len(set(self.bus.tolist())) == self.n
         self.iwn = 1.0 / (2 * np.pi * p["fn"])
-        self.Lb = Lag(1.0, p["Tf"])
-        self.WOb = Washout(self.iwn, p["Tw"])
+        self.Lb = Lag(1.0, p[self.freq_params[0]])
+        self.WOb = Washout(self.iwn, p[self.freq_params[1]])
+        self._key = {o: f"{self.type_name}.{o}" for o in self.outputs}
         self.Ipb = Lag(1.0, p["tip"])
         self.Iqb = Lag(1.0, p["tiq"])
 
@@ -133,7 +140,14 @@ class PVD1(Component):
         return [(self.instance_states(i) + system.bus_vars(self.bus[i]),) * 2 for i in range(self.n)]
 
     # ---------------------------------------------------------------- algebra
-    def _commands(self, v, V, fHz, ipout, iqout):
+    #: lower bound of the active-power command, as a fraction of ``pmx`` (PV: no absorption)
+    pmin_frac = 0.0
+
+    def _ip_gates(self, x):
+        """Factors ``(lo, hi)`` of the active-current limits: ``lo*Ipmax <= Ipcmd <= hi*Ipmax``."""
+        return 0.0, 1.0
+
+    def _commands(self, v, V, fHz, ipout, iqout, gates=(0.0, 1.0)):
         p = self.p
         vp = np.maximum(v, 0.01)
         R = _band_lo(v, p["vt0"], p["vt1"]) * _band_hi(v, p["vt2"], p["vt3"]) \
@@ -143,7 +157,8 @@ class PVD1(Component):
         pdrp = p["ddn"] * (np.where(fdev >= 999.0, fdev - 999.0, 0.0)
                            + np.where(fdev <= p["fdbd"], fdev - p["fdbd"], 0.0))
         psum = self.pref0 + pdrp
-        ipul = np.where(psum >= p["pmx"], p["pmx"], np.where(psum <= 0.0, 0.0, psum)) / vp
+        pmin = self.pmin_frac * p["pmx"]
+        ipul = np.where(psum >= p["pmx"], p["pmx"], np.where(psum <= pmin, pmin, psum)) / vp
         vcomp = np.abs(V + 1j * p["xc"] * (ipout + 1j * iqout))
         qdrp = np.where(vcomp <= self.Vql, p["qmx"], 0.0) + np.where(vcomp >= self.Vqu, p["qmn"], 0.0) \
             + np.where((vcomp > self.Vql) & (vcomp < p["v0"]), p["qmx"] + p["dqdv"] * (self.Vqu - vcomp), 0.0) \
@@ -152,12 +167,13 @@ class PVD1(Component):
         pri = p["pqflag"] > 0
         lim = p["ialim"]
         # P priority: Ip limited by ialim, Iq by what is left; Q priority the other way round
-        ipcmd_p = R * np.clip(ipul, 0.0, lim)
+        glo, ghi = gates
+        ipcmd_p = R * np.clip(ipul, glo * lim, ghi * lim)
         iqmax_p = np.sqrt(np.maximum(lim ** 2 - ipcmd_p ** 2, 0.0))
         iqcmd_p = R * np.clip(iqul, -iqmax_p, iqmax_p)
         iqcmd_q = R * np.clip(iqul, -lim, lim)
         ipmax_q = np.sqrt(np.maximum(lim ** 2 - iqcmd_q ** 2, 0.0))
-        ipcmd_q = R * np.clip(ipul, 0.0, ipmax_q)
+        ipcmd_q = R * np.clip(ipul, glo * ipmax_q, ghi * ipmax_q)
         return np.where(pri, ipcmd_p, ipcmd_q), np.where(pri, iqcmd_p, iqcmd_q), R, qdrp, ipul
 
     def init(self, system, x, sig):
@@ -172,7 +188,7 @@ class PVD1(Component):
             self.Vqu = p["v1"] - (self.qref0 - p["qmn"]) / p["dqdv"]
             self.Vql = p["v0"] + (p["qmx"] - self.qref0) / p["dqdv"]
         ip0, iq0 = self.pref0 / v, self.qref0 / v
-        ipc, iqc, R, qdrp, _ = self._commands(v, V, p["fn"], ip0, iq0)
+        ipc, iqc, R, qdrp, _ = self._commands(v, V, p["fn"], ip0, iq0, self._init_gates())
         bad = (np.abs(ipc - ip0) > 1e-9) | (np.abs(iqc - iq0) > 1e-9)
         for i in np.nonzero(bad)[0]:
             why = ("the voltage or frequency is in a trip band" if R[i] < 1 else
@@ -186,6 +202,9 @@ class PVD1(Component):
         x[self.sl(2)] = ip0
         x[self.sl(3)] = iq0
 
+    def _init_gates(self):
+        return 0.0, 1.0
+
     # -------------------------------------------------------------- equations
     def compute(self, ctx):
         x = ctx.x
@@ -198,7 +217,7 @@ class PVD1(Component):
         err = np.angle(V * np.conj(self.V0) * np.exp(-1j * L))
         df = self.WOb.output(wo, L)
         fHz = self.p["fn"] * (1.0 + df)
-        ipcmd, iqcmd, R, _, ipul = self._commands(v, V, fHz, ipout, iqout)
+        ipcmd, iqcmd, R, _, ipul = self._commands(v, V, fHz, ipout, iqout, self._ip_gates(x))
         vs = np.where(v > 1e-6, v, 1e-6)
         scatter_add(ctx.I, self.bus, (ipout - 1j * iqout) * V / vs, self._uniq)
         f = ctx.f
@@ -206,6 +225,7 @@ class PVD1(Component):
         f[..., sl[1]] = self.WOb.deriv(wo, L)
         f[..., sl[2]] = self.Ipb.deriv(ipout, ipcmd)
         f[..., sl[3]] = self.Iqb.deriv(iqout, iqcmd)
-        o = ctx.out
-        o["PVD1.fHz"], o["PVD1.R"], o["PVD1.Ipcmd"], o["PVD1.Iqcmd"] = fHz, R, ipcmd, iqcmd
-        o["PVD1.Pe"], o["PVD1.Qe"], o["PVD1.Ipul"] = ipout * v, iqout * v, ipul
+        o, k = ctx.out, self._key
+        o[k["fHz"]], o[k["R"]], o[k["Ipcmd"]], o[k["Iqcmd"]] = fHz, R, ipcmd, iqcmd
+        o[k["Pe"]], o[k["Qe"]], o[k["Ipul"]] = ipout * v, iqout * v, ipul
+        return ipout, v
