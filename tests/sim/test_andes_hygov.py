@@ -164,3 +164,30 @@ def test_kundur_hygov_remainder_is_andes_step_error_at_the_exciter_ceiling(tmp_p
     va = np.asarray(ss.dae.ts.x[:, ss.EXDC2.LA_y.a])
     assert np.all(va[:, 2:].max(axis=0) >= 5.2 - 1e-9)
     assert gw < SPEED_TOL and dw_deg < ANGLE_TOL and gw < g1 / 10
+
+
+@pytest.mark.slow
+def test_nordic44_hygovs_match_andes_with_its_conventions(tmp_path):
+    """ANDES's nordic44 (raw + dyr) without the IEEET2/STAB2A records ANDES's parser drops:
+    50 HYGOV on 680-1650 MVA units of a 1000-MVA system, all with ``Dt > 0``."""
+    import re
+
+    src = open(andes.get_case("nordic44/N44_BC.dyr")).read()
+    records = [r for r in src.split("/") if r.strip()]
+    kept = [r for r in records if not re.search(r"'(IEEET2|STAB2A)'", r)]
+    assert len(records) - len(kept) == 12 + 53
+    dyr = tmp_path / "N44_BC_no_ieeet2_stab2a.dyr"
+    dyr.write_text("/\n".join(kept) + "/\n")
+    raw = andes.get_case("nordic44/N44_BC.raw")
+    a = run_andes_ss(load_case(raw, str(dyr), fault="auto"), 5.0, H, hold_step=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        w = run_weakgrid_ss(load_case(raw, str(dyr), fault="auto"), 5.0, H, conventions="andes")
+        s = run_weakgrid_ss(load_case(raw, str(dyr), fault="auto"), 5.0, H)
+    assert a["ok"] and w["ok"] and s["ok"]
+    assert w["system"].conventions_applied["HYGOV"] == 50
+    dw, dd = compare_named(a, w)
+    dw_s, dd_s = compare_named(a, s)
+    print(f"nordic44: ANDES conventions {dw:.3g} pu / {dd:.3g} deg; standard {dw_s:.3g} pu / {dd_s:.3g} deg")
+    assert dw < SPEED_TOL and dd < ANGLE_TOL
+    assert dw_s == pytest.approx(6.6e-5, rel=0.05) and dw_s > 10 * dw
