@@ -18,7 +18,7 @@ folder whose name is the longest prefix of its own). For each:
 Two columns: weakgrid with its standard models (``conventions="standard"``, the default of the
 importer) and with ANDES 2.0's documented departures from them (``conventions="andes"``: EXAC1
 and ESDC2A without their sensing lag, IEEEX1 with constant regulator limits, EXST1's output
-limiter; see
+limiter, HYGOV's system-base equations; see
 :data:`weakgrid.sim.io.andes.ANDES_CONVENTIONS`). A case none of whose models has such a
 departure gets the same result in both (``"andes": {"same": true}``); otherwise weakgrid runs
 again with the ANDES conventions against the same ANDES run (with the same step halving).

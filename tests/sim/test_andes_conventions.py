@@ -10,7 +10,10 @@ that a peer comparison isolates real differences:
 * IEEEX1: ``VR_Vt = 0`` -- ANDES's anti-windup limiter keeps the constant bounds ``VRMAX``,
   ``VRMIN`` (not ``VRMAX*Vt``);
 * EXST1: ``VR_limited = 0`` -- ANDES tests its output limits on the rate-feedback signal, so
-  the regulator output passes unlimited (and feeds the rate feedback).
+  the regulator output passes unlimited (and feeds the rate feedback);
+* HYGOV: ``Tr_used = 0, Tw_sysbase = 1, Dt_sysbase = 1, VELM_offset = 1`` -- ANDES computes it
+  on the system base (unit-gain gate integrator, water column and damping in system-base
+  values) with rate bounds ``±VELM - x1/r`` (``test_andes_hygov.py``).
 
 The census inputs these departures made mismatch (ANDES's census fault: three-phase at the
 bus of the first load, 1.0-1.05 s; 5 s at 1/120 s in both tools), measured 2026-11-26:
