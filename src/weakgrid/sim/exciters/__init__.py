@@ -8,5 +8,9 @@ from .exst1 import EXST1
 from .ieeet1 import IEEET1
 from .ieeex1 import IEEEX1
 from .sexs import SEXS
+from .esst4b import ESST4B
+from .exac4 import EXAC4
+from .ac8b import AC8B
 
 __all__ = ["EXDC2", "SEXS", "ESST3A", "EXST1", "IEEEX1", "IEEET1", "EXAC1", "ESDC2A"]
+__all__ += ["ESST4B", "EXAC4", "AC8B"]

@@ -74,6 +74,8 @@ ANDES_CONVENTIONS = {
     "ESDC2A": {"TR_used": 0.0},   # idem
     "IEEEX1": {"VR_Vt": 0.0},     # regulator limits VRMAX, VRMIN, not times Vt
     "EXST1": {"VR_limited": 0.0},  # output limit tested on the rate feedback (in effect never acts)
+    "ESST4B": {"PI_nonwindup": 0.0},   # PI regulators with tracking anti-windup (Ks = 2)
+    "AC8B": {"PID_nonwindup": 0.0, "VE_limited": 0.0},   # tracking PID; VEMIN, VFEMAX unused
 }
 CONVENTIONS = ("standard", "andes")
 
@@ -102,6 +104,12 @@ _CONTROL_FIELDS = {
     "IEESGO": ("Tn", "wref0", "T1", "T2", "T3", "T4", "T5", "T6", "K1", "K2", "K3", "PMAX", "PMIN"),
     "TG2": ("Tn", "wref0", "R", "pmax", "pmin", "dbl", "dbu", "dbc", "T1", "T2"),
     "TGOV1N": ("Tn", "wref0", "R", "VMAX", "VMIN", "T1", "T2", "T3", "Dt"),
+    "ESST4B": ("TR", "KPR", "KIR", "VRMAX", "VRMIN", "TA", "KPM", "KIM", "VMMAX", "VMMIN", "KG", "KP", "KI",
+               "VBMAX", "KC", "XL", "THETAP", "VGMAX"),
+    "EXAC4": ("TR", "VIMAX", "VIMIN", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KC"),
+    "AC8B": ("TR", "kP", "kI", "kD", "Td", "VPMAX", "VPMIN", "VRMAX", "VRMIN", "VFEMAX", "VEMIN", "TA", "KA",
+             "TE", "E1", "SE1", "E2", "SE2", "KE", "KD", "KC"),
+    "GAST": ("Tn", "wref0", "R", "VMAX", "VMIN", "KT", "AT", "T1", "T2", "T3", "Dt"),
     "ST2CUT": ("MODE", "MODE2", "K1", "K2", "T1", "T2", "T3", "T4", "T5", "T6", "T7", "T8", "T9", "T10",
                "LSMAX", "LSMIN", "VCU", "VCL"),
 }
