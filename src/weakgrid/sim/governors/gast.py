@@ -48,7 +48,7 @@ class GAST(MachineControl):
         Param("Dt", 0.0, "pu (turbine base)", "turbine damping", "", "power"),
     )
     states = ("LAG", "LG2", "LT")
-    outputs = ("plim", "pout")
+    outputs = ("pd", "plim", "pout")
     #: parameter names of the limits of each limited state (for error messages)
     limit_fields = {"LAG": ("VMIN", "VMAX")}
 
@@ -89,4 +89,4 @@ class GAST(MachineControl):
         f[..., self._sls[2]] = self.LT.deriv(lt, y2)
         pout = y2 - p["Dt"] * wd
         ctx.sig["tm"][..., m] = pout
-        ctx.out["GAST.plim"], ctx.out["GAST.pout"] = plim, pout
+        ctx.out["GAST.pd"], ctx.out["GAST.plim"], ctx.out["GAST.pout"] = pd, plim, pout
