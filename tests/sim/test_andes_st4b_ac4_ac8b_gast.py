@@ -123,7 +123,8 @@ def test_gast_limits():
     ("ieee14/ieee14_esst4b.xlsx", "ESST4B", ("TR", "TA", "KG", "KI", "XL")),
     ("ieee14/ieee14_exac4.xlsx", "EXAC4", ("TR", "TB", "TC")),
     ("ieee14/ieee14_ac8b.xlsx", "AC8B", ("TR", "kD", "kI")),
-], ids=["ESST4B", "EXAC4", "AC8B"])
+    ("ieee14/ieee14_ieeet1.xlsx", "IEEET1", ("TA",)),      # EI_33's IEEET1 data (before: refused)
+], ids=["ESST4B", "EXAC4", "AC8B", "IEEET1"])
 def test_zero_parameters_as_andes(case, model, zeros):
     """Zeros meaning "absent" (no sensing lag, no regulator delay, no lead-lag, no feedback,
     no derivative/integral action) are read as ANDES reads them. (AC8B with ``TA = 0`` is

@@ -25,6 +25,11 @@ Differences from ANDES 2.0 (documented, not copied), each reproduced by a flag t
 * ANDES does not apply ``VEMIN`` and ``VFEMAX`` (its ``VE`` integrator is unlimited):
   ``VE_limited = 0``. They agree while ``VE`` stays above ``VEMIN`` and ``VFE`` below
   ``VFEMAX`` (ANDES's ieee14 data: -999 and 999).
+
+Not reproduced: with ``TA = 0`` the regulator here is ``clip(KA*VPID, VRMIN, VRMAX)``, while
+ANDES's anti-windup is not enforced on a zero time constant and its regulator output leaves
+the limits (54.6 and -30.6 pu with ``VRMAX = 7.3``, ``VRMIN = 1`` on ieee14_ac8b, census fault;
+3.4e-4 pu of speed apart).
 """
 
 from __future__ import annotations
