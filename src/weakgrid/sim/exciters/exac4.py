@@ -18,7 +18,6 @@ so that ``Efd = vf0``; the initial input ``vf0/KA`` must lie within ``VIMIN..VIM
 
 from __future__ import annotations
 
-
 from ..blocks import Lag, LeadLag, hard_limit
 from ..control_base import MachineControl
 from ..params import Param
