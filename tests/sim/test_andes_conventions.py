@@ -77,7 +77,13 @@ def test_flags_accept_only_0_or_1():
     assert validate("EXAC1 'x'", EXAC1.params, {"TR_used": 0})["TR_used"] == 0
     with pytest.raises(DataError, match="TR_used"):
         validate("EXAC1 'x'", EXAC1.params, {"TR_used": 0.5})
-    assert set(ANDES_CONVENTIONS) == {"EXAC1", "ESDC2A", "IEEEX1", "EXST1"}
+    assert {"EXAC1", "ESDC2A", "IEEEX1", "EXST1", "ESST4B", "AC8B"} <= set(ANDES_CONVENTIONS)
+    from weakgrid.sim.system import _registry
+
+    for model, flags in ANDES_CONVENTIONS.items():   # each a declared flag of a registered model
+        declared = {prm.name: prm for prm in _registry()[model].params}
+        for flag, value in flags.items():
+            assert declared[flag].rule == "flag" and declared[flag].default == 1.0 and value == 0.0
 
 
 CENSUS = {
