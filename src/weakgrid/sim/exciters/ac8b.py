@@ -20,7 +20,8 @@ Differences from ANDES 2.0 (documented, not copied), each reproduced by a flag t
 ``from_andes(..., conventions="andes")`` sets:
 
 * ANDES's PID has a *tracking* anti-windup (integrator driven back by ``Ks = 2`` times the part
-  of the output its limiter cuts, ``PIDTrackAW``) instead of non-windup limits:
+  of the output its limiter cuts, ``PIDTrackAW``) instead of non-windup limits (as IEEE
+  421.5-2016 draws VPIDMAX, VPIDMIN in AC8C):
   ``PID_nonwindup = 0``. They agree while the PID output stays inside ``VPMIN..VPMAX``.
 * ANDES does not apply ``VEMIN`` and ``VFEMAX`` (its ``VE`` integrator is unlimited):
   ``VE_limited = 0``. They agree while ``VE`` stays above ``VEMIN`` and ``VFE`` below
