@@ -93,12 +93,15 @@ def _registry():
     from .exciters import ESDC2A, ESST3A, EXAC1, EXST1, IEEET1, IEEEVC, IEEEX1
     from .governors import IEEEG1, IEESGO, TG2, TGOV1N
     from .pss import ST2CUT
+    from .exciters import AC8B, ESST4B, EXAC4
+    from .governors import GAST
 
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
                                     IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT, IEEEVC)
             + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ESD1, ZIP)
-            + (InfiniteBus, PVSource)}
+            + (InfiniteBus, PVSource)
+            + (ESST4B, EXAC4, AC8B, GAST)}
 
 
 class System:
@@ -376,6 +379,26 @@ class System:
                         raise DataError(f"{c.type_name} '{st[0]}'", bad[0], float(bad[1]),
                                         f"{msg}. Raise the limit, change the dispatch/voltage set point, "
                                         'or pass System.setup(limits="warn") to clamp it (as ANDES does)')
+        # static (windup) limits and gates whose initial input must lie inside them
+        # (components set ``initial_bounds`` in init: (signal, value, lower, upper, lower_field,
+        # upper_field), arrays over the component's devices); beyond them the output would be
+        # cut at t = 0+ and the grid would drift with no event, as for a non-windup state
+        for c in self.comps:
+            for sig, val, lo, hi, flo, fhi in getattr(c, "initial_bounds", ()):
+                val, lo, hi = (np.broadcast_to(np.asarray(a, float), (c.n,)) for a in (val, lo, hi))
+                for k in range(c.n):
+                    if lo[k] - 1e-9 <= val[k] <= hi[k] + 1e-9:
+                        continue
+                    fld, lim, side = (fhi, hi[k], "above") if val[k] > hi[k] else (flo, lo[k], "below")
+                    msg = (f"initial value of {sig} = {val[k]:.6g} pu is {side} {fld} = {lim:.6g} pu: "
+                           "the operating point needs a signal beyond its limit")
+                    if limits == "warn":
+                        warnings.warn(f"{c.type_name} '{c.names[k]}': {msg}; it is cut at the limit "
+                                      "from t = 0+ and the grid drifts before any event", stacklevel=3)
+                    else:
+                        raise DataError(f"{c.type_name} '{c.names[k]}'", fld, float(lim),
+                                        f"{msg}. Raise the limit, change the dispatch/voltage set point, "
+                                        'or pass System.setup(limits="warn") to cut it (as ANDES does)')
         F, _ = self.residual(0.0, self.z0)
         nx = self.nx
         if not np.all(np.isfinite(F)):

@@ -9,5 +9,9 @@ from .ieeet1 import IEEET1
 from .ieeevc import IEEEVC
 from .ieeex1 import IEEEX1
 from .sexs import SEXS
+from .esst4b import ESST4B
+from .exac4 import EXAC4
+from .ac8b import AC8B
 
 __all__ = ["EXDC2", "SEXS", "ESST3A", "EXST1", "IEEEX1", "IEEET1", "EXAC1", "ESDC2A", "IEEEVC"]
+__all__ += ["ESST4B", "EXAC4", "AC8B"]

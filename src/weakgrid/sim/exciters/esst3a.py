@@ -40,6 +40,13 @@ def source_voltage(ctx, mach, bus, KPC, KI, XL):
     return np.abs(KPC * V + 1j * (KI + KPC * XL) * It)
 
 
+def rectified_voltage(VE, XadIfd, KC, VBMAX):
+    """Available exciter voltage ``VB = min(VE * FEX(IN), VBMAX)``, ``IN = KC*XadIfd/VE`` [pu]."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        IN = np.where(VE > 0, KC * XadIfd / VE, 0.0)
+    return np.minimum(VE * rectifier_fex(IN), VBMAX)
+
+
 class ESST3A(MachineControl):
     """IEEE ST3A static exciter. Times [s]: TR, TC, TB, TA, TM; gains [pu]: KA, KM, KG, KP, KI, KC;
     reactance XL [pu]; THETAP [deg]; limits VIMAX, VIMIN, VRMAX, VRMIN, VMMAX, VMMIN, VBMAX, VGMAX [pu]."""
@@ -86,10 +93,7 @@ class ESST3A(MachineControl):
         return [(self.idx("VR"), p["VRMIN"], p["VRMAX"]), (self.idx("VM"), p["VMMIN"], p["VMMAX"])]
 
     def _vb(self, VE, XadIfd):
-        p = self.p
-        with np.errstate(divide="ignore", invalid="ignore"):
-            IN = np.where(VE > 0, p["KC"] * XadIfd / VE, 0.0)
-        return np.minimum(VE * rectifier_fex(IN), p["VBMAX"])
+        return rectified_voltage(VE, XadIfd, self.p["KC"], self.p["VBMAX"])
 
     def init(self, system, x, sig):
         p = self.p

@@ -40,6 +40,18 @@ def _efd(VE, KC, XadIfd):
     return VE * rectifier_fex(IN)
 
 
+def ve_for_efd(efd, KC, XadIfd):
+    """Alternator voltage ``VE`` with ``VE * FEX(KC*XadIfd/VE) = efd`` (monotone in ``VE``;
+    bisection) [pu]."""
+    lo = np.asarray(efd, float).copy()                 # Efd <= VE
+    hi = efd + 2.0 * KC * np.abs(XadIfd) + 1.0         # FEX = 0 beyond IN = 1
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        below = _efd(mid, KC, XadIfd) < efd
+        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+    return 0.5 * (lo + hi)
+
+
 class EXAC1(MachineControl):
     """IEEE AC1 exciter. Times [s]: TR, TB, TC, TA, TE, TF; gains [pu]: KA, KF, KC, KD, KE;
     VRMAX, VRMIN [pu]; E1, SE1, E2, SE2 (saturation)."""
@@ -83,13 +95,7 @@ class EXAC1(MachineControl):
         p = self.p
         m = self.mach
         vf0, v, xad = sig["vf0"][m], sig["Ecomp0"][m], sig["XadIfd"][m]
-        lo = np.asarray(vf0, float).copy()                 # Efd <= VE
-        hi = vf0 + 2.0 * p["KC"] * np.abs(xad) + 1.0         # FEX = 0 beyond IN = 1
-        for _ in range(200):
-            mid = 0.5 * (lo + hi)
-            below = _efd(mid, p["KC"], xad) < vf0
-            lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
-        VE0 = 0.5 * (lo + hi)
+        VE0 = ve_for_efd(vf0, p["KC"], xad)
         vfe0 = self.EX.vfe(VE0) + p["KD"] * xad
         vi0 = vfe0 / p["KA"]
         self.vref0 = v + vi0

@@ -8,7 +8,8 @@ Block diagram (pu, times in s)::
     TE dEfd/dt = VR - (KE*Efd + Efd*SE(Efd))             (DC exciter, quadratic saturation)
     Efd --[Washout s*KF/(1+sTF)]--> WF                   (rate feedback)
 
-``VRMAX = 0`` means no upper limit (as ANDES). ``Switch`` is accepted and unused
+``VRMAX = 0`` means no upper limit (as ANDES); ``TA = 0`` makes the regulator the limited
+gain ``VR = clip(KA*(vi - WF), VRMIN, VRMAX)`` (PSS/E; ANDES's EI_33 data). ``Switch`` is accepted and unused
 (as in PSS/E). ``KE = 0`` is taken literally (PSS/E's "compute KE so that VR
 starts at VRMAX" option is not implemented).
 """
@@ -30,7 +31,7 @@ class IEEET1(MachineControl):
     params = (
         Param("TR", 0.02, "s", "sensing time constant", "nonneg"),
         Param("KA", 5.0, "pu", "regulator gain", "pos"),
-        Param("TA", 0.04, "s", "regulator time constant", "pos"),
+        Param("TA", 0.04, "s", "regulator time constant (0: no lag)", "nonneg"),
         Param("VRMAX", 7.3, "pu", "maximum regulator output (0: unlimited)", ""),
         Param("VRMIN", -7.3, "pu", "minimum regulator output", ""),
         Param("KE", 1.0, "pu", "exciter constant", ""),
@@ -71,8 +72,9 @@ class IEEET1(MachineControl):
         vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
-        f[..., self._sls[1]] = self.LA.deriv(vr, vi - self.WF.output(wf, efd))
-        f[..., self._sls[2]] = self.EX.deriv(efd, vr)
+        u = vi - self.WF.output(wf, efd)
+        f[..., self._sls[1]] = self.LA.deriv(vr, u)
+        f[..., self._sls[2]] = self.EX.deriv(efd, self.LA.output(vr, u))   # = vr unless TA = 0
         f[..., self._sls[3]] = self.WF.deriv(wf, efd)
         s["vf"][..., m] = efd
         ctx.out["IEEET1.vi"], ctx.out["IEEET1.vout"] = vi, efd

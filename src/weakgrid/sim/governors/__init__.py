@@ -6,5 +6,7 @@ from .ieesgo import IEESGO
 from .tg2 import TG2
 from .tgov1 import TGOV1
 from .tgov1n import TGOV1N
+from .gast import GAST
 
 __all__ = ["TGOV1", "TGOV1N", "HYGOV", "IEEEG1", "IEESGO", "TG2"]
+__all__ += ["GAST"]

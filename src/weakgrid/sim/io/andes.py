@@ -77,6 +77,8 @@ ANDES_CONVENTIONS = {
     "IEEEVC": {"on_Sb": 1.0},     # rc, xc on the system base (its IEEEVC has no Sn)
     # unit-gain gate integrator (Tr unused); flow, gate and Dt on the system base; rate bounds -x1/r
     "HYGOV": {"Tr_used": 0.0, "Tw_sysbase": 1.0, "Dt_sysbase": 1.0, "VELM_offset": 1.0},
+    "ESST4B": {"PI_nonwindup": 0.0},   # PI regulators with tracking anti-windup (Ks = 2)
+    "AC8B": {"PID_nonwindup": 0.0, "VE_limited": 0.0},   # tracking PID; VEMIN, VFEMAX unused
 }
 CONVENTIONS = ("standard", "andes")
 
@@ -106,6 +108,12 @@ _CONTROL_FIELDS = {
     "TG2": ("Tn", "wref0", "R", "pmax", "pmin", "dbl", "dbu", "dbc", "T1", "T2"),
     "TGOV1N": ("Tn", "wref0", "R", "VMAX", "VMIN", "T1", "T2", "T3", "Dt"),
     "IEEEVC": ("rc", "xc"),
+    "ESST4B": ("TR", "KPR", "KIR", "VRMAX", "VRMIN", "TA", "KPM", "KIM", "VMMAX", "VMMIN", "KG", "KP", "KI",
+               "VBMAX", "KC", "XL", "THETAP", "VGMAX"),
+    "EXAC4": ("TR", "VIMAX", "VIMIN", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KC"),
+    "AC8B": ("TR", "kP", "kI", "kD", "Td", "VPMAX", "VPMIN", "VRMAX", "VRMIN", "VFEMAX", "VEMIN", "TA", "KA",
+             "TE", "E1", "SE1", "E2", "SE2", "KE", "KD", "KC"),
+    "GAST": ("Tn", "wref0", "R", "VMAX", "VMIN", "KT", "AT", "T1", "T2", "T3", "Dt"),
     "ST2CUT": ("MODE", "MODE2", "K1", "K2", "T1", "T2", "T3", "T4", "T5", "T6", "T7", "T8", "T9", "T10",
                "LSMAX", "LSMIN", "VCU", "VCL"),
 }
