@@ -93,10 +93,12 @@ def _registry():
     from .exciters import ESDC2A, ESST3A, EXAC1, EXST1, IEEET1, IEEEX1
     from .governors import IEEEG1, IEESGO, TG2, TGOV1N
     from .pss import ST2CUT
+    from .exciters import ESAC1A, ESDC1A, ESST1A, IEEET3
 
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
                                     IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT)
+            + (ESST1A, ESAC1A, ESDC1A, IEEET3)
             + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ZIP)
             + (InfiniteBus, PVSource)}
 
