@@ -93,7 +93,7 @@ def test_shipped_case_matches(model):
     r = _runs(model, conventions=("andes", "standard"))
     dw, dd, w = r["andes"]
     assert dw < SPEED_TOL and dd < ANGLE_TOL
-    dws, dds, ws = r["standard"]
+    dws, dds, _ = r["standard"]
     if model in STANDARD_GAP:
         assert w["system"].conventions_applied.get(model) == 1
         assert dws == pytest.approx(STANDARD_GAP[model], rel=0.05) and dds > 5.0

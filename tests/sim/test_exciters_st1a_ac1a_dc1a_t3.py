@@ -90,7 +90,7 @@ def test_esst1a_pss_at_the_regulator_output_passes_without_lag():
     for code in (1, 2):
         s = _system("ESST1A", dict(EXCITERS["ESST1A"], VOSc=code))
         c = s.components["ESST1A"]
-        F0, ctx0 = s.residual(0.0, s.z0)
+        _, ctx0 = s.residual(0.0, s.z0)
         sig = s.sig_defaults
         ctx0.sig["vs"][...] = 0.05                  # PSS output stepped: evaluate the exciter alone
         ctx0.f[...] = 0.0
@@ -113,7 +113,7 @@ def test_esac1a_flags_remove_rate_feedback_and_regulator_limits():
         z = sysm.z0.copy()
         z[c.idx("VA")] = 9.0                     # regulator above VRMAX = 5
         z[c.idx("VF")] -= 0.1                    # rate feedback output (KF/TF)*(VFE - VF) > 0
-        F, ctx = sysm.residual(0.0, z)
+        _, ctx = sysm.residual(0.0, z)
         assert ctx.out["ESAC1A.VR"][0] == (5.0 if clipped else 9.0)
         vi0 = c.vref0[0] - ctx.sig["Vt"][0]
         fb = c.p["KF"][0] / c.p["TF"][0] * 0.1

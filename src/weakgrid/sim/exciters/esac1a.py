@@ -69,11 +69,7 @@ class ESAC1A(MachineControl):
               "0: it is left out (ANDES 2.0)", "flag"),
         Param("VR_limited", 1.0, "-", "1: VR clipped to VRMIN..VRMAX and VE >= 0 (IEEE 421.5); "
               "0: neither (ANDES 2.0)", "flag"),
-        Param("E1", 0.0, "pu", "first saturation point", "nonneg"),
-        Param("SE1", 0.0, "pu", "saturation at E1", "nonneg"),
-        Param("E2", 1.0, "pu", "second saturation point", "nonneg"),
-        Param("SE2", 1.0, "pu", "saturation at E2", "nonneg"),
-    )
+    ) + SATURATION_PARAMS
     states = ("LG", "LL", "VA", "VE", "VF")
     outputs = ("vi", "VR", "VFE", "vout")
     limit_fields = {"VA": ("VAMIN", "VAMAX"), "VE": ("VE floor (0)", "none")}

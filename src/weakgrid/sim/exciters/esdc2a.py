@@ -39,6 +39,7 @@ class ESDC2A(ESDC1A):
         Param("VRMAX", 7.3, "pu", "maximum regulator output at Vt = 1 (0: unlimited)", "") if p.name == "VRMAX"
         else Param("VRMIN", -7.3, "pu", "minimum regulator output at Vt = 1", "") if p.name == "VRMIN"
         else p for p in ESDC1A.params)
+    limit_fields = {"VR": ("VRMIN*Vt", "VRMAX*Vt")}
 
     def limits(self):
         v0 = self._vt0
