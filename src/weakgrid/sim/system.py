@@ -95,13 +95,15 @@ def _registry():
     from .pss import ST2CUT
     from .exciters import AC8B, ESST4B, EXAC4
     from .governors import GAST
+    from .exciters import ESAC1A, ESDC1A, ESST1A, IEEET3
 
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
                                     IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT, IEEEVC)
             + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ESD1, ZIP)
             + (InfiniteBus, PVSource)
-            + (ESST4B, EXAC4, AC8B, GAST)}
+            + (ESST4B, EXAC4, AC8B, GAST)
+            + (ESST1A, ESAC1A, ESDC1A, IEEET3)}
 
 
 class System:

@@ -1,6 +1,7 @@
 """ESDC2A: IEEE 421.5-2005 type DC2A exciter (PSS/E ESDC2A).
 
-Block diagram (pu, times in s)::
+The DC1A diagram (:mod:`weakgrid.sim.exciters.esdc1a`, whose class this one extends) with
+the regulator limits scaled by the terminal voltage (pu, times in s)::
 
     v --[Lag 1/(1+sTR)]--> LG
     vsen = LG if TR_used else v                          (sensed voltage; TR_used = 0: ANDES 2.0)
@@ -26,53 +27,19 @@ on ``7.3*Vt`` during the fault), as here.
 
 from __future__ import annotations
 
-import numpy as np
-
-from ..blocks import Lag, LagNonWindup, LeadLag, Washout
-from ..control_base import MachineControl
 from ..params import Param
-from .dc_common import DCExciter, vrmax_or_unlimited
+from .esdc1a import ESDC1A
 
 
-class ESDC2A(MachineControl):
+class ESDC2A(ESDC1A):
     """IEEE DC2A exciter. Times [s]: TR, TA, TB, TC, TE, TF1; gains [pu]: KA, KE, KF;
     VRMAX, VRMIN [pu, times Vt]; E1, SE1, E2, SE2 (saturation)."""
 
-    kind = "exciter"
-    order = 2
-    params = (
-        Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
-        Param("KA", 80.0, "pu", "regulator gain", "pos"),
-        Param("TA", 0.04, "s", "regulator time constant", "pos"),
-        Param("TB", 1.0, "s", "lag time constant", "nonneg"),
-        Param("TC", 1.0, "s", "lead time constant", "nonneg"),
-        Param("VRMAX", 7.3, "pu", "maximum regulator output at Vt = 1 (0: unlimited)", ""),
-        Param("VRMIN", -7.3, "pu", "minimum regulator output at Vt = 1", ""),
-        Param("KE", 1.0, "pu", "exciter constant", ""),
-        Param("TE", 0.8, "s", "exciter time constant", "pos"),
-        Param("KF", 0.1, "pu", "rate feedback gain", "nonneg"),
-        Param("TF1", 1.0, "s", "rate feedback time constant", "pos"),
-        Param("Switch", 0.0, "-", "unused (PSS/E)", ""),
-        Param("TR_used", 1.0, "-", "1: the sensed voltage passes through TR (IEEE 421.5); "
-              "0: the unfiltered voltage enters the summing junction (ANDES 2.0)", "flag"),
-        Param("E1", 0.0, "pu", "first saturation point", "nonneg"),
-        Param("SE1", 0.0, "pu", "saturation at E1", "nonneg"),
-        Param("E2", 0.0, "pu", "second saturation point", "nonneg"),
-        Param("SE2", 0.0, "pu", "saturation at E2", "nonneg"),
-    )
-    states = ("LG", "LL", "VR", "Efd", "WF")
-    outputs = ("vi", "vout")
-
-    def setup(self, system):
-        super().setup(system)
-        p = self.p
-        self.LG = Lag(1.0, p["TR"])
-        self.LL = LeadLag(p["TC"], p["TB"])
-        self._vrmax = vrmax_or_unlimited(p["VRMAX"])
-        self.LA = LagNonWindup(p["KA"], p["TA"], p["VRMIN"], self._vrmax)
-        self.EX = DCExciter(p["KE"], p["TE"], p["E1"], p["SE1"], p["E2"], p["SE2"])
-        self.WF = Washout(p["KF"], p["TF1"])
-        self._lagged = p["TR_used"] > 0
+    params = tuple(
+        Param("VRMAX", 7.3, "pu", "maximum regulator output at Vt = 1 (0: unlimited)", "") if p.name == "VRMAX"
+        else Param("VRMIN", -7.3, "pu", "minimum regulator output at Vt = 1", "") if p.name == "VRMIN"
+        else p for p in ESDC1A.params)
+    limit_fields = {"VR": ("VRMIN*Vt", "VRMAX*Vt")}
 
     def limits(self):
         v0 = self._vt0
@@ -82,32 +49,3 @@ class ESDC2A(MachineControl):
         """Current regulator limits ``(VRMIN*Vt, VRMAX*Vt)``."""
         v = ctx.sig["Ecomp"][self.mach]
         return self.p["VRMIN"] * v, self._vrmax * v
-
-    def init(self, system, x, sig):
-        m = self.mach
-        vf0, v = sig["vf0"][m], sig["Ecomp0"][m]
-        self._vt0 = v.copy()
-        vr0 = self.EX.vr0(vf0)
-        vi0 = vr0 / self.p["KA"]
-        self.vref0 = v + vi0
-        x[self.sl(0)] = self.LG.init(v)
-        x[self.sl(1)] = self.LL.init(vi0)
-        x[self.sl(2)] = vr0
-        x[self.sl(3)] = vf0
-        x[self.sl(4)] = self.WF.init(vf0)
-
-    def compute(self, ctx):
-        m = self._mi
-        lg, ll, vr, efd, wf = (ctx.x[..., s] for s in self._sls)
-        s = ctx.sig
-        v = s["Ecomp"][..., m]
-        sensed = np.where(self._lagged, self.LG.output(lg, v), v)
-        vi = self.vref0 - sensed - self.WF.output(wf, efd) + s["vs"][..., m]
-        f = ctx.f
-        f[..., self._sls[0]] = self.LG.deriv(lg, v)
-        f[..., self._sls[1]] = self.LL.deriv(ll, vi)
-        f[..., self._sls[2]] = self.LA.deriv(vr, self.LL.output(ll, vi))
-        f[..., self._sls[3]] = self.EX.deriv(efd, vr)
-        f[..., self._sls[4]] = self.WF.deriv(wf, efd)
-        s["vf"][..., m] = efd
-        ctx.out["ESDC2A.vi"], ctx.out["ESDC2A.vout"] = vi, efd

@@ -47,6 +47,13 @@ def rectified_voltage(VE, XadIfd, KC, VBMAX):
     return np.minimum(VE * rectifier_fex(IN), VBMAX)
 
 
+def source_voltage0(sig, mach, KPC, KI, XL):
+    """:func:`source_voltage` at the power-flow point, from the initial signals ``sig``."""
+    V = sig["Vt0"][mach] * np.exp(1j * sig["theta0"][mach])
+    It = np.conj((sig["Pe0"][mach] + 1j * sig["Qe0"][mach]) / V)
+    return np.abs(KPC * V + 1j * (KI + KPC * XL) * It)
+
+
 class ESST3A(MachineControl):
     """IEEE ST3A static exciter. Times [s]: TR, TC, TB, TA, TM; gains [pu]: KA, KM, KG, KP, KI, KC;
     reactance XL [pu]; THETAP [deg]; limits VIMAX, VIMIN, VRMAX, VRMIN, VMMAX, VMMIN, VBMAX, VGMAX [pu]."""
@@ -99,9 +106,7 @@ class ESST3A(MachineControl):
         p = self.p
         m = self.mach
         vf0, v = sig["vf0"][m], sig["Ecomp0"][m]
-        V = sig["Vt0"][m] * np.exp(1j * sig["theta0"][m])      # terminal phasor (for VE)
-        It = np.conj((sig["Pe0"][m] + 1j * sig["Qe0"][m]) / V)
-        VE0 = np.abs(self.KPC * V + 1j * (p["KI"] + self.KPC * p["XL"]) * It)
+        VE0 = source_voltage0(sig, m, self.KPC, p["KI"], p["XL"])
         VB0 = self._vb(VE0, sig["XadIfd"][m])
         VM0 = vf0 / VB0
         VR0 = VM0 / p["KM"] + np.minimum(p["KG"] * vf0, p["VGMAX"])

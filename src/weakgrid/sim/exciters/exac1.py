@@ -35,19 +35,20 @@ from .dc_common import SATURATION_PARAMS, DCExciter
 
 
 def _efd(VE, KC, XadIfd):
+    """Rectifier output ``VE * FEX(KC*XadIfd/VE)`` of an AC exciter [pu]."""
     with np.errstate(divide="ignore", invalid="ignore"):
         IN = np.where(VE > 0, KC * XadIfd / VE, 0.0)
     return VE * rectifier_fex(IN)
 
 
-def ve_for_efd(efd, KC, XadIfd):
-    """Alternator voltage ``VE`` with ``VE * FEX(KC*XadIfd/VE) = efd`` (monotone in ``VE``;
-    bisection) [pu]."""
-    lo = np.asarray(efd, float).copy()                 # Efd <= VE
-    hi = efd + 2.0 * KC * np.abs(XadIfd) + 1.0         # FEX = 0 beyond IN = 1
+def ve_for_efd(vf0, KC, XadIfd):
+    """Exciter voltage ``VE`` with ``VE*FEX(KC*XadIfd/VE) = vf0`` [pu] (bisection; the left side
+    increases with ``VE``). Shared by the AC exciters (EXAC1, ESAC1A)."""
+    lo = np.asarray(vf0, float).copy()                 # Efd <= VE
+    hi = vf0 + 2.0 * KC * np.abs(XadIfd) + 1.0          # FEX = 0 beyond IN = 1
     for _ in range(200):
         mid = 0.5 * (lo + hi)
-        below = _efd(mid, KC, XadIfd) < efd
+        below = _efd(mid, KC, XadIfd) < vf0
         lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
     return 0.5 * (lo + hi)
 

@@ -79,6 +79,9 @@ ANDES_CONVENTIONS = {
     "HYGOV": {"Tr_used": 0.0, "Tw_sysbase": 1.0, "Dt_sysbase": 1.0, "VELM_offset": 1.0},
     "ESST4B": {"PI_nonwindup": 0.0},   # PI regulators with tracking anti-windup (Ks = 2)
     "AC8B": {"PID_nonwindup": 0.0, "VE_limited": 0.0},   # tracking PID; VEMIN, VFEMAX unused
+    "ESST1A": {"VOSc": 1.0},       # the PSS output always enters the summing junction
+    "ESAC1A": {"VF_used": 0.0, "VR_limited": 0.0},  # no rate feedback; no VRMIN..VRMAX, no VE >= 0
+    "ESDC1A": {"TR_used": 0.0},   # as ESDC2A
 }
 CONVENTIONS = ("standard", "andes")
 
@@ -102,6 +105,13 @@ _CONTROL_FIELDS = {
               "E1", "SE1", "E2", "SE2"),
     "ESDC2A": ("TR", "KA", "TA", "TB", "TC", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF1", "Switch",
                "E1", "SE1", "E2", "SE2"),
+    "ESST1A": ("TR", "VIMAX", "VIMIN", "TB", "TC", "TB1", "TC1", "VAMAX", "VAMIN", "KA", "TA", "ILR", "KLR",
+               "VRMAX", "VRMIN", "KF", "TF", "KC", "UELc", "VOSc"),
+    "ESAC1A": ("TR", "TB", "TC", "VAMAX", "VAMIN", "KA", "TA", "VRMAX", "VRMIN", "TE", "E1", "SE1", "E2", "SE2",
+               "KD", "KC", "KE", "KF", "TF", "Switch"),
+    "ESDC1A": ("TR", "KA", "TA", "TB", "TC", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF1", "Switch",
+               "E1", "SE1", "E2", "SE2"),
+    "IEEET3": ("TR", "KA", "TA", "VRMAX", "VRMIN", "VBMAX", "KE", "TE", "KF", "TF", "KP", "KI"),
     "IEEEG1": ("Tn", "wref0", "K", "T1", "T2", "T3", "UO", "UC", "PMAX", "PMIN", "T4", "K1", "K2", "T5", "K3",
                "K4", "T6", "K5", "K6", "T7", "K7", "K8"),
     "IEESGO": ("Tn", "wref0", "T1", "T2", "T3", "T4", "T5", "T6", "K1", "K2", "K3", "PMAX", "PMIN"),

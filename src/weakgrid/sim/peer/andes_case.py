@@ -115,6 +115,23 @@ def hold_andes_step(tds):
     set_method_held(tds.config.method)
 
 
+def fix_andes_esdc1a(ss):
+    """Point ANDES 2.0's ESDC1A regulator at its constant limits ``VRMAX``, ``VRMIN``.
+
+    ANDES's ESDC1A derives from its ESDC2A and replaces the limit services ``VRU = VRMAX*v``,
+    ``VRL = VRMIN*v`` by constants after its anti-windup regulator ``LA`` was built; the block
+    keeps the discarded services, never evaluated (value 0), and ANDES's initialization stops
+    (``TypeError`` while adjusting the limit). This re-points the block and its limiter at the
+    constant services, i.e. the DC1A diagram. Use as ``run_andes_ss(..., configure=...)``
+    (after ``ss.setup()``); a no-op without ESDC1A devices. ANDES's code is not changed.
+    """
+    if "ESDC1A" not in ss.models or ss.ESDC1A.n == 0:
+        return
+    m = ss.ESDC1A
+    for blk in (m.LA, m.LA.lim):
+        blk.upper, blk.lower = m.VRU, m.VRL
+
+
 def run_andes_ss(ss, tf, h, tol=1e-8, hold_step=False, configure=None):
     """Set up, solve the power flow and simulate ``ss`` in ANDES at the fixed step ``h``.
 
