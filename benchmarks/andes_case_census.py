@@ -23,6 +23,10 @@ limiter, HYGOV's system-base equations; see
 departure gets the same result in both (``"andes": {"same": true}``); otherwise weakgrid runs
 again with the ANDES conventions against the same ANDES run (with the same step halving).
 
+ANDES 2.0 cannot initialize an ``ESDC1A`` (its regulator keeps limit services it never
+evaluates); its runs are patched with :func:`weakgrid.sim.peer.andes_case.fix_andes_esdc1a`
+(a no-op without ESDC1A), which points the regulator at its constant limits.
+
 Each case runs in its own subprocess with a time limit (``--timeout``, default 300 s). Results
 are written atomically to ``--out`` (default ``benchmarks/andes_case_census.json``) after every
 case; a re-run skips the cases already there (``--fresh`` to start over). The summary counts the
@@ -71,7 +75,8 @@ def run_one(path, addfile, tf, h, halve=True):
     """Try one case; returns a dict with ``stage`` (where it stopped) and details."""
     from weakgrid.sim.errors import DataError
     from weakgrid.sim.io.andes import from_andes
-    from weakgrid.sim.peer.andes_case import load_case, machine_names, run_andes_ss, run_weakgrid_ss
+    from weakgrid.sim.peer.andes_case import (fix_andes_esdc1a, load_case, machine_names, run_andes_ss,
+                                              run_weakgrid_ss)
 
     r = {"stage": "parse"}
     try:
@@ -105,7 +110,7 @@ def run_one(path, addfile, tf, h, halve=True):
         return {**r, "error": "weakgrid run failed"}
     r["stage"] = "andes"
     try:
-        a = run_andes_ss(load_case(path, addfile, fault="auto"), tf, h)
+        a = run_andes_ss(load_case(path, addfile, fault="auto"), tf, h, configure=fix_andes_esdc1a)
     except Exception as exc:
         return {**r, "error": f"ANDES: {type(exc).__name__}: {exc}"[:400]}
     if not a["ok"]:
@@ -132,7 +137,8 @@ def _compare(path, addfile, tf, h, a, w, andes_runs, conventions, halve):
     near miss is re-run at h/2 and h/4 in both tools (ANDES runs cached in ``andes_runs``)."""
     import numpy as np
 
-    from weakgrid.sim.peer.andes_case import compare_named, load_case, run_andes_ss, run_weakgrid_ss
+    from weakgrid.sim.peer.andes_case import (compare_named, fix_andes_esdc1a, load_case, run_andes_ss,
+                                              run_weakgrid_ss)
 
     dw, dd = compare_named(a, w)
     ok = bool(np.isfinite(dw) and dw < DW_TOL and dd < DD_TOL)
@@ -145,7 +151,8 @@ def _compare(path, addfile, tf, h, a, w, andes_runs, conventions, halve):
                 wk = run_weakgrid_ss(load_case(path, addfile, fault="auto"), tf, h / k,
                                      conventions=conventions)
                 if k not in andes_runs:
-                    andes_runs[k] = run_andes_ss(load_case(path, addfile, fault="auto"), tf, h / k)
+                    andes_runs[k] = run_andes_ss(load_case(path, addfile, fault="auto"), tf, h / k,
+                                                  configure=fix_andes_esdc1a)
                 dwk, ddk = compare_named(andes_runs[k], wk)
                 r.update({f"dw_h{k}": dwk, f"dd_h{k}": ddk})
                 if dwk < DW_TOL and ddk < DD_TOL:
