@@ -35,7 +35,7 @@ from ..blocks import Lag, LagNonWindup, LeadLag, Washout, hard_limit
 from ..control_base import MachineControl
 from ..params import Param
 from .dc_common import SATURATION_PARAMS, DCExciter
-from .exac1 import _efd, ve_for_efd
+from .exac1 import _efd, init_ac_exciter
 
 
 class ESAC1A(MachineControl):
@@ -93,18 +93,7 @@ class ESAC1A(MachineControl):
         return [(self.idx("VA"), p["VAMIN"], p["VAMAX"]), (self.idx("VE"), self._vemin, np.inf)]
 
     def init(self, system, x, sig):
-        p = self.p
-        m = self.mach
-        vf0, v, xad = sig["vf0"][m], sig["Ecomp0"][m], sig["XadIfd"][m]
-        VE0 = ve_for_efd(vf0, p["KC"], xad)
-        vfe0 = self.EX.vfe(VE0) + p["KD"] * xad
-        vi0 = vfe0 / p["KA"]
-        self.vref0 = v + vi0
-        x[self.sl(0)] = self.LG.init(v)
-        x[self.sl(1)] = self.LL.init(vi0)
-        x[self.sl(2)] = vfe0
-        x[self.sl(3)] = VE0
-        x[self.sl(4)] = self.VF.init(vfe0)
+        init_ac_exciter(self, x, sig, self.VF)
 
     def compute(self, ctx):
         p = self.p

@@ -53,6 +53,23 @@ def ve_for_efd(vf0, KC, XadIfd):
     return 0.5 * (lo + hi)
 
 
+def init_ac_exciter(c, x, sig, feedback):
+    """Steady state of an AC exciter with states ``(LG, LL, regulator, VE, rate feedback)``
+    (EXAC1, ESAC1A): ``VE`` from the field voltage, the regulator at ``VFE = KE VE + SE + KD
+    XadIfd``, the voltage reference from the input error ``VFE / KA``."""
+    p, m = c.p, c.mach
+    vf0, v, xad = sig["vf0"][m], sig["Ecomp0"][m], sig["XadIfd"][m]
+    VE0 = ve_for_efd(vf0, p["KC"], xad)
+    vfe0 = c.EX.vfe(VE0) + p["KD"] * xad
+    vi0 = vfe0 / p["KA"]
+    c.vref0 = v + vi0
+    x[c.sl(0)] = c.LG.init(v)
+    x[c.sl(1)] = c.LL.init(vi0)
+    x[c.sl(2)] = vfe0
+    x[c.sl(3)] = VE0
+    x[c.sl(4)] = feedback.init(vfe0)
+
+
 class EXAC1(MachineControl):
     """IEEE AC1 exciter. Times [s]: TR, TB, TC, TA, TE, TF; gains [pu]: KA, KF, KC, KD, KE;
     VRMAX, VRMIN [pu]; E1, SE1, E2, SE2 (saturation)."""
@@ -93,18 +110,7 @@ class EXAC1(MachineControl):
         return [(self.idx("VR"), self.p["VRMIN"], self.p["VRMAX"])]
 
     def init(self, system, x, sig):
-        p = self.p
-        m = self.mach
-        vf0, v, xad = sig["vf0"][m], sig["Ecomp0"][m], sig["XadIfd"][m]
-        VE0 = ve_for_efd(vf0, p["KC"], xad)
-        vfe0 = self.EX.vfe(VE0) + p["KD"] * xad
-        vi0 = vfe0 / p["KA"]
-        self.vref0 = v + vi0
-        x[self.sl(0)] = self.LG.init(v)
-        x[self.sl(1)] = self.LL.init(vi0)
-        x[self.sl(2)] = vfe0
-        x[self.sl(3)] = VE0
-        x[self.sl(4)] = self.WF.init(vfe0)
+        init_ac_exciter(self, x, sig, self.WF)
 
     def compute(self, ctx):
         p = self.p
