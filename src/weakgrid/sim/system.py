@@ -352,6 +352,22 @@ class System:
         """
         import warnings
 
+        def beyond(element, name, v, lo, hi, flo, fhi, what, fate):
+            """Refuse (or warn about) an initial value ``v`` outside ``[lo, hi]``."""
+            if lo - 1e-9 <= v <= hi + 1e-9:
+                return
+            fld, lim, side = (fhi, hi, "above") if v > hi else (flo, lo, "below")
+            msg = (f"initial value of {name} = {v:.6g} pu is {side} {fld} = {lim:.6g} pu "
+                   f"(system base): the operating point needs a {what} beyond its limit")
+            if limits == "warn":
+                warnings.warn(f"{element}: {msg}; it is {fate} at the limit from t = 0+ and the grid "
+                              "drifts before any event", stacklevel=4)
+                return
+            raise DataError(element, fld, float(lim),
+                            f"{msg}. Raise the limit, change the dispatch/voltage set point, "
+                            f'or pass System.setup(limits="warn") to {"clamp" if fate == "held" else "cut"} it '
+                            "(as ANDES does)")
+
         x0 = self.z0[:self.nx]
         for c in self.comps:
             fields = getattr(c, "limit_fields", {})
@@ -360,27 +376,10 @@ class System:
                 lo = np.broadcast_to(np.asarray(lo, float), idx.shape)
                 hi = np.broadcast_to(np.asarray(hi, float), idx.shape)
                 for k, j in enumerate(idx):
-                    v = x0[j]
-                    if lo[k] - 1e-9 <= v <= hi[k] + 1e-9:
-                        continue
                     st = self.var_name(int(j)).rsplit(".", 1)
                     flo, fhi = fields.get(st[-1], ("lower limit", "upper limit"))
-                    bad = None
-                    if v > hi[k] + 1e-9:
-                        bad = (fhi, hi[k], "above")
-                    elif v < lo[k] - 1e-9:
-                        bad = (flo, lo[k], "below")
-                    if bad is None:
-                        continue
-                    msg = (f"initial value of {st[-1]} = {v:.6g} pu is {bad[2]} {bad[0]} = {bad[1]:.6g} pu "
-                           "(system base): the operating point needs a state beyond its limit")
-                    if limits == "warn":
-                        warnings.warn(f"{c.type_name} '{st[0]}': {msg}; it is held at the limit "
-                                      "from t = 0+ and the grid drifts before any event", stacklevel=3)
-                    else:
-                        raise DataError(f"{c.type_name} '{st[0]}'", bad[0], float(bad[1]),
-                                        f"{msg}. Raise the limit, change the dispatch/voltage set point, "
-                                        'or pass System.setup(limits="warn") to clamp it (as ANDES does)')
+                    beyond(f"{c.type_name} '{st[0]}'", st[-1], x0[j], lo[k], hi[k], flo, fhi,
+                           "state", "held")
         # static (windup) limits and gates whose initial input must lie inside them
         # (components set ``initial_bounds`` in init: (signal, value, lower, upper, lower_field,
         # upper_field), arrays over the component's devices); beyond them the output would be
@@ -389,18 +388,8 @@ class System:
             for sig, val, lo, hi, flo, fhi in getattr(c, "initial_bounds", ()):
                 val, lo, hi = (np.broadcast_to(np.asarray(a, float), (c.n,)) for a in (val, lo, hi))
                 for k in range(c.n):
-                    if lo[k] - 1e-9 <= val[k] <= hi[k] + 1e-9:
-                        continue
-                    fld, lim, side = (fhi, hi[k], "above") if val[k] > hi[k] else (flo, lo[k], "below")
-                    msg = (f"initial value of {sig} = {val[k]:.6g} pu is {side} {fld} = {lim:.6g} pu: "
-                           "the operating point needs a signal beyond its limit")
-                    if limits == "warn":
-                        warnings.warn(f"{c.type_name} '{c.names[k]}': {msg}; it is cut at the limit "
-                                      "from t = 0+ and the grid drifts before any event", stacklevel=3)
-                    else:
-                        raise DataError(f"{c.type_name} '{c.names[k]}'", fld, float(lim),
-                                        f"{msg}. Raise the limit, change the dispatch/voltage set point, "
-                                        'or pass System.setup(limits="warn") to cut it (as ANDES does)')
+                    beyond(f"{c.type_name} '{c.names[k]}'", sig, val[k], lo[k], hi[k], flo, fhi,
+                           "signal", "cut")
         F, _ = self.residual(0.0, self.z0)
         nx = self.nx
         if not np.all(np.isfinite(F)):
