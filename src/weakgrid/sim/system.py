@@ -93,11 +93,13 @@ def _registry():
     from .exciters import ESDC2A, ESST3A, EXAC1, EXST1, IEEET1, IEEEVC, IEEEX1
     from .governors import IEEEG1, IEESGO, TG2, TGOV1N
     from .pss import ST2CUT
+    from .renewables import WTARA1, WTDTA1, WTPTA1, WTTQA1
 
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
                                     IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT, IEEEVC)
             + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ZIP)
+            + (WTDTA1, WTARA1, WTPTA1, WTTQA1)    # after REECA1: the ANDES importer links in this order
             + (InfiniteBus, PVSource)}
 
 

@@ -75,6 +75,10 @@ ANDES_CONVENTIONS = {
     "IEEEX1": {"VR_Vt": 0.0},     # regulator limits VRMAX, VRMIN, not times Vt
     "EXST1": {"VR_limited": 0.0},  # output limit tested on the rate feedback (in effect never acts)
     "IEEEVC": {"on_Sb": 1.0},     # rc, xc on the system base (its IEEEVC has no Sn)
+    # wind type 3: speed reference held at w0, rate limits on Tp*dtheta/dt
+    "WTPTA1": {"wref_tq": 0.0, "rate_T": 1.0},
+    # speed error wref - wg, unfiltered Pe, REECA1's wg = 1 + wg - fPe, limits widened at t = 0
+    "WTTQA1": {"speed_err": 0.0, "Pe_filt": 0.0, "wg_reset": 1.0, "adjust_lim": 1.0},
 }
 CONVENTIONS = ("standard", "andes")
 
@@ -488,6 +492,9 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
             values = _params(cls, m, k)
             if hasattr(cls, "andes_params"):
                 values = cls.andes_params(m, k, ss, values)
+            if conventions == "andes" and mname in ANDES_CONVENTIONS:
+                values.update(ANDES_CONVENTIONS[mname])
+                applied[mname] = applied.get(mname, 0) + 1
             comp.add(name, link, values)
             dev_name[(mname, m.idx.v[k])] = name
     # every in-service static generator needs a dynamic model (machine or converter)
