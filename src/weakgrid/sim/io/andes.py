@@ -3,7 +3,8 @@
 Supported ANDES models: the network (``Bus``, ``Line``, ``PQ``, ``Shunt``,
 ``PV``, ``Slack``), every dynamic model registered in
 :func:`weakgrid.sim.system._registry` (machines, exciters, governors, PSS,
-renewables — REGCA1 with its controls REECA1/REECB1 and REPCA1, PVD1 —, ZIP loads;
+renewables — REGCA1 with its controls REECA1/REECB1 and REPCA1, PVD1, the type-3 wind
+turbine WTDTA1/WTARA1/WTPTA1/WTTQA1 —, ZIP loads;
 parameters are read by their ANDES names), and the
 events ``Toggle`` (of a ``Line``: each toggle flips the line's status, so
 a second toggle recloses it) and ``Fault``. Measurement-only models
