@@ -34,10 +34,15 @@ import pytest
 
 andes = pytest.importorskip("andes")
 
-from weakgrid.sim.errors import DataError  # noqa: E402
-from weakgrid.sim.io.andes import from_andes  # noqa: E402
-from weakgrid.sim.peer.andes_case import compare_named, load_case, run_andes_ss, run_weakgrid_ss  # noqa: E402
-from weakgrid.sim.peer.andes_runs import interp_to  # noqa: E402
+from weakgrid.sim.errors import DataError
+from weakgrid.sim.io.andes import from_andes
+from weakgrid.sim.peer.andes_case import (
+    compare_named,
+    load_case,
+    run_andes_ss,
+    run_weakgrid_ss,
+)
+from weakgrid.sim.peer.andes_runs import interp_to
 
 pytestmark = pytest.mark.andes
 
