@@ -15,7 +15,7 @@ KUNDUR = "kundur/kundur_full.xlsx"
 
 
 def test_all_unsupported_models_listed_in_one_message():
-    ss = load_case("kundur/kundur_wtds.xlsx", keep_events=True)
+    ss = load_case("kundur/kundur_vsc.xlsx", keep_events=True)
     expected = sorted(n for n, m in ss.models.items() if m.n and n not in _supported())
     assert len(expected) >= 3
     with pytest.raises(DataError) as e:

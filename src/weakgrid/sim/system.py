@@ -96,11 +96,13 @@ def _registry():
     from .exciters import AC8B, ESST4B, EXAC4
     from .governors import GAST
     from .exciters import ESAC1A, ESDC1A, ESST1A, IEEET3
+    from .renewables import WTARA1, WTDTA1, WTPTA1, WTTQA1
 
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
                                     IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT, IEEEVC)
             + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ESD1, ZIP)
+            + (WTDTA1, WTARA1, WTPTA1, WTTQA1)    # after REECA1: the ANDES importer links in this order
             + (InfiniteBus, PVSource)
             + (ESST4B, EXAC4, AC8B, GAST)
             + (ESST1A, ESAC1A, ESDC1A, IEEET3)}

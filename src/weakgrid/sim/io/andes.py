@@ -3,7 +3,8 @@
 Supported ANDES models: the network (``Bus``, ``Line``, ``PQ``, ``Shunt``,
 ``PV``, ``Slack``), every dynamic model registered in
 :func:`weakgrid.sim.system._registry` (machines, exciters, governors, PSS,
-renewables — REGCA1 with its controls REECA1/REECB1 and REPCA1, PVD1 —, ZIP loads;
+renewables — REGCA1 with its controls REECA1/REECB1 and REPCA1, PVD1, the type-3 wind
+turbine WTDTA1/WTARA1/WTPTA1/WTTQA1 —, ZIP loads;
 parameters are read by their ANDES names), and the
 events ``Toggle`` (of a ``Line``: each toggle flips the line's status, so
 a second toggle recloses it) and ``Fault``. Measurement-only models
@@ -82,6 +83,10 @@ ANDES_CONVENTIONS = {
     "ESST1A": {"VOSc": 1.0},       # the PSS output always enters the summing junction
     "ESAC1A": {"VF_used": 0.0, "VR_limited": 0.0},  # no rate feedback; no VRMIN..VRMAX, no VE >= 0
     "ESDC1A": {"TR_used": 0.0},   # as ESDC2A
+    # wind type 3: speed reference held at w0, rate limits on Tp*dtheta/dt
+    "WTPTA1": {"wref_tq": 0.0, "rate_T": 1.0},
+    # speed error wref - wg, unfiltered Pe, REECA1's wg = 1 + wg - fPe, limits widened at t = 0
+    "WTTQA1": {"speed_err": 0.0, "Pe_filt": 0.0, "wg_reset": 1.0, "adjust_lim": 1.0},
 }
 CONVENTIONS = ("standard", "andes")
 
@@ -508,6 +513,9 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
             values = _params(cls, m, k)
             if hasattr(cls, "andes_params"):
                 values = cls.andes_params(m, k, ss, values)
+            if conventions == "andes" and mname in ANDES_CONVENTIONS:
+                values.update(ANDES_CONVENTIONS[mname])
+                applied[mname] = applied.get(mname, 0) + 1
             comp.add(name, link, values)
             dev_name[(mname, m.idx.v[k])] = name
     # every in-service static generator needs a dynamic model (machine or converter)

@@ -20,8 +20,11 @@ diagram (system per unit, times in s; ``v`` is the converter's terminal voltage)
       Iqcmd = clip(Qsel + Iqinj, Iqmin, Iqmax)
     active power:
       Pref + Pext --[LagRate 1/(1+s tpfilt), dPmin..dPmax]--> pfilt
-      pfilt --[Lag 1/(1+sTpord), non-windup PMIN..PMAX, frozen in a dip]--> s5 = Pord
+      Psel = wg pfilt (PFLAG = 1) or pfilt (PFLAG = 0)
+      Psel --[Lag 1/(1+sTpord), non-windup PMIN..PMAX, frozen in a dip]--> s5 = Pord
       Ipcmd = clip(Pord / vp, 0, Ipmax),        vp = max(v, 0.01)
+      (Pref = Pref0 and wg = 1 unless a wind turbine's torque controller WTTQA1 sets Pref and its
+      drive train WTDTA1 sets the generator speed wg, see :mod:`.wttqa1`, :mod:`.wtdta1`)
     current limiter (PQFLAG = 1: P priority, 0: Q priority):
       VDL1(s0), VDL2(s0): piecewise-linear through (Vq1, Iq1)..(Vq4, Iq4), (Vp1, Ip1)..(Vp4, Ip4)
       P priority: Ipmax = min(VDL2, Imax),  Iqmax = min(VDL1, sqrt(Imax^2 - Ipcmd^2))
@@ -140,7 +143,7 @@ class REECA1(Component):
     )
     states = ("s0", "S1", "PIQ", "s4", "pfilt", "s5", "PIV")
     outputs = ("Ipcmd", "Iqcmd", "Ipmax", "Iqmax", "Iqinj", "Pord", "Volt_dip", "Qsel", "PIQ_y", "PIV_y",
-               "fThld2", "s4_y")
+               "fThld2", "s4_y", "Pref")
 
     # ------------------------------------------------------------------ import
     @classmethod
@@ -349,9 +352,10 @@ class REECA1(Component):
         # voltage-dip reactive current injection
         iqv = p["Kqv"] * deadband(self.Vref0r - s0y, p["dbd1"], p["dbd2"])
         iqinj = self._iqinj(iqv, dip, t)
-        # active power
-        pref = self.Pref0 + pext
+        # active power: Pref from a torque controller (WTTQA1) if any, wg from a drive train
+        pref = ctx.sig.get(f"{self.type_name}.Pref", self.Pref0) + pext
         pfy = pfl                      # LagRate: output = state (tpfilt > 0)
+        pfy = np.where(p["PFLAG"] > 0, ctx.sig.get(f"{self.type_name}.wg", 1.0) * pfy, pfy)   # Psel
         # Tpord = 0: the limiter only (held in a dip, as a frozen state)
         pord = np.where(p["Tpord"] > 0, s5, np.where(dip, self._pord_hold, np.clip(pfy, p["PMIN"], p["PMAX"])))
         # current limiter
@@ -399,6 +403,7 @@ class REECA1(Component):
         o[f"{tn}.Qsel"], o[f"{tn}.PIQ_y"], o[f"{tn}.PIV_y"] = qsel, piq, piv
         o[f"{tn}.fThld2"] = fthld2.astype(float)
         o[f"{tn}.s4_y"] = s4y
+        o[f"{tn}.Pref"] = pref + 0.0
 
     def accept(self, t, ctx):
         """Update the discrete memory at an accepted point: dip end times, held values."""
