@@ -279,13 +279,25 @@ class System:
         self.sig_defaults = dict(zip(SIGNALS, self._sig_stack))
         for c in self.comps:
             c.setup(self)
-        # one machine per static generator
+        # one dynamic model per static generator, or several that share it (gammap, gammaq)
+        shares = {}
         for c in self.comps:
             if c.kind == "machine" or (c.kind == "device" and hasattr(c, "gen")):
+                shared = getattr(c, "gen_shared", False)
                 for i, g in enumerate(c.gen):
-                    if g in gen_used and not getattr(c, "gen_shared", False):
-                        raise DataError(c.element(i), "gen", int(g), f"gen row already used by {gen_used[g]}")
-                    gen_used[g] = c.element(i)
+                    if g in gen_used and not (shared and gen_used[g][1]):
+                        raise DataError(c.element(i), "gen", int(g), f"gen row already used by {gen_used[g][0]}")
+                    gen_used[g] = (c.element(i), shared)
+                    if shared:
+                        shares.setdefault(int(g), []).append(
+                            (c.element(i), c.p.get("gammap", np.ones(c.n))[i], c.p.get("gammaq", np.ones(c.n))[i]))
+        for g, devs in shares.items():
+            for k, f in ((1, "gammap"), (2, "gammaq")):
+                tot = sum(d[k] for d in devs)
+                if abs(tot - 1.0) > 1e-9:
+                    raise DataError(devs[0][0], f, float(devs[0][k]),
+                                    f"the {f} of the devices on gen row {g} ({', '.join(d[0] for d in devs)}) "
+                                    f"sum to {tot:g}; they must sum to 1")
         from .network import GEN_STATUS
 
         for g in range(net.gen.shape[0]):

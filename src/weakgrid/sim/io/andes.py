@@ -91,9 +91,9 @@ ANDES_CONVENTIONS = {
 CONVENTIONS = ("standard", "andes")
 
 _MACHINE_FIELDS = {
-    "GENCLS": ("Sn", "Vn", "fn", "D", "M", "ra", "xd1"),
+    "GENCLS": ("Sn", "Vn", "fn", "D", "M", "ra", "xd1", "gammap", "gammaq"),
     "GENROU": ("Sn", "Vn", "fn", "D", "M", "ra", "xd1", "xl", "xd", "xq", "xd2", "xq1", "xq2",
-               "Td10", "Td20", "Tq10", "Tq20", "S10", "S12"),
+               "Td10", "Td20", "Tq10", "Tq20", "S10", "S12", "gammap", "gammaq"),
 }
 _CONTROL_FIELDS = {
     "EXDC2": ("TR", "TA", "TC", "TB", "TE", "TF1", "KF1", "KA", "KE", "VRMAX", "VRMIN", "E1", "SE1", "E2", "SE2"),
@@ -448,10 +448,6 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
             if _raw(m, "u")[k] <= 0:
                 notes.append(f"{mname} {m.idx.v[k]}: out of service (u = 0), skipped")
                 continue
-            for fld in ("gammap", "gammaq"):
-                if _raw(m, fld)[k] != 1:
-                    raise DataError(f"ANDES {mname} {m.idx.v[k]}", fld, _raw(m, fld)[k],
-                                    "only one machine per static generator (gamma = 1) is supported")
             if gen_row[m.gen.v[k]] is None or G[gen_row[m.gen.v[k]]][7] <= 0:
                 notes.append(f"{mname} {m.idx.v[k]}: its static generator {m.gen.v[k]} is out of service, skipped")
                 continue

@@ -15,6 +15,8 @@ BASE_PARAMS = (
     Param("D", 0.0, "pu (machine base)", "damping coefficient", "nonneg", "power"),
     Param("ra", 0.0, "pu (machine base)", "armature resistance", "nonneg", "z"),
     Param("xd1", 0.302, "pu (machine base)", "d-axis transient reactance x'd", "pos", "z"),
+    Param("gammap", 1.0, "-", "share of its static generator's P (devices on one row sum to 1)", "nonneg"),
+    Param("gammaq", 1.0, "-", "share of its static generator's Q (devices on one row sum to 1)", "nonneg"),
 )
 
 
@@ -34,6 +36,7 @@ class SyncMachine(Component):
 
     kind = "machine"
     order = 0
+    gen_shared = True        # with converters or other machines, by the shares gammap, gammaq
     units = {"delta": "angle", "omega": "speed", "Pe": "power", "Qe": "power", "te": "power",
              "tm": "power", "Id": "current", "Iq": "current"}
 
@@ -58,6 +61,10 @@ class SyncMachine(Component):
 
     def pattern(self, system):
         return None  # grouped with its controls by the system
+
+    def power_share(self, pf):
+        """Complex power of the power flow this machine takes: ``gammap Pg + j gammaq Qg`` [pu]."""
+        return pf.Pg[self.gen] * self.p["gammap"] + 1j * pf.Qg[self.gen] * self.p["gammaq"]
 
     @staticmethod
     def dq_voltage(V, delta):

@@ -35,7 +35,7 @@ class GENCLS(SyncMachine):
     def init(self, system, x, sig):
         pf = system.network.pf
         V = pf.V[self.bus]
-        S = pf.Pg[self.gen] + 1j * pf.Qg[self.gen]
+        S = self.power_share(pf)
         I = np.conj(S / V)
         ra, xq = self.p["ra"], self.p["xd1"]
         E = V + I * (ra + 1j * xq)

@@ -122,7 +122,7 @@ class GENROU(SyncMachine):
         p = self.p
         pf = system.network.pf
         V = pf.V[self.bus]
-        S = pf.Pg[self.gen] + 1j * pf.Qg[self.gen]
+        S = self.power_share(pf)
         It = np.conj(S / V)
         ra, xd2, xq2, xq, xd, xl = p["ra"], p["xd2"], p["xq2"], p["xq"], p["xd"], p["xl"]
         psi20 = V + It * (ra + 1j * xd2)          # sub-transient flux in the network frame

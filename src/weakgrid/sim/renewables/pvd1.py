@@ -115,15 +115,7 @@ class PVD1(Component):
     def setup(self, system):
         super().setup(system)
         p = self.p
-        self.resolve_gen_rows(system)
-        for f in ("gammap", "gammaq"):
-            for g in set(self.gen.tolist()):
-                on = self.gen == g
-                tot = p[f][on].sum()
-                if abs(tot - 1.0) > 1e-9:
-                    i = int(np.nonzero(on)[0][0])
-                    raise DataError(self.element(i), f, p[f][i],
-                                    f"the {f} of the PVD1 on gen row {g} sum to {tot:g}; they must sum to 1")
+        self.resolve_gen_rows(system)     # the shares on a row must sum to 1: System.setup checks
         c = p["Sn"] / system.Sb
         for prm in self.params:
             if prm.base in ("power", "current"):

@@ -43,6 +43,7 @@ class REGCA1(Component):
     """Renewable generator/converter model A (WECC); one per static generator row."""
 
     kind = "device"
+    gen_shared = True        # with machines or other converters, by the shares gammap, gammaq
     order = 0
     params = (
         Param("Sn", 100.0, "MVA", "device rating", "pos"),
@@ -82,11 +83,6 @@ class REGCA1(Component):
         super().setup(system)
         p = self.p
         self.resolve_gen_rows(system)
-        for i in range(self.n):
-            for f in ("gammap", "gammaq"):
-                if p[f][i] != 1:
-                    raise DataError(self.element(i), f, p[f][i],
-                                    "only one converter per static generator (gamma = 1) is supported")
         c = p["Sn"] / system.Sb
         for prm in self.params:
             if prm.base == "current":
