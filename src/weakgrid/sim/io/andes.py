@@ -74,6 +74,7 @@ ANDES_CONVENTIONS = {
     "ESDC2A": {"TR_used": 0.0},   # idem
     "IEEEX1": {"VR_Vt": 0.0},     # regulator limits VRMAX, VRMIN, not times Vt
     "EXST1": {"VR_limited": 0.0},  # output limit tested on the rate feedback (in effect never acts)
+    "REGCA1": {"LVPL_strict": 0.0},  # LVPL resets S0 only while dS0/dt >= 0 (S0 may stay above it)
 }
 CONVENTIONS = ("standard", "andes")
 
@@ -485,6 +486,9 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
             values = _params(cls, m, k)
             if hasattr(cls, "andes_params"):
                 values = cls.andes_params(m, k, ss, values)
+            if conventions == "andes" and mname in ANDES_CONVENTIONS:
+                values.update(ANDES_CONVENTIONS[mname])
+                applied[mname] = applied.get(mname, 0) + 1
             comp.add(name, link, values)
             dev_name[(mname, m.idx.v[k])] = name
     # every in-service static generator needs a dynamic model (machine or converter)
