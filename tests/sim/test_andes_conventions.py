@@ -77,7 +77,7 @@ def test_flags_accept_only_0_or_1():
     assert validate("EXAC1 'x'", EXAC1.params, {"TR_used": 0})["TR_used"] == 0
     with pytest.raises(DataError, match="TR_used"):
         validate("EXAC1 'x'", EXAC1.params, {"TR_used": 0.5})
-    assert set(ANDES_CONVENTIONS) == {"EXAC1", "ESDC2A", "IEEEX1", "EXST1"}
+    assert set(ANDES_CONVENTIONS) == {"EXAC1", "ESDC2A", "IEEEX1", "EXST1", "REGCA1"}
 
 
 CENSUS = {
