@@ -68,7 +68,7 @@ class REGCA1(Component):
         Param("gammap", 1.0, "-", "share of the static generator's P", "pos"),
         Param("gammaq", 1.0, "-", "share of the static generator's Q", "pos"),
         Param("LVPL_strict", 1.0, "-", "1: S0 never exceeds LVPL (reset whenever it crosses it); "
-              "0: reset only while dS0/dt >= 0 (ANDES 2.0)", "nonneg"),
+              "0: reset only while dS0/dt >= 0 (ANDES 2.0)", "flag"),
     )
     states = ("S0", "S1", "S2")
     outputs = ("Ipout", "Iqout", "Pe", "Qe", "LVG", "LVPL", "Ipcmd", "Iqcmd")
