@@ -52,7 +52,7 @@ pu with the voltage PI on too:
   output is recomputed at that iterate (8.948 pu, its upper limit) and frozen there when the
   dip resumes at the next one, and ANDES stops at h/4 ("Time step reduced to zero"). This is
   an artifact of iterates, not a model to reproduce: the harness removes it from ANDES
-  (``run_andes_ss(..., solve_at_clearing=True)``: after ANDES's restore the network is solved
+  (``solve_network_at_clearing``: after ANDES's restore the network is solved
   with the states and every ``VarService`` kept as at the clearing; ANDES's own step then
   starts there, nothing else changes). (``restore = 0`` is no remedy: ANDES's Newton then
   converges to a low-voltage solution, v = 0.44 pu after clearing.)
@@ -82,7 +82,7 @@ import pytest
 andes = pytest.importorskip("andes")
 
 from weakgrid.sim.peer.andes_case import (compare_named, load_case, run_andes_ss,  # noqa: E402
-                                          run_weakgrid_ss)
+                                          run_weakgrid_ss, solve_network_at_clearing)
 from converter_outputs import pq_gap  # noqa: E402
 
 pytestmark = [pytest.mark.andes, pytest.mark.slow]
@@ -113,7 +113,8 @@ voltage_pi_p = _set(QFLAG=1, Kvp=5, Kvi=20, PQFLAG=1)
 def _run(tool, h, modify, hold_step=True, solve_at_clearing=False, conventions="standard"):
     ss = load_case(CASE, fault=FAULT, modify=modify)
     if tool == "andes":
-        return run_andes_ss(ss, TF, h, hold_step=hold_step, solve_at_clearing=solve_at_clearing)
+        return run_andes_ss(ss, TF, h, hold_step=hold_step,
+                            configure=solve_network_at_clearing if solve_at_clearing else None)
     return run_weakgrid_ss(ss, TF, h, conventions=conventions)
 
 
@@ -223,7 +224,7 @@ def _fault_part(a, w):
 @pytest.fixture(scope="module")
 def lim():
     """The limits case (P priority). ANDES with its first Newton iterate after the clearing
-    on the network's solution (``solve_at_clearing``) and, at h, as ANDES does it
+    on the network's solution (``solve_network_at_clearing``) and, at h, as ANDES does it
     (``"a_raw"``); weakgrid with ANDES's conventions (REGCA1 ``LVPL_strict = 0``) and, at h,
     with the standard LVPL (``"w_std"``)."""
     return {"a": _run("andes", H, limits, solve_at_clearing=True),
