@@ -111,3 +111,22 @@ def test_lvpl_release_resumes_from_the_limit_without_a_jump():
     # released at Brkpt, S0 rises from the limit with the lag Tg: at most (0.6-0.3)*h/Tg per step
     assert jumps.max() < 0.3 * (1 / 240) / 0.05 * 1.05, jumps.max()
     assert ip[-1] == pytest.approx(0.6 / abs(s.network.pf.V[0]), abs=1e-2)
+
+
+def test_lvpl_reset_convention_flag():
+    """``LVPL_strict = 0`` (ANDES) resets S0 to LVPL only while dS0/dt >= 0. Without an
+    electrical control the command is constant, S0 sits on it (dS0/dt = 0) when LVPL falls
+    below it and is reset in both conventions: identical results. The flag takes 0 or 1."""
+    kw = dict(Brkpt=0.95, Zerox=0.5, Lvpl1=0.3, Lvpnt0=0.0, Lvpnt1=0.01, Tg=0.05)
+    ev = [Fault(bus=1, t_on=1.0, t_off=1.1, xf=0.08)]
+    std = build(**kw)
+    anc = build(LVPL_strict=0, **kw)
+    assert not std.lim_pushing.any() and anc.lim_pushing.sum() == 1
+    r_std, r_anc = simulate(std, 2.0, dt=1 / 240, events=ev), simulate(anc, 2.0, dt=1 / 240, events=ev)
+    for r in (r_std, r_anc):
+        s0, lvpl = np.asarray(r["PV.S0"]), np.asarray(r["PV.LVPL"])
+        assert lvpl.min() < 0.31 and np.all(s0 <= lvpl + 1e-7)     # reset to LVPL in both
+    # the same to the Newton tolerance (S0 at rest on its command: dS0/dt = 0 +- round-off)
+    assert np.max(np.abs(np.asarray(r_std["PV.Ipout"]) - np.asarray(r_anc["PV.Ipout"]))) < 1e-7
+    with pytest.raises(DataError, match="LVPL_strict"):
+        build(LVPL_strict=0.5, **kw)

@@ -186,6 +186,14 @@ class Component:
         """Non-windup limited states: list of ``(global_indices, lower, upper)``."""
         return []
 
+    def limits_reset_if_pushing(self) -> list[np.ndarray] | None:
+        """Optional, one boolean array per entry of :meth:`limits`: ``True`` where a state
+        that crosses its limit is reset to it only while its derivative pushes outwards
+        (``>= 0`` at an upper limit, ``<= 0`` at a lower one), as ANDES's ``AntiWindup``;
+        a state beyond its limit moving back towards it then stays free. ``None``: every
+        limit is a non-windup limit (the state never crosses it)."""
+        return None
+
     # -------------------------------------------------------------- equations
     def init(self, system, x: np.ndarray, sig: dict):
         """Set initial states in ``x`` from the power flow and published signals."""

@@ -516,10 +516,22 @@ class Simulator:
                 xl = z[li]
                 new_hi = (self.frozen == 0) & (xl > self.sys.lim_hi + 1e-9)
                 new_lo = (self.frozen == 0) & (xl < self.sys.lim_lo - 1e-9)
+                if self.sys.lim_pushing.any():   # reset only while pushing outwards (ANDES)
+                    fl, push = f1[li], self.sys.lim_pushing
+                    new_hi &= ~push | (fl >= 0)
+                    new_lo &= ~push | (fl <= 0)
                 if new_hi.any() or new_lo.any():
                     self.frozen[new_hi] = 1
                     self.frozen[new_lo] = -1
                     guess = z
+                    if (self.sys.lim_pushing & (new_hi | new_lo)).any():
+                        # a state reset from beyond its limit jumps (ANDES's AntiWindup): start
+                        # from the network solved with it at its limit, as after an event
+                        g = z.copy()
+                        g[li[new_hi]] = self.sys.lim_hi[new_hi]
+                        g[li[new_lo]] = self.sys.lim_lo[new_lo]
+                        guess = self.solve_algebraic(t + h, g)
+                        self._refresh_jacobian(t + h, guess)
                     continue
                 self._release_held(f1)
             # nonlinear correction to the predictor, extrapolated to the next step

@@ -322,19 +322,24 @@ class System:
         self.fault_shunt = np.zeros(self.nb, dtype=complex)
         self.z0 = np.concatenate([x0, V0.real, V0.imag])
         # non-windup limits
-        li, lo, hi = [], [], []
+        li, lo, hi, pushing = [], [], [], []
         self._var_lim = []   # components whose limits move with the solution (limit_values(ctx))
         for c in self.comps:
             start = sum(len(i) for i in li)
-            for idx, l, h in c.limits():
+            cond = c.limits_reset_if_pushing()
+            for k, (idx, l, h) in enumerate(c.limits()):
                 li.append(np.asarray(idx, int))
                 lo.append(np.broadcast_to(np.asarray(l, float), len(idx)))
                 hi.append(np.broadcast_to(np.asarray(h, float), len(idx)))
+                pushing.append(np.zeros(len(idx), bool) if cond is None
+                               else np.broadcast_to(np.asarray(cond[k], bool), len(idx)))
             if hasattr(c, "limit_values"):
                 self._var_lim.append((c, slice(start, sum(len(i) for i in li))))
         self.lim_idx = np.concatenate(li) if li else np.zeros(0, int)
         self.lim_lo = np.concatenate(lo) if lo else np.zeros(0)
         self.lim_hi = np.concatenate(hi) if hi else np.zeros(0)
+        # limits that reset a crossing state only while its derivative pushes outwards (ANDES)
+        self.lim_pushing = np.concatenate(pushing) if pushing else np.zeros(0, bool)
         # components with discrete memory (dip timers, held values) updated at accepted points
         self._accepting = [c for c in self.comps if hasattr(c, "accept")]
         self.update_network()

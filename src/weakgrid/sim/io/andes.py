@@ -73,6 +73,7 @@ def _supported():
 ANDES_CONVENTIONS = {
     "EXAC1": {"TR_used": 0.0},    # the summing junction takes the unfiltered voltage (TR unused)
     "ESDC2A": {"TR_used": 0.0},   # idem
+    "REGCA1": {"LVPL_strict": 0.0},  # LVPL resets S0 only while dS0/dt >= 0 (S0 may stay above it)
     "IEEEX1": {"VR_Vt": 0.0},     # regulator limits VRMAX, VRMIN, not times Vt
     "EXST1": {"VR_limited": 0.0},  # output limit tested on the rate feedback (in effect never acts)
     "IEEEVC": {"on_Sb": 1.0},     # rc, xc on the system base (its IEEEVC has no Sn)

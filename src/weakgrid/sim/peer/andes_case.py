@@ -207,3 +207,64 @@ def compare_named(a, b, t_grid=None):
     db = interp_to(t_grid, b["t"], b["delta"][:, ib])
     ra, rb = da - da[:, :1], db - db[:, :1]
     return float(np.max(np.abs(wa - wb))), float(np.degrees(np.max(np.abs(ra - rb))))
+
+
+def solve_network_at_clearing(ss, tol=1e-10, max_iter=30):
+    """Start ANDES's first Newton iterate after a fault clearing on the network's solution.
+
+    At a clearing ANDES's ``Fault`` (config ``restore = 1``) sets every algebraic variable
+    but the bus angles back to its pre-fault value, and the step after it starts its Newton
+    iteration there. ANDES evaluates its discrete services (``VarService``: REECA1's
+    ``Volt_dip``; ``ExtendedEvent``: its Thld/Thld2 timers; ``VarHold``: the held Ipmax) and
+    the freezes of its blocks at *every* iterate and keeps what they record there, so that
+    first iterate, which is not a solution (v = 1.0 pu, inside REECA1's normal band, where
+    the solution is outside it), can end a voltage dip that goes on at every accepted point.
+
+    This wraps the clearing callback of ``ss.Fault`` (only this system's): after ANDES's
+    restore, the algebraic equations are solved for the algebraic variables by Newton's method
+    with the states fixed at the clearing instant and every ``VarService`` kept at its value
+    there (limiters and anti-windups are evaluated as usual; the states and the state
+    derivatives that the trapezoidal step uses are put back). ANDES's own first step then
+    starts from that solution; nothing else of ANDES changes. A test-side diagnosis (the
+    peer harness), not a change of ANDES's method: ``test_reeca1_peer.py`` measures it with
+    and without. Pass it as ``run_andes_ss(..., configure=solve_network_at_clearing)``
+    (called after ``ss.setup()``).
+    """
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    fault = ss.Fault
+    clear = fault.tc.callback
+
+    def clear_and_solve(is_time):
+        action = clear(is_time)
+        if not action:
+            return action
+        dae = ss.dae
+        models = ss.exist.pflow_tds
+        x0, f0 = dae.x.copy(), dae.f.copy()
+        for it in range(max_iter):
+            dae.clear_fg()
+            ss.l_update_var(models, niter=it, err=None)
+            ss.f_update(models)
+            ss.l_update_eq(models, niter=it)
+            ss.g_update(models)
+            ss.fg_to_dae()
+            dae.x[:] = x0
+            if np.max(np.abs(dae.g)) < tol:
+                break
+            ss.j_update(models)
+            gy = dae.gy
+            A = sp.csc_matrix((np.asarray(gy.V).ravel(), (np.asarray(gy.I).ravel(), np.asarray(gy.J).ravel())),
+                              shape=gy.size)
+            dae.y[:] -= spla.spsolve(A, np.asarray(dae.g).ravel())
+            ss.vars_to_models()
+        else:
+            raise RuntimeError(f"the network after the clearing at t = {float(dae.t):g} s did not converge "
+                               f"in {max_iter} Newton iterations (|g| = {np.max(np.abs(dae.g)):.3g})")
+        dae.x[:] = x0
+        dae.f[:] = f0
+        ss.vars_to_models()
+        return action
+
+    fault.tc.callback = clear_and_solve

@@ -48,8 +48,10 @@ Conventions (those of ANDES 2.0, checked against it in ``tests/sim/test_reeca1_p
   its dip flags at every Newton iterate, and the first iterate after a fault clearing starts
   from the restored pre-fault voltage (inside the normal band): its hold starts there, with
   the pre-fault Ipmax, and stays on while the dip goes on. With P priority this lifts ANDES's
-  Ipmax from VDL2 (4.2 pu) to Imax for the first 20 ms after clearing in the peer case
-  (``test_reeca1_peer.py::test_limits_case``).
+  Ipmax from VDL2 (4.2 pu) to Imax for the first 20 ms after clearing in the peer case. An
+  artifact of ANDES's iterates, not reproduced here: the peer harness starts ANDES on the
+  network's solution after the clearing (``run_andes_ss(..., configure=solve_network_at_clearing)``), and
+  the tools then agree (``test_reeca1_peer.py::test_limits_case_andes_newton_start_at_clearing``).
 * The flag combinations follow ANDES's diagram, including its initial references:
   ``Qref0 = q0`` with ``QFLAG = 0``, ``Vref1 - v0`` with ``QFLAG = 1``.
 * ANDES adds ``Ipcmd0/LVG0 - Ipcmd0`` to the active current command so that the converter

@@ -22,9 +22,13 @@ Limits follow ANDES: the rate limits bound ``T dx/dt``; the upper limit LVPL of 
 an anti-windup limit that moves with ``S2``: a state that crosses it is *reset* to it and held
 there while its input pushes up (the integrator's non-windup limits, refreshed at every Newton
 iterate through :meth:`limit_values`), as ANDES's ``AntiWindup`` resets the state. The output
-is the state, so it never exceeds LVPL. (ANDES resets only a state whose derivative is >= 0:
-a state above a falling LVPL that decreases towards a smaller Ipcmd stays above the limit
-there, e.g. 5.4 pu against LVPL = 0.34 pu in ``tests/sim/test_reeca1_peer.py``'s limit case.) (Holding the state where it was when the limit first bound, and clipping only
+is the state, so it never exceeds LVPL. ANDES 2.0's ``AntiWindup`` resets only a state whose
+derivative is >= 0 (at every Newton iterate: ``x >= upper and dx/dt >= 0``): a state above a
+falling LVPL that decreases towards a smaller Ipcmd stays above the limit there, e.g. 5.4 pu
+against LVPL = 0.34 pu in ``tests/sim/test_reeca1_peer.py``'s limit case. The flag
+``LVPL_strict = 0`` reproduces that (the integrator then holds S0 at LVPL only when it
+crosses the limit with dS0/dt >= 0; a held S0 is released when dS0/dt < 0, as always);
+``from_andes(..., conventions="andes")`` sets it. (Holding the state where it was when the limit first bound, and clipping only
 the output, leaves the state far above a limit that fell in a fault; when LVPL switches off
 at ``Brkpt`` the output then jumps back to the state, and the step cannot converge.)
 """
@@ -64,6 +68,8 @@ class REGCA1(Component):
         Param("Accel", 0.0, "-", "acceleration factor (unused, as ANDES)", ""),
         Param("gammap", 1.0, "-", "share of the static generator's P", "pos"),
         Param("gammaq", 1.0, "-", "share of the static generator's Q", "pos"),
+        Param("LVPL_strict", 1.0, "-", "1: S0 never exceeds LVPL (reset whenever it crosses it); "
+              "0: reset only while dS0/dt >= 0 (ANDES 2.0)", "flag"),
     )
     states = ("S0", "S1", "S2")
     outputs = ("Ipout", "Iqout", "Pe", "Qe", "LVG", "LVPL", "Ipcmd", "Iqcmd")
@@ -113,6 +119,10 @@ class REGCA1(Component):
     def limits(self):
         """``S0`` below LVPL(S2) (anti-windup, reset to the limit when it crosses it)."""
         return [(self.idx("S0"), np.full(self.n, -np.inf), self._lvpl_limit(self._v0))]
+
+    def limits_reset_if_pushing(self):
+        """``LVPL_strict = 0`` (ANDES 2.0): S0 is reset to LVPL only while dS0/dt >= 0."""
+        return [self.p["LVPL_strict"] <= 0]
 
     def _lvpl_limit(self, s2):
         lim = self._lvpl(s2)
