@@ -22,10 +22,15 @@ import pytest
 
 andes = pytest.importorskip("andes")
 
-from weakgrid.sim.integrate import Simulator  # noqa: E402
-from weakgrid.sim.io.andes import from_andes  # noqa: E402
-from weakgrid.sim.peer.andes_case import compare_named, load_case, run_andes_ss, run_weakgrid_ss  # noqa: E402
-from weakgrid.sim.peer.andes_dip_hold import andes_dip_holds, impose_dip_holds  # noqa: E402
+from weakgrid.sim.integrate import Simulator
+from weakgrid.sim.io.andes import from_andes
+from weakgrid.sim.peer.andes_case import (
+    compare_named,
+    load_case,
+    run_andes_ss,
+    run_weakgrid_ss,
+)
+from weakgrid.sim.peer.andes_dip_hold import andes_dip_holds, impose_dip_holds
 
 pytestmark = pytest.mark.andes      # ~15 s
 
