@@ -11,7 +11,14 @@ REECA1 without its voltage-dependent current limits (VDL1, VDL2), its post-dip s
 * ``Vsel = clip(PIQ, VMIN, VMAX)`` with VFLAG = 1, 0 with VFLAG = 0; the voltage PI's input is
   ``Vsel`` (QFLAG = 1); the initial Q reference is ``q0``.
 
-The voltage-dip freeze of ``s4``, ``s5`` and the PI controllers is REECA1's.
+The voltage-dip freeze of ``s4``, ``s5`` and the PI controllers is REECA1's: in a dip the PI
+outputs are held at their value at the last accepted point before it. ANDES 2.0 holds them at
+their value in the Newton iterate at which its dip flag switched, which after a network event
+is neither: on ANDES's ``ieee14_reecb1`` (census fault) its held ``PIV_y`` is 0.110 pu in the
+fault and 0.089 pu from the clearing to the end of the dip, against 0.072 pu before it. That
+value depends on ANDES's Newton path, so no model flag reproduces it; it alone makes the
+2.1e-5 pu gap on that case (4.5e-6 pu with ANDES's held values imposed,
+:mod:`weakgrid.sim.peer.andes_dip_hold`, ``tests/sim/test_reecb1_peer.py``).
 """
 
 from __future__ import annotations
