@@ -130,3 +130,28 @@ def test_lvpl_reset_convention_flag():
     assert np.max(np.abs(np.asarray(r_std["PV.Ipout"]) - np.asarray(r_anc["PV.Ipout"]))) < 1e-7
     with pytest.raises(DataError, match="LVPL_strict"):
         build(LVPL_strict=0.5, **kw)
+
+
+def build_shared(g_machine, g_conv, **gen):
+    """Bus 1's generator row shared by a GENCLS (share g_machine) and a REGCA1 (g_conv)."""
+    s = System(two_machine_case(x_line=0.2, p=0.6))
+    s.add_machine("GENROU", "SG", 1, **SG)
+    s.add_machine("GENCLS", "G1", 0, Sn=100, M=4.0, xd1=0.3, gammap=g_machine[0], gammaq=g_machine[1])
+    c = s.add_component(REGCA1())
+    c.add_regca1("PV", gen=0, Sn=100, Brkpt=0.8, gammap=g_conv[0], gammaq=g_conv[1])
+    return s.setup(**gen)
+
+
+def test_machine_and_converter_share_a_generator_row():
+    # ANDES's ieee14_wt3n: a GENCLS that takes no power shares the slack row with a converter
+    for gm, gc in [((0.3, 0.6), (0.7, 0.4)), ((0.0, 0.0), (1.0, 1.0))]:
+        s = build_shared(gm, gc)
+        F, ctx = s.residual(0.0, s.z0)
+        assert np.max(np.abs(F)) < 1e-8
+        pf = s.network.pf
+        assert ctx.out["REGCA1.Pe"][0] == pytest.approx(gc[0] * pf.Pg[0], abs=1e-9)
+        m = s.machine_number("G1")
+        assert ctx.sig["Pe"][m] == pytest.approx(gm[0] * pf.Pg[0], abs=1e-9)
+        assert ctx.sig["Qe"][m] == pytest.approx(gm[1] * pf.Qg[0], abs=1e-9)
+    with pytest.raises(DataError, match="gammaq.*sum to 1.1"):
+        build_shared((0.3, 0.7), (0.7, 0.4))
