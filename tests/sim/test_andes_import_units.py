@@ -1,6 +1,5 @@
 """Per-unit conversions of the ANDES importer against ANDES's own (issue 8, item 4)."""
 
-import numpy as np
 import pytest
 
 andes = pytest.importorskip("andes")

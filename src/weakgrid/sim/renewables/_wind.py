@@ -35,6 +35,20 @@ def resolve(comp, system, field, target):
     return tc, out
 
 
+def andes_link(m, k, dev_name, field, target, why=""):
+    """Link ``{field: weakgrid name}`` of ANDES turbine device ``k`` of model ``m`` to the ``target``
+    device its ``field`` names; ``None`` (skipped) when that device exists but was skipped
+    (out of service); refuses a name that is not a ``target``."""
+    idx = getattr(m, field).v[k]
+    name = dev_name.get((target, idx))
+    if name is None:
+        ss = m.system
+        if target in ss.models and idx in list(ss.models[target].idx.v):
+            return None
+        raise DataError(f"ANDES {m.class_name} {m.idx.v[k]}", field, idx, f"no {target} with this idx{why}")
+    return {field: name}
+
+
 def chain_of(comp):
     """``(REECA1 component, REECA1 indices)`` of the instances of a turbine model (after init)."""
     return comp.ree_comp, comp.ree

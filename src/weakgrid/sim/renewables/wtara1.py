@@ -17,7 +17,7 @@ import numpy as np
 from ..component import Component
 from ..errors import DataError
 from ..params import Param
-from ._wind import resolve
+from ._wind import andes_link, resolve
 
 
 class WTARA1(Component):
@@ -35,14 +35,7 @@ class WTARA1(Component):
     @classmethod
     def andes_link(cls, m, k, dev_name, **_):
         """Link of ANDES device ``k``: the weakgrid name of its drive train (``rego``)."""
-        name = dev_name.get(("WTDTA1", m.rego.v[k]))
-        if name is None:
-            ss = m.system
-            if "WTDTA1" in ss.models and m.rego.v[k] in list(ss.WTDTA1.idx.v):
-                return None
-            raise DataError(f"ANDES WTARA1 {m.idx.v[k]}", "rego", m.rego.v[k],
-                            "no WTDTA1 with this idx (the only drive train supported)")
-        return {"rego": name}
+        return andes_link(m, k, dev_name, "rego", "WTDTA1", " (the only drive train supported)")
 
     @classmethod
     def andes_params(cls, m, k, ss, values):

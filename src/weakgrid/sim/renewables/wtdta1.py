@@ -32,7 +32,7 @@ from ..blocks import Integrator
 from ..component import Component
 from ..errors import DataError
 from ..params import Param
-from ._wind import chain_pattern, publish, resolve
+from ._wind import andes_link, chain_pattern, publish, resolve
 
 
 class WTDTA1(Component):
@@ -54,14 +54,7 @@ class WTDTA1(Component):
     @classmethod
     def andes_link(cls, m, k, dev_name, **_):
         """Link of ANDES device ``k``: the weakgrid name of its REECA1 (``ree``)."""
-        name = dev_name.get(("REECA1", m.ree.v[k]))
-        if name is None:
-            ss = m.system
-            if "REECA1" in ss.models and m.ree.v[k] in list(ss.REECA1.idx.v):
-                return None
-            raise DataError(f"ANDES WTDTA1 {m.idx.v[k]}", "ree", m.ree.v[k],
-                            "no REECA1 with this idx (the only electrical control supported for WTDTA1)")
-        return {"ree": name}
+        return andes_link(m, k, dev_name, "ree", "REECA1", " (the only electrical control supported for WTDTA1)")
 
     def add_wtdta1(self, name, ree, **params):
         """Add one drive train linked to the REECA1 named ``ree``."""

@@ -34,7 +34,7 @@ from ..blocks import LagRate, PINonWindup
 from ..component import Component
 from ..errors import DataError
 from ..params import Param
-from ._wind import chain_pattern, held, resolve
+from ._wind import andes_link, chain_pattern, held, resolve
 
 
 class WTPTA1(Component):
@@ -64,13 +64,7 @@ class WTPTA1(Component):
     @classmethod
     def andes_link(cls, m, k, dev_name, **_):
         """Link of ANDES device ``k``: the weakgrid name of its aerodynamics (``rea``)."""
-        name = dev_name.get(("WTARA1", m.rea.v[k]))
-        if name is None:
-            ss = m.system
-            if "WTARA1" in ss.models and m.rea.v[k] in list(ss.WTARA1.idx.v):
-                return None
-            raise DataError(f"ANDES WTPTA1 {m.idx.v[k]}", "rea", m.rea.v[k], "no WTARA1 with this idx")
-        return {"rea": name}
+        return andes_link(m, k, dev_name, "rea", "WTARA1", "")
 
     @classmethod
     def andes_params(cls, m, k, ss, values):

@@ -39,7 +39,7 @@ from ..blocks import Lag, PINonWindup, piecewise_linear
 from ..component import Component
 from ..errors import DataError
 from ..params import Param
-from ._wind import chain_pattern, held, publish, resolve
+from ._wind import andes_link, chain_pattern, held, publish, resolve
 
 
 class WTTQA1(Component):
@@ -73,13 +73,7 @@ class WTTQA1(Component):
     @classmethod
     def andes_link(cls, m, k, dev_name, **_):
         """Link of ANDES device ``k``: the weakgrid name of its pitch controller (``rep``)."""
-        name = dev_name.get(("WTPTA1", m.rep.v[k]))
-        if name is None:
-            ss = m.system
-            if "WTPTA1" in ss.models and m.rep.v[k] in list(ss.WTPTA1.idx.v):
-                return None
-            raise DataError(f"ANDES WTTQA1 {m.idx.v[k]}", "rep", m.rep.v[k], "no WTPTA1 with this idx")
-        return {"rep": name}
+        return andes_link(m, k, dev_name, "rep", "WTPTA1", "")
 
     @classmethod
     def andes_params(cls, m, k, ss, values):
