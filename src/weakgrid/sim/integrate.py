@@ -516,7 +516,7 @@ class Simulator:
                 xl = z[li]
                 new_hi = (self.frozen == 0) & (xl > self.sys.lim_hi + 1e-9)
                 new_lo = (self.frozen == 0) & (xl < self.sys.lim_lo - 1e-9)
-                if self.sys.lim_pushing.any():   # reset only while pushing outwards (ANDES)
+                if self.sys.any_pushing:   # reset only while pushing outwards (ANDES)
                     fl, push = f1[li], self.sys.lim_pushing
                     new_hi &= ~push | (fl >= 0)
                     new_lo &= ~push | (fl <= 0)

@@ -90,22 +90,19 @@ def _registry():
     from .renewables import ESD1, PVD1, REECA1, REECB1, REGCA1, REPCA1
     from .sources import InfiniteBus, PVSource
 
-    from .exciters import ESDC2A, ESST3A, EXAC1, EXST1, IEEET1, IEEEVC, IEEEX1
-    from .governors import IEEEG1, IEESGO, TG2, TGOV1N
+    from .exciters import (AC8B, ESAC1A, ESDC1A, ESDC2A, ESST1A, ESST3A, ESST4B, EXAC1, EXAC4, EXST1,
+                           IEEET1, IEEET3, IEEEVC, IEEEX1)
+    from .governors import GAST, IEEEG1, IEESGO, TG2, TGOV1N
     from .pss import ST2CUT
-    from .exciters import AC8B, ESST4B, EXAC4
-    from .governors import GAST
-    from .exciters import ESAC1A, ESDC1A, ESST1A, IEEET3
     from .renewables import WTARA1, WTDTA1, WTPTA1, WTTQA1
 
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
-                                    IEEEG1, IEESGO, TG2, TGOV1N, ST2CUT, IEEEVC)
+                                    ESST1A, ESAC1A, ESDC1A, IEEET3, ESST4B, EXAC4, AC8B, IEEEVC,
+                                    IEEEG1, IEESGO, TG2, TGOV1N, GAST, ST2CUT)
             + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ESD1, ZIP)
             + (WTDTA1, WTARA1, WTPTA1, WTTQA1)    # after REECA1: the ANDES importer links in this order
-            + (InfiniteBus, PVSource)
-            + (ESST4B, EXAC4, AC8B, GAST)
-            + (ESST1A, ESAC1A, ESDC1A, IEEET3)}
+            + (InfiniteBus, PVSource)}
 
 
 class System:
@@ -340,6 +337,7 @@ class System:
         self.lim_hi = np.concatenate(hi) if hi else np.zeros(0)
         # limits that reset a crossing state only while its derivative pushes outwards (ANDES)
         self.lim_pushing = np.concatenate(pushing) if pushing else np.zeros(0, bool)
+        self.any_pushing = bool(self.lim_pushing.any())
         # components with discrete memory (dip timers, held values) updated at accepted points
         self._accepting = [c for c in self.comps if hasattr(c, "accept")]
         self.update_network()

@@ -35,7 +35,7 @@ import numpy as np
 from ..blocks import Lag, PINonWindup, PITrackAW
 from ..control_base import MachineControl
 from ..params import Param
-from .esst3a import rectified_voltage, source_voltage
+from .esst3a import rectified_voltage, source_voltage, source_voltage0
 
 #: tracking gain of ANDES's PITrackAW (its ESST4B config ``ksr = ksm = 2``)
 ANDES_TRACKING_GAIN = 2.0
@@ -101,9 +101,7 @@ class ESST4B(MachineControl):
         p = self.p
         m = self.mach
         vf0, v = sig["vf0"][m], sig["Ecomp0"][m]
-        V = sig["Vt0"][m] * np.exp(1j * sig["theta0"][m])      # terminal phasor (for VE)
-        It = np.conj((sig["Pe0"][m] + 1j * sig["Qe0"][m]) / V)
-        VE0 = np.abs(self.KPC * V + 1j * (p["KI"] + self.KPC * p["XL"]) * It)
+        VE0 = source_voltage0(sig, m, self.KPC, p["KI"], p["XL"])
         VB0 = self._vb(VE0, sig["XadIfd"][m])
         VM0 = vf0 / VB0
         VR0 = np.minimum(p["KG"] * vf0, p["VGMAX"])        # VA = VG: zero inner-loop error

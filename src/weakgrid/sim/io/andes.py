@@ -91,49 +91,6 @@ ANDES_CONVENTIONS = {
 }
 CONVENTIONS = ("standard", "andes")
 
-_MACHINE_FIELDS = {
-    "GENCLS": ("Sn", "Vn", "fn", "D", "M", "ra", "xd1", "gammap", "gammaq"),
-    "GENROU": ("Sn", "Vn", "fn", "D", "M", "ra", "xd1", "xl", "xd", "xq", "xd2", "xq1", "xq2",
-               "Td10", "Td20", "Tq10", "Tq20", "S10", "S12", "gammap", "gammaq"),
-}
-_CONTROL_FIELDS = {
-    "EXDC2": ("TR", "TA", "TC", "TB", "TE", "TF1", "KF1", "KA", "KE", "VRMAX", "VRMIN", "E1", "SE1", "E2", "SE2"),
-    "SEXS": ("TATB", "TB", "K", "TE", "EMIN", "EMAX"),
-    "TGOV1": ("Tn", "wref0", "R", "VMAX", "VMIN", "T1", "T2", "T3", "Dt"),
-    "IEEEST": ("MODE", "A1", "A2", "A3", "A4", "A5", "A6", "T1", "T2", "T3", "T4", "T5", "T6", "KS",
-               "LSMAX", "LSMIN", "VCU", "VCL"),
-    "ESST3A": ("TR", "VIMAX", "VIMIN", "KM", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KG", "KP", "KI",
-               "VBMAX", "KC", "XL", "VGMAX", "THETAP", "TM", "VMMAX", "VMMIN"),
-    "EXST1": ("TR", "VIMAX", "VIMIN", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KC", "KF", "TF"),
-    "IEEEX1": ("TR", "TA", "TC", "TB", "TE", "TF1", "KF1", "KA", "KE", "VRMAX", "VRMIN", "E1", "SE1", "E2", "SE2"),
-    "IEEET1": ("TR", "KA", "TA", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF", "Switch", "E1", "SE1", "E2", "SE2"),
-    "EXAC1": ("TR", "TB", "TC", "KA", "TA", "VRMAX", "VRMIN", "TE", "KF", "TF", "KC", "KD", "KE",
-              "E1", "SE1", "E2", "SE2"),
-    "ESDC2A": ("TR", "KA", "TA", "TB", "TC", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF1", "Switch",
-               "E1", "SE1", "E2", "SE2"),
-    "ESST1A": ("TR", "VIMAX", "VIMIN", "TB", "TC", "TB1", "TC1", "VAMAX", "VAMIN", "KA", "TA", "ILR", "KLR",
-               "VRMAX", "VRMIN", "KF", "TF", "KC", "UELc", "VOSc"),
-    "ESAC1A": ("TR", "TB", "TC", "VAMAX", "VAMIN", "KA", "TA", "VRMAX", "VRMIN", "TE", "E1", "SE1", "E2", "SE2",
-               "KD", "KC", "KE", "KF", "TF", "Switch"),
-    "ESDC1A": ("TR", "KA", "TA", "TB", "TC", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF1", "Switch",
-               "E1", "SE1", "E2", "SE2"),
-    "IEEET3": ("TR", "KA", "TA", "VRMAX", "VRMIN", "VBMAX", "KE", "TE", "KF", "TF", "KP", "KI"),
-    "IEEEG1": ("Tn", "wref0", "K", "T1", "T2", "T3", "UO", "UC", "PMAX", "PMIN", "T4", "K1", "K2", "T5", "K3",
-               "K4", "T6", "K5", "K6", "T7", "K7", "K8"),
-    "IEESGO": ("Tn", "wref0", "T1", "T2", "T3", "T4", "T5", "T6", "K1", "K2", "K3", "PMAX", "PMIN"),
-    "TG2": ("Tn", "wref0", "R", "pmax", "pmin", "dbl", "dbu", "dbc", "T1", "T2"),
-    "TGOV1N": ("Tn", "wref0", "R", "VMAX", "VMIN", "T1", "T2", "T3", "Dt"),
-    "IEEEVC": ("rc", "xc"),
-    "ESST4B": ("TR", "KPR", "KIR", "VRMAX", "VRMIN", "TA", "KPM", "KIM", "VMMAX", "VMMIN", "KG", "KP", "KI",
-               "VBMAX", "KC", "XL", "THETAP", "VGMAX"),
-    "EXAC4": ("TR", "VIMAX", "VIMIN", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KC"),
-    "AC8B": ("TR", "kP", "kI", "kD", "Td", "VPMAX", "VPMIN", "VRMAX", "VRMIN", "VFEMAX", "VEMIN", "TA", "KA",
-             "TE", "E1", "SE1", "E2", "SE2", "KE", "KD", "KC"),
-    "GAST": ("Tn", "wref0", "R", "VMAX", "VMIN", "KT", "AT", "T1", "T2", "T3", "Dt"),
-    "ST2CUT": ("MODE", "MODE2", "K1", "K2", "T1", "T2", "T3", "T4", "T5", "T6", "T7", "T8", "T9", "T10",
-               "LSMAX", "LSMIN", "VCU", "VCL"),
-}
-
 
 def _col(m, name):
     p = getattr(m, name)
@@ -159,11 +116,9 @@ def _in_service(m):
 
 
 def _params(cls, m, k):
-    """Values of the weakgrid parameters of ``cls`` read by name from ANDES device ``k`` of ``m``."""
-    fields = _MACHINE_FIELDS.get(cls.__name__) or _CONTROL_FIELDS.get(cls.__name__)
-    if fields is None:
-        fields = [p.name for p in cls.params if p.name in m.params]
-    return {f: float(_raw(m, f)[k]) for f in fields}
+    """Values of the weakgrid parameters of ``cls`` read by name from ANDES device ``k`` of ``m``
+    (those ANDES has: weakgrid's own flags, e.g. the conventions, keep their defaults)."""
+    return {p.name: float(_raw(m, p.name)[k]) for p in cls.params if p.name in m.params}
 
 
 def psse_branch_sn(ss):

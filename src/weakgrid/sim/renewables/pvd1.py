@@ -103,8 +103,6 @@ class PVD1(Component):
             j = list(ss.BusFreq.idx.v).index(bf)
             values[tf] = float(ss.BusFreq.Tf.v[j])
             values[tw] = float(ss.BusFreq.Tw.v[j])
-        else:
-            values.pop(tf, None)   # an ANDES field of the same name is not the BusFreq's
         return values
 
     def add_pvd1(self, name, gen, **params):
@@ -139,7 +137,7 @@ class PVD1(Component):
         """Factors ``(lo, hi)`` of the active-current limits: ``lo*Ipmax <= Ipcmd <= hi*Ipmax``."""
         return 0.0, 1.0
 
-    def _commands(self, v, V, fHz, ipout, iqout, gates=(0.0, 1.0)):
+    def _commands(self, v, V, fHz, ipout, iqout, gates):
         p = self.p
         vp = np.maximum(v, 0.01)
         R = _band_lo(v, p["vt0"], p["vt1"]) * _band_hi(v, p["vt2"], p["vt3"]) \

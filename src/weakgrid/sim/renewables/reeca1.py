@@ -405,7 +405,7 @@ class REECA1(Component):
         o[f"{tn}.Qsel"], o[f"{tn}.PIQ_y"], o[f"{tn}.PIV_y"] = qsel, piq, piv
         o[f"{tn}.fThld2"] = fthld2.astype(float)
         o[f"{tn}.s4_y"] = s4y
-        o[f"{tn}.Pref"] = pref + 0.0
+        o[f"{tn}.Pref"] = pref
 
     def accept(self, t, ctx):
         """Update the discrete memory at an accepted point: dip end times, held values."""

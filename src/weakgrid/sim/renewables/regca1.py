@@ -44,7 +44,8 @@ from ..params import Param
 
 
 class REGCA1(Component):
-    """Renewable generator/converter model A (WECC); one per static generator row."""
+    """Renewable generator/converter model A (WECC) on a static generator row (or its share of it:
+    ``gammap``, ``gammaq``)."""
 
     kind = "device"
     gen_shared = True        # with machines or other converters, by the shares gammap, gammaq
