@@ -10,11 +10,6 @@ Layers (imports flow one way): ``cli → study → (sim, models) → game``.
 * :mod:`weakgrid.cli` — the ``weakgrid`` command.
 """
 
-from importlib.metadata import PackageNotFoundError, version as _version
-
-try:
-    __version__ = _version("weakgrid")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0.0.0+unknown"
+from ._version import __version__
 
 __all__ = ["__version__"]

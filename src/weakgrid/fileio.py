@@ -203,9 +203,18 @@ def write_json_atomic(path, obj) -> Path:
 
 def savefig_atomic(fig, path, **kwargs) -> Path:
     """``fig.savefig(path)`` through the atomic writer (format from the target's suffix)."""
+    import matplotlib
+
     path = Path(path)
     fmt = kwargs.pop("format", path.suffix.lstrip(".") or None)
-    return replace_atomic(path, lambda tmp: fig.savefig(tmp, format=fmt, **kwargs))
+
+    def save(tmp):
+        # SVG text kept as text (labels stay searchable), for this call only: the host's
+        # rcParams are left alone
+        with matplotlib.rc_context({"svg.fonttype": "none"}):
+            fig.savefig(tmp, format=fmt, **kwargs)
+
+    return replace_atomic(path, save)
 
 
 _UNSAFE = re.compile(r"[^A-Za-z0-9_.+-]")

@@ -58,12 +58,9 @@ def run(args) -> int:
     print(f"  => mode of the controlled machine '{setup.source}' (participation {part:.2f}); "
           f"design model (10): {abs(lam_d.imag) / (2 * np.pi):.4g} Hz")
     if args.plot:
-        import matplotlib
+        from ..figure import new_figure
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(7, 4.5))
+        fig, ax = new_figure(figsize=(7, 4.5))
         lam = m.eigenvalues
         ax.scatter(lam.real, lam.imag, s=12, label="full grid")
         if k_m is not None:
@@ -88,6 +85,5 @@ def run(args) -> int:
         from ..fileio import savefig_atomic
 
         savefig_atomic(fig, args.plot, dpi=110)
-        plt.close(fig)
         print(f"  wrote {args.plot}")
     return 0

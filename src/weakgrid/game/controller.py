@@ -34,12 +34,9 @@ FILE_FORMAT = "weakgrid-controller/1"
 
 
 def _package_version():
-    from importlib.metadata import PackageNotFoundError, version
+    from .._version import __version__
 
-    try:
-        return version("weakgrid")
-    except PackageNotFoundError:  # pragma: no cover
-        return "0.0.0+unknown"
+    return __version__
 
 
 @dataclass(eq=False)

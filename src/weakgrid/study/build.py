@@ -27,7 +27,6 @@ The UPQC is either an existing series branch (``upqc.branch``: a branch name, a 
 
 from __future__ import annotations
 
-import logging
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -37,6 +36,7 @@ import numpy as np
 from ..design import derive_design
 from ..design.upqc_insert import insert_upqc_matpower, insert_upqc_pandapower
 from ..game.errors import ParameterError
+from ..logs import quiet_loggers
 from ..sim.errors import DataError
 from ..sim.controllers import gti_design_states, sg_design_states
 from ..sim.gti import GTI
@@ -139,7 +139,6 @@ def _pandapower_net(g, load):
     if fn is None or not callable(fn):
         raise ParameterError("grid.network", g["network"], "not a function of "
                              "pandapower.networks (e.g. case9, create_cigre_network_mv)")
-    logging.getLogger("pandapower").setLevel(logging.ERROR)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         net = fn(**g.get("kwargs", {}))
@@ -310,7 +309,6 @@ def _andes_network(study, g, up):
     from ..sim.io.andes import from_andes
 
     addfile = _andes_file(study, g["dyr"]) if g.get("dyr") else None
-    logging.getLogger("andes").setLevel(logging.ERROR)
     ss = andes.load(_andes_file(study, g["file"]), addfile=addfile, setup=False,
                     no_output=True, default_config=True)
     system, _ = from_andes(ss, include_events=False)
@@ -341,7 +339,8 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
     upqc = upqc or d["upqc"]["structure"]
     if variant not in VARIANTS:
         raise ParameterError("variant", variant, f"choose one of {VARIANTS}")
-    network, bus_id, br_names, k_up, system = _network(study, load)
+    with quiet_loggers("pandapower", "andes"):   # their parsers' notes; restored after
+        network, bus_id, br_names, k_up, system = _network(study, load)
     if d["upqc"].get("side", "from") == "to":     # the branch's to-bus is the shunt bus r
         row = network.branch[k_up]
         row[F_BUS], row[T_BUS] = row[T_BUS], row[F_BUS]

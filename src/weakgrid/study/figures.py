@@ -9,13 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-matplotlib.rcParams["svg.fonttype"] = "none"  # keep text as text: labels stay searchable
-import matplotlib.pyplot as plt  # noqa: E402
-
-from ..fileio import savefig_atomic  # noqa: E402
+from ..figure import new_figure
+from ..fileio import savefig_atomic
 
 __all__ = ["PANELS", "figure_specs", "write_figures"]
 
@@ -93,8 +88,8 @@ def write_figures(records: dict, folder, specs, formats=("png", "svg")) -> list[
         fig_id, title = spec["id"], spec["title"]
         panels = [(k, PANELS.get(k, k)) for k in spec["panels"]]
         runs = [tuple(r) for r in spec["runs"]]
-        fig, axes = plt.subplots(len(panels), 1, figsize=(7.0, 2.6 * len(panels) + 0.6),
-                                 sharex=True, squeeze=False)
+        fig, axes = new_figure(len(panels), 1, figsize=(7.0, 2.6 * len(panels) + 0.6),
+                               sharex=True, squeeze=False)
         missing = []
         for ax, (key, ylabel) in zip(axes[:, 0], panels):
             for rid, label in runs:
@@ -123,5 +118,4 @@ def write_figures(records: dict, folder, specs, formats=("png", "svg")) -> list[
             p = folder / f"{fig_id}.{fmt}"
             savefig_atomic(fig, p, dpi=110)
             written.append(p)
-        plt.close(fig)
     return written

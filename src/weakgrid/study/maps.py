@@ -65,11 +65,10 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
     -------
     matplotlib.figure.Figure
     """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
     from matplotlib.colors import TwoSlopeNorm
+    from matplotlib.patches import Rectangle
+
+    from ..figure import new_figure
 
     facets = [None] if facet is None else list(dict.fromkeys(table[facet].tolist()))
     xs = sorted(dict.fromkeys(table[x].tolist()))
@@ -82,9 +81,9 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
     norm = None
     if center is not None and vmin < center < vmax:
         norm = TwoSlopeNorm(vcenter=center, vmin=vmin, vmax=vmax)
-    fig, axes = plt.subplots(1, len(facets), figsize=(1.2 + 0.9 * len(xs) * len(facets) + 1.2,
-                                                       1.4 + 0.55 * len(ys)),
-                             squeeze=False, constrained_layout=True)
+    fig, axes = new_figure(1, len(facets), figsize=(1.2 + 0.9 * len(xs) * len(facets) + 1.2,
+                                                     1.4 + 0.55 * len(ys)),
+                           squeeze=False, layout="constrained")
     im = None
     for ax, fv in zip(axes[0], facets):
         sub = table if fv is None else table[table[facet] == fv]
@@ -121,7 +120,7 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
                         color="white" if dark else "black")
         if mark is not None and mark[0] in xs and mark[1] in ys:
             j, i = xs.index(mark[0]), ys.index(mark[1])
-            ax.add_patch(plt.Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, lw=2.5,
+            ax.add_patch(Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, lw=2.5,
                                        edgecolor="black"))
         ax.set_xticks(range(len(xs)), [_fmt(v) if isinstance(v, float) else str(v) for v in xs])
         ax.set_yticks(range(len(ys)), [_fmt(v) if isinstance(v, float) else str(v) for v in ys])

@@ -211,8 +211,6 @@ def draw_maps(study, table, folder, quick=False) -> list[dict]:
     (PNG); returns per map: spec, cells (DataFrame), path, mark."""
     from pathlib import Path
 
-    import matplotlib.pyplot as plt
-
     from .studyfile import get_path
     from .sweep import _axes
 
@@ -240,7 +238,7 @@ def draw_maps(study, table, folder, quick=False) -> list[dict]:
                        x_label=_short(x), y_label=_short(y),
                        cmap="RdBu_r" if center else "viridis", center=center,
                        mark_label="the shipped (paper's) setting", path=path)
-        plt.close(fig)
+        del fig
         out.append({"spec": spec, "cells": cells, "path": path, "mark": mark,
                     "axes": (x, y, facet)})
     return out
