@@ -8,7 +8,7 @@ import os
 from pathlib import Path
 
 from .. import __version__
-from ..models import load_preset, load_problem, preset_names
+from ..models.presets import preset_names
 
 
 def add_problem_arguments(p):
@@ -20,6 +20,8 @@ def add_problem_arguments(p):
 
 def problem_of(args):
     """The :class:`~weakgrid.models.TrainingProblem` selected by the arguments."""
+    from ..models import load_preset, load_problem
+
     return load_preset(args.preset) if args.preset else load_problem(args.config)
 
 

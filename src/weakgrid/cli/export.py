@@ -8,10 +8,6 @@ from pathlib import Path
 
 from .. import __version__
 from ..fileio import write_json_atomic
-from ..game.errors import ParameterError
-from ..game.export_c import generate_c, valid_c_name
-from ..game.export_json import describe_controller
-from ..models import load_controller
 from ..fileio import write_texts_atomic
 from ._common import input_file, output_folder
 
@@ -51,6 +47,11 @@ def default_name(path: Path) -> str:
 
 def run(args) -> int:
     """Run ``weakgrid export`` with the parsed ``args``; return the exit status."""
+    from ..game.errors import ParameterError
+    from ..game.export_c import generate_c, valid_c_name
+    from ..game.export_json import describe_controller
+    from ..models import load_controller
+
     path = Path(args.file)
     if not path.exists():
         raise FileNotFoundError(f"controller file {path} does not exist (write one with "

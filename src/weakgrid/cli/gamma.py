@@ -7,8 +7,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..fileio import write_json_atomic
-from ..game.checkpoint import load_search_checkpoint, save_search_checkpoint
-from ..game.gamma_search import SearchSettings, search_min_gamma
+from ..game.gamma_settings import SearchSettings
 from ._checkpoint import (Keeper, add_restart_argument, checkpoint_path, content_key,
                           load_kept, problem_inputs, say_kept)
 from ._common import (add_force_argument, add_problem_arguments, guard_training, output_file,
@@ -74,6 +73,9 @@ def _running(r, text) -> str:
 
 def run(args) -> int:
     """Run ``weakgrid gamma`` with the parsed ``args``; return the exit status."""
+    from ..game.checkpoint import load_search_checkpoint, save_search_checkpoint
+    from ..game.gamma_search import search_min_gamma
+
     problem = problem_of(args)
     settings = SearchSettings(rtol=args.rtol, max_trials=args.max_trials,
                               rollout_steps=args.rollout_steps, escape_factor=args.escape_factor,

@@ -6,10 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-import numpy as np
 
-from ..game.hji import closed_loop_spectral_radius
-from ..game.errors import ParameterError
 from ._checkpoint import (CHECKPOINT_SECONDS, TrainingCheckpoint, add_restart_argument,
                           checkpoint_path, outer_bar, training_key)
 from ._common import (add_force_argument, add_problem_arguments, guard_training, output_file,
@@ -49,6 +46,10 @@ def _fmt_row(cells, widths):
 
 def run(args) -> int:
     """Run ``weakgrid train`` with the parsed ``args``; return the exit status."""
+    import numpy as np
+    from ..game.hji import closed_loop_spectral_radius
+    from ..game.errors import ParameterError
+
     problem = problem_of(args)
     if args.u_bound is not None:
         problem = problem.with_input_bound(

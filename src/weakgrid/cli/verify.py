@@ -5,14 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import numpy as np
 
 from ..fileio import write_json_atomic
-from ..game.checkpoint import load_dp_checkpoint, save_dp_checkpoint
-from ..game.dynamic_programming import DPSettings, solve_game_dp
-from ..game.errors import ParameterError
-from ..game.optimality import closed_loop_gap, default_starts, value_error
-from ..models import load_controller
+from ..game.dp_settings import DPSettings
 from ._checkpoint import (Keeper, TrainingCheckpoint, add_restart_argument, checkpoint_path,
                           content_key, load_kept, say_kept, training_key)
 from ._common import (add_force_argument, add_problem_arguments, guard_dp, guard_training,
@@ -72,6 +67,13 @@ def _pct(v):
 
 def run(args) -> int:
     """Run ``weakgrid verify`` with the parsed ``args``; return the exit status."""
+    import numpy as np
+    from ..game.checkpoint import load_dp_checkpoint, save_dp_checkpoint
+    from ..game.dynamic_programming import solve_game_dp
+    from ..game.errors import ParameterError
+    from ..game.optimality import closed_loop_gap, default_starts, value_error
+    from ..models import load_controller
+
     problem = problem_of(args)
     if args.u_bound is not None:
         problem = problem.with_input_bound(

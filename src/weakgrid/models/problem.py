@@ -47,16 +47,13 @@ from ..game.bases import PolynomialBasis
 from ..game.errors import ShapeError
 from .design import UPQCDesignModel, gti_design_model, sg_design_model
 from .policies import NonlinearInitialPolicy, lqr_policy
+from .presets import preset_names
 
 __all__ = ["TrainingProblem", "preset_names", "load_preset", "load_problem", "problem_from_dict"]
 
 _SECTIONS = {"preset", "model", "cost", "mesh", "basis", "initial_policy", "solver", "published"}
 
 
-def preset_names() -> list[str]:
-    """Names of the shipped presets."""
-    folder = resources.files("weakgrid") / "data" / "presets"
-    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
 
 
 def _read_toml(path) -> dict:
