@@ -11,6 +11,17 @@ from .. import __version__
 from ..models.presets import preset_names
 
 
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Help with each option's default, said once: not appended where the help text already
+    says it (``default: …``), nor where there is none to say (``None``, ``False``)."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if "default" in text.lower() or action.default in (None, False, argparse.SUPPRESS):
+            return text
+        return super()._get_help_string(action)
+
+
 def add_problem_arguments(p):
     """``--preset NAME`` or ``--config FILE`` (one of them required)."""
     src = p.add_mutually_exclusive_group(required=True)

@@ -3,12 +3,11 @@ the full grid's mode, train the HJI controller and write it."""
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 from ._checkpoint import TrainingCheckpoint, add_restart_argument, checkpoint_path, outer_bar
 from ._checkpoint import training_key
-from ._common import output_file
+from ._common import HelpFormatter, output_file
 from ._study import add_operating_point, add_study_argument, study_of
 
 NAME = "design"
@@ -22,7 +21,7 @@ def add_parser(sub):
                     "(10) with every intermediate value and its source, set its mode beside the "
                     "full grid's mode in which the controlled machine participates most, train "
                     "the HJI controller with the study's design settings and write it.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        formatter_class=HelpFormatter)
     add_study_argument(p)
     add_operating_point(p)
     p.add_argument("--output", "-o", type=output_file(".json"), default=None,

@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import argparse
 import re
 from pathlib import Path
 
 from .. import __version__
 from ..fileio import write_json_atomic
 from ..fileio import write_texts_atomic
-from ._common import input_file, output_folder
+from ._common import HelpFormatter, input_file, output_folder
 
 NAME = "export"
 
@@ -26,7 +25,7 @@ def add_parser(sub):
                     "parameters, basis exponents, weights, cost and the saddle-point formula. "
                     "Supported model kinds: 'upqc-design' (the paper's model (10)) and "
                     "'linear'.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        formatter_class=HelpFormatter)
     p.add_argument("file", type=input_file, help="controller file (JSON)")
     p.add_argument("--format", choices=("c", "json"), default="c", help="what to write")
     p.add_argument("--name", default=None,

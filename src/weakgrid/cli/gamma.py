@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import argparse
 from dataclasses import replace
 from pathlib import Path
 
@@ -10,8 +9,8 @@ from ..fileio import write_json_atomic
 from ..game.gamma_settings import SearchSettings
 from ._checkpoint import (Keeper, add_restart_argument, checkpoint_path, content_key,
                           load_kept, problem_inputs, say_kept)
-from ._common import (add_force_argument, add_problem_arguments, guard_training, output_file,
-                      positive_float, positive_int, problem_of, provenance)
+from ._common import (HelpFormatter, add_force_argument, add_problem_arguments, guard_training,
+                      output_file, positive_float, positive_int, problem_of, provenance)
 
 NAME = "gamma"
 
@@ -26,7 +25,7 @@ def add_parser(sub):
                     "worst-case disturbance w* stays bounded and returns to the origin from "
                     "the corners and edge midpoints of the training region. Prints gamma*, "
                     "the bracket and every trial; writes the controller at gamma*.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        formatter_class=HelpFormatter)
     add_problem_arguments(p)
     d = SearchSettings()
     p.add_argument("--rtol", type=positive_float, default=d.rtol, help="relative width of the bracket")

@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-import argparse
 
-from ._common import nonnegative_float, output_file
+from ._common import HelpFormatter, nonnegative_float, output_file
 from ._study import add_operating_point, add_study_argument, study_of
 
 NAME = "modes"
@@ -18,7 +17,7 @@ def add_parser(sub):
                     "(algebraic variables eliminated), print every oscillatory mode with its "
                     "frequency, damping ratio and most participating states, mark the mode of "
                     "the controlled machine beside the design model's, and plot them.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        formatter_class=HelpFormatter)
     add_study_argument(p)
     add_operating_point(p)
     p.add_argument("--min-hz", type=nonnegative_float, default=0.0,

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
-from ._common import add_cluster_arguments, check_cluster, output_folder
+from ._common import HelpFormatter, add_cluster_arguments, check_cluster, output_folder
 
 NAME = "reproduce"
 
@@ -18,7 +17,7 @@ def add_parser(sub):
                     "simulate every scenario and baseline, and write the figures (Figs. 7–16, "
                     "18–25; PNG and SVG), a metrics table (CSV and Markdown) and report.html "
                     "with a verdict for each claim of the paper.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        formatter_class=HelpFormatter)
     p.add_argument("--output", "-o", type=output_folder, default=Path("reproduce-output"),
                    help="output folder")
     p.add_argument("--quick", action="store_true",

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
-from ._common import add_cluster_arguments, check_cluster, output_folder
+from ._common import HelpFormatter, add_cluster_arguments, check_cluster, output_folder
 
 NAME = "run"
 
@@ -18,7 +17,7 @@ def add_parser(sub):
                     "need, train the HJI controller there, simulate every scenario with every "
                     "controller, and write metrics (CSV, Markdown), figures, run signals and "
                     "report.html.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        formatter_class=HelpFormatter)
     p.add_argument("study", nargs="?", help="a study file (TOML) or a shipped study's name")
     p.add_argument("--output", "-o", type=output_folder, default=None,
                    help="output folder (default: <study>-output)")

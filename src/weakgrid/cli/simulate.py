@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-import argparse
 
-from ._common import output_file, positive_float
+from ._common import HelpFormatter, output_file, positive_float
 
 NAME = "simulate"
 
@@ -16,7 +15,7 @@ def add_parser(sub):
         description="Build the study's grid at the scenario's operating point, attach the "
                     "controller to the UPQC (or the PQ baseline), apply the scenario's events "
                     "and print the metrics.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        formatter_class=HelpFormatter)
     p.add_argument("study", help="a study file (TOML) or a shipped study's name")
     p.add_argument("--scenario", "-s", default=None,
                    help="scenario id (default: the study's first)")

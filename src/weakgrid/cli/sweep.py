@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
-from ._common import add_cluster_arguments, add_force_argument, check_cluster, output_folder
+from ._common import (HelpFormatter, add_cluster_arguments, add_force_argument, check_cluster,
+                      output_folder)
 
 NAME = "sweep"
 
@@ -24,7 +24,7 @@ def add_parser(sub):
                     "runs still to do (a short probe of the study's grid is timed) and refuses "
                     "a sweep beyond 30 min or 4 GiB / half the available memory "
                     "(WEAKGRID_MAX_GIB) unless --force.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        formatter_class=HelpFormatter)
     p.add_argument("study", help="a study file (TOML) or a shipped study's name")
     p.add_argument("--output", "-o", type=output_folder, default=None,
                    help="output folder (default: <study>-sweep)")

@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
 
 from ._checkpoint import (CHECKPOINT_SECONDS, TrainingCheckpoint, add_restart_argument,
                           checkpoint_path, outer_bar, training_key)
-from ._common import (add_force_argument, add_problem_arguments, guard_training, output_file,
-                      positive_float, problem_of)
+from ._common import (HelpFormatter, add_force_argument, add_problem_arguments, guard_training,
+                      output_file, positive_float, problem_of)
 
 NAME = "train"
 
@@ -22,7 +21,7 @@ def add_parser(sub):
         description="Train the game-theoretic controller of a preset or a TOML problem file, "
                     "print the iterations, the weights beside the published ones, timing and "
                     "diagnostics, and write the controller file (JSON).",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        formatter_class=HelpFormatter)
     add_problem_arguments(p)
     p.add_argument("--output", "-o", type=output_file(".json"), default=None,
                    help="controller file to write (default: NAME.controller.json)")

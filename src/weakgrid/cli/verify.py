@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 
@@ -10,9 +9,9 @@ from ..fileio import write_json_atomic
 from ..game.dp_settings import DPSettings
 from ._checkpoint import (Keeper, TrainingCheckpoint, add_restart_argument, checkpoint_path,
                           content_key, load_kept, say_kept, training_key)
-from ._common import (add_force_argument, add_problem_arguments, guard_dp, guard_training,
-                      input_file, nonnegative_float, output_file, positive_float, positive_int,
-                      problem_of, provenance)
+from ._common import (HelpFormatter, add_force_argument, add_problem_arguments, guard_dp,
+                      guard_training, input_file, nonnegative_float, output_file, positive_float,
+                      positive_int, problem_of, provenance)
 
 NAME = "verify"
 
@@ -28,7 +27,7 @@ def add_parser(sub):
                     "value on the training region and the closed-loop optimality gap (cost "
                     "of u* vs the DP policy from a set of starts, with no disturbance and with "
                     "the DP's worst-case disturbance).",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        formatter_class=HelpFormatter)
     add_problem_arguments(p)
     d = DPSettings()
     p.add_argument("--controller", type=input_file, default=None,
