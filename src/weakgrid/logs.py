@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import sys
 
-__all__ = ["logger", "quiet_loggers"]
+__all__ = ["logger", "quiet_loggers", "console"]
 
 #: the package's logger; modules use ``logging.getLogger(__name__)`` below it
 logger = logging.getLogger("weakgrid")
@@ -32,3 +33,42 @@ def quiet_loggers(*names: str, level: int = logging.ERROR):
     finally:
         for n, old in saved.items():
             logging.getLogger(n).setLevel(old)
+
+
+class _Stdout(logging.StreamHandler):
+    """A handler writing plain messages to the *current* ``sys.stdout`` (so that a caller that
+    redirects it after the handler was made, e.g. a test's capture, still receives them)."""
+
+    def __init__(self):
+        super().__init__(sys.stdout)
+        self.setFormatter(logging.Formatter("%(message)s"))
+
+    @property
+    def stream(self):
+        return sys.stdout
+
+    @stream.setter
+    def stream(self, value):   # StreamHandler.__init__ assigns it; the property decides
+        pass
+
+
+@contextlib.contextmanager
+def console(verbosity: int = 0):
+    """Show the package's messages on stdout for the duration of a command (the CLI's use).
+
+    ``verbosity``: -1 warnings and errors only (``--quiet``), 0 progress messages (INFO),
+    1 or more debugging details (``-v``). The handler and level are removed on exit, so a
+    host that calls :func:`weakgrid.cli.main.main` keeps its own logging setup.
+    """
+    level = logging.WARNING if verbosity < 0 else logging.INFO if verbosity == 0 else logging.DEBUG
+    handler = _Stdout()
+    old_level, old_propagate = logger.level, logger.propagate
+    logger.addHandler(handler)
+    logger.setLevel(level)
+    logger.propagate = False
+    try:
+        yield handler
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(old_level)
+        logger.propagate = old_propagate

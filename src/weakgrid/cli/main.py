@@ -56,8 +56,18 @@ def build_parser() -> argparse.ArgumentParser:
                         help="print the full traceback of an error")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for mod in SUBCOMMANDS:
-        mod.add_parser(sub)
+        _add_verbosity(mod.add_parser(sub))
     return parser
+
+
+def _add_verbosity(p):
+    """``--quiet``/``-q`` and ``--verbose``/``-v`` on a subcommand (the package's log level;
+    a command that already has ``--quiet`` keeps its own, which also shortens its tables)."""
+    if "--quiet" not in p._option_string_actions:
+        p.add_argument("--quiet", "-q", action="store_true",
+                       help="print only warnings, errors and the results")
+    p.add_argument("--verbose", "-v", action="count", default=0,
+                   help="more detail (repeatable)")
 
 
 def _input_errors():
@@ -149,8 +159,11 @@ def main(argv=None) -> int:
         previous = signal.signal(signal.SIGTERM, _sigterm)
     except ValueError:  # not the main thread
         pass
+    from ..logs import console
+
     try:
-        return int(args.func(args) or 0)
+        with console(-1 if getattr(args, "quiet", False) else getattr(args, "verbose", 0)):
+            return int(args.func(args) or 0)
     except BaseException as exc:  # the one error boundary
         if isinstance(exc, SystemExit):
             raise

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import math
 from pathlib import Path
 
@@ -90,8 +91,10 @@ def load_run(folder, scenario, key: str, record_class):
     return record_class(scenario, metrics, series, d.get("info", {}))
 
 
-def remove_stale(folder, keep_ids, log=print, suffix=".json") -> list[str]:
-    """Remove the runs in ``folder`` whose id is not in ``keep_ids``; say so."""
+def remove_stale(folder, keep_ids, log=None, suffix=".json") -> list[str]:
+    """Remove the runs in ``folder`` whose id is not in ``keep_ids``; say so (``log``, default
+    this module's logger as a warning)."""
+    log = log or logging.getLogger(__name__).warning
     folder = Path(folder)
     if not folder.is_dir():
         return []

@@ -16,6 +16,7 @@ Every file is written atomically (:mod:`weakgrid.fileio`).
 from __future__ import annotations
 
 import contextlib
+import logging
 import json
 import time
 from pathlib import Path
@@ -141,7 +142,7 @@ def _run_task(study, run, trained):
     return run_scenario(study, run, trained)
 
 
-def run_studies(studies, output, quick=False, log=print, title=None, progress=True,
+def run_studies(studies, output, quick=False, log=None, title=None, progress=True,
                 scheduler=None, workers=None, maps=True) -> dict:
     """Run every (scenario, controller) of ``studies`` and write everything to ``output``.
 
@@ -151,6 +152,7 @@ def run_studies(studies, output, quick=False, log=print, title=None, progress=Tr
 
     Returns a summary dict (claims, metrics, figures, report, designs, maps).
     """
+    log = log or logging.getLogger(__name__).info
     out = Path(output)
     runs_dir = out / "runs"
     runs_dir.mkdir(parents=True, exist_ok=True)

@@ -19,7 +19,7 @@ def paper_studies():
     return out
 
 
-def reproduce(output="reproduce-output", quick=False, log=print, scheduler=None,
+def reproduce(output="reproduce-output", quick=False, log=None, scheduler=None,
               workers=None) -> dict:
     """Run the paper's case studies (and their sweeps, as maps) and write everything to
     ``output``; simulations run on a Dask cluster (see :func:`run_studies`)."""

@@ -245,7 +245,7 @@ def run_point(inputs: dict):
 
 
 def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
-                    progress=True, log=print, cache_dir=None) -> pd.DataFrame:
+                    progress=True, log=None, cache_dir=None) -> pd.DataFrame:
     """Run the study's sweep; write ``<output>/<study>-sweep.parquet``; return the table.
 
     The cache (``<output>/cache`` unless given) keeps every finished run: an interrupted

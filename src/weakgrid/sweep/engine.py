@@ -31,6 +31,8 @@ from ..fileio import replace_atomic
 from ..game.errors import ParameterError, WeakgridError
 from .cache import ResultCache, run_key
 
+_log = logging.getLogger(__name__)
+
 __all__ = ["run_sweep", "execute", "SweepInterrupted", "results_table", "open_client",
            "LOCAL_CLUSTER_CONFIG"]
 
@@ -250,7 +252,7 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
     """
     if workers is not None and (not isinstance(workers, int) or workers < 0):
         raise ParameterError("workers", workers, "give a whole number ≥ 0 (0 = serial)")
-    log = log or (lambda msg: None)
+    log = log or _log.info
     cache = ResultCache(cache_dir)
     keys = [run_key(p.inputs, run) for p in points]
     if len(set(keys)) != len(keys):
