@@ -58,6 +58,11 @@ LOCAL_CLUSTER_CONFIG = {
     "distributed.admin.system-monitor.interval": "2s",
     # the memory limits (pause, spill, restart) checked every 0.5 s, not 0.1 s
     "distributed.worker.memory.monitor-interval": "500ms",
+    # no HTTP endpoints: the scheduler and the workers start an HTTP server even without the
+    # dashboard (health, JSON state, Prometheus metrics), which nobody here reads and which
+    # needs no credentials; with no routes it answers nothing
+    "distributed.scheduler.http.routes": [],
+    "distributed.worker.http.routes": [],
 }
 
 
@@ -137,9 +142,19 @@ def open_client(scheduler=None, workers=None):
     """A ``distributed.Client`` for the block: of the cluster at ``scheduler``
     (``tcp://host:port``), else of a new LocalCluster with ``workers`` single-threaded
     worker processes (default: one per core) and :data:`LOCAL_CLUSTER_CONFIG`, closed at
-    the end. One cluster can serve several sweeps (pass the client to :func:`run_sweep`)."""
+    the end. One cluster can serve several sweeps (pass the client to :func:`run_sweep`).
+
+    The local cluster is private: it listens on 127.0.0.1 only, speaks TLS with mutual
+    authentication by a key pair made for it in memory (``distributed.Security.temporary``),
+    so that no other process of the machine — another user's included — can connect to it
+    and run code in its workers; the dashboard and every HTTP endpoint are off. A cluster
+    given by ``scheduler`` is the user's: its security is its own (for a TLS cluster, set
+    the client's certificates in Dask's configuration, ``distributed.comm.tls.*``, which
+    ``Client`` reads).
+    """
     import dask
     from distributed import Client, LocalCluster
+    from distributed.security import Security
 
     if scheduler:
         client = Client(scheduler, timeout="20s")
@@ -152,10 +167,12 @@ def open_client(scheduler=None, workers=None):
     # the workers' own logs stay quiet: a run's failure is a row of the table, and an interrupt
     # (SIGINT/SIGTERM) must not print the workers' shutdown tracebacks (heartbeats to a closing
     # scheduler); a lost worker still reaches the client as an exception
+    security = Security.temporary()   # TLS, both ends authenticated; the key never touches disk
     with dask.config.set(LOCAL_CLUSTER_CONFIG):  # the workers get this config at their start
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.CRITICAL)
-    client = Client(cluster)
+                               host="127.0.0.1", dashboard_address=None,
+                               silence_logs=logging.CRITICAL, security=security)
+    client = Client(cluster, security=security)
     try:
         yield client
     finally:
