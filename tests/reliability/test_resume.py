@@ -49,3 +49,49 @@ def test_stale_runs_of_an_earlier_plan_are_removed_with_a_warning(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "keep.json", "keep.parquet", "keep.samples.parquet"]
     assert "stale" in said[0] and "old" in said[0]
+
+
+def test_a_forged_or_edited_record_is_refused_with_a_warning(tmp_path, caplog):
+    import json
+    import logging
+
+    sc = Scenario("f", C1, "high", "conventional", "pq", 0.2, 0.25, 1.0)
+    key = inputs_key(scenario=sc.to_dict())
+    save_run(_rec(sc), tmp_path, key)
+    assert load_run(tmp_path, sc, key, RunRecord) is not None
+    p = tmp_path / "f.json"
+    good = p.read_text()
+    d = json.loads(good)
+    d["metrics"]["failed"] = True                # a well-formed record with another result
+    p.write_text(json.dumps(d))
+    with caplog.at_level(logging.WARNING, logger="weakgrid"):
+        assert load_run(tmp_path, sc, key, RunRecord) is None
+    assert any("checksum" in r.getMessage() for r in caplog.records)
+    p.write_text(good)                           # the signals edited: refused as well
+    import pandas as pd
+    df = pd.read_parquet(tmp_path / "f.parquet")
+    df["speed"] *= 2
+    df.to_parquet(tmp_path / "f.parquet")
+    assert load_run(tmp_path, sc, key, RunRecord) is None
+
+
+def test_a_forged_sweep_record_is_refused_and_run_again(tmp_path, caplog):
+    import json
+    import logging
+
+    from weakgrid.sweep import expand, run_sweep
+
+    pts = expand({"x": 1.0}, {"x": [1.0, 2.0]})
+    t1 = run_sweep(pts, _double, cache_dir=tmp_path, workers=0, progress=False)
+    rec_path = tmp_path / f"{t1['key'][0]}.json"
+    d = json.loads(rec_path.read_text())
+    d["metrics"]["v"] = 99.0
+    rec_path.write_text(json.dumps(d))
+    with caplog.at_level(logging.WARNING, logger="weakgrid"):
+        t2 = run_sweep(pts, _double, cache_dir=tmp_path, workers=0, progress=False)
+    assert list(t2["v"]) == [2.0, 4.0]           # recomputed, not the forged 99
+    assert any("checksum" in r.getMessage() for r in caplog.records)
+
+
+def _double(inputs):
+    return {"v": 2.0 * inputs["x"]}

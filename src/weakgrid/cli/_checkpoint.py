@@ -15,7 +15,6 @@ One pattern for every long command:
 
 from __future__ import annotations
 
-import hashlib
 import sys
 import time
 from pathlib import Path
@@ -39,11 +38,10 @@ def checkpoint_path(out: Path, kind: str = "") -> Path:
 
 def content_key(inputs: dict) -> str:
     """A content hash of ``inputs`` (JSON-able) and of the code (every source and data file
-    of the package, with its version)."""
-    from ..sweep.cache import canonical_json, code_fingerprint
+    of the package, with its version): :func:`weakgrid.hashing.content_key`."""
+    from ..hashing import content_key as key
 
-    text = canonical_json({"inputs": inputs, "code": code_fingerprint()})
-    return hashlib.sha256(text.encode()).hexdigest()[:24]
+    return key(inputs)
 
 
 def problem_inputs(problem, settings) -> dict:

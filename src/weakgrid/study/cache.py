@@ -9,7 +9,6 @@ simulating it again; a changed input gives another key and the run is redone.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import logging
 import math
@@ -20,17 +19,16 @@ import pandas as pd
 
 from .. import __version__
 from ..fileio import replace_atomic, write_json_atomic
-from ..sweep.cache import canonical_json, code_fingerprint
+from ..hashing import checksum_ok, content_key, with_checksum
 
 __all__ = ["inputs_key", "save_run", "load_run", "remove_stale"]
 
 
 def inputs_key(**inputs) -> str:
     """A short hash of ``inputs`` (JSON-serializable) and of the code (every source and data
-    file of the package, :func:`weakgrid.sweep.code_fingerprint`): a changed input or a
-    changed code never reuses a stale result."""
-    text = canonical_json({"inputs": inputs, "code": code_fingerprint()})
-    return hashlib.sha256(text.encode()).hexdigest()[:20]
+    file of the package): a changed input or a changed code never reuses a stale result
+    (:func:`weakgrid.hashing.content_key`)."""
+    return content_key(inputs)
 
 
 def _frame(series: dict, length_of: str):
@@ -67,9 +65,10 @@ def save_run(rec, folder, key: str, version: str = __version__) -> Path:
     replace_atomic(folder / f"{sid}.parquet", t_frame.to_parquet)
     s_frame = _frame({k: v for k, v in rec.series.items() if k not in t_frame.columns}, "tk")
     replace_atomic(folder / f"{sid}.samples.parquet", s_frame.to_parquet)
-    return write_json_atomic(folder / f"{sid}.json", {
-        "scenario": rec.scenario.to_dict(), "metrics": rec.metrics, "info": rec.info,
-        "weakgrid_version": version, "inputs_key": key})
+    record = {"scenario": rec.scenario.to_dict(), "metrics": rec.metrics, "info": rec.info,
+              "weakgrid_version": version, "inputs_key": key}
+    files = [folder / f"{sid}.parquet", folder / f"{sid}.samples.parquet"]
+    return write_json_atomic(folder / f"{sid}.json", with_checksum(record, files))
 
 
 def load_run(folder, scenario, key: str, record_class):
@@ -82,6 +81,11 @@ def load_run(folder, scenario, key: str, record_class):
     try:
         d = json.loads(paths[0].read_text(encoding="utf-8"))
         if not isinstance(d, dict) or d.get("inputs_key") != key:
+            return None
+        if not checksum_ok(d, paths[1:]):
+            logging.getLogger(__name__).warning(
+                "the finished run %s does not match its checksum (edited or damaged); it is "
+                "run again", paths[0])
             return None
         series = _unframe(pd.read_parquet(paths[1]))
         series.update(_unframe(pd.read_parquet(paths[2])))

@@ -1,62 +1,27 @@
-"""Finished runs cached under a content hash of their full input.
+"""Finished runs cached under a content hash of their full input (:mod:`weakgrid.hashing`).
 
 The key of a run is the SHA-256 of its input (canonical JSON), the name of the
 function that runs it and a fingerprint of the package's code (every ``.py``
 and data file of :mod:`weakgrid`), so a changed input or a changed code never
 reuses a stale result, and an interrupted sweep resumes where it stopped. Each
 run is one JSON file written atomically (plus its signals as Parquet, on
-request): a result is either complete on disk or absent.
+request): a result is either complete on disk or absent. Each record carries a checksum of
+its content and of its signals file; a record that fails it is refused with a warning and
+its run is done again.
 """
 
 from __future__ import annotations
 
-import functools
-import hashlib
 import json
-import math
+import logging
 from pathlib import Path
 
-from .. import __version__
 from ..fileio import replace_atomic, write_json_atomic
+from ..hashing import canonical_json, checksum_ok, code_fingerprint, content_key, with_checksum
 
 __all__ = ["ResultCache", "code_fingerprint", "run_key", "canonical_json"]
 
-
-def _canon(obj):
-    """JSON-able canonical form: tuples → lists, numpy scalars → Python, finite floats."""
-    if isinstance(obj, dict):
-        return {str(k): _canon(v) for k, v in sorted(obj.items(), key=lambda kv: str(kv[0]))}
-    if isinstance(obj, (list, tuple)):
-        return [_canon(v) for v in obj]
-    if hasattr(obj, "tolist") and not isinstance(obj, (str, bytes)):
-        return _canon(obj.tolist())
-    if isinstance(obj, float):
-        if math.isnan(obj):
-            return None
-        if math.isinf(obj):
-            return "Infinity" if obj > 0 else "-Infinity"
-        return float(repr(obj)) if obj != 0 else 0.0
-    if obj is None or isinstance(obj, (bool, int, str)):
-        return obj
-    return repr(obj)
-
-
-def canonical_json(obj) -> str:
-    """A canonical JSON text of ``obj`` (sorted keys, no spaces): equal inputs, equal text."""
-    return json.dumps(_canon(obj), sort_keys=True, separators=(",", ":"), allow_nan=False)
-
-
-@functools.lru_cache(maxsize=1)
-def code_fingerprint() -> str:
-    """SHA-256 over the package's source and data files (relative path and content)."""
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256(__version__.encode())
-    for p in sorted(root.rglob("*")):
-        if p.is_file() and p.suffix in (".py", ".toml", ".json", ".m") and \
-                "__pycache__" not in p.parts:
-            h.update(str(p.relative_to(root)).encode())
-            h.update(p.read_bytes())
-    return h.hexdigest()
+_log = logging.getLogger(__name__)
 
 
 def _func_name(run) -> str:
@@ -65,14 +30,10 @@ def _func_name(run) -> str:
 
 
 def run_key(inputs: dict, run=None) -> str:
-    """The cache key of a run: hash of its input, its function and the code (hex, 24 chars)."""
-    h = hashlib.sha256()
-    h.update(canonical_json(inputs).encode())
-    h.update(_func_name(run).encode() if run is not None else b"")
-    if run is not None and hasattr(run, "keywords"):
-        h.update(canonical_json(run.keywords).encode())
-    h.update(code_fingerprint().encode())
-    return h.hexdigest()[:24]
+    """The cache key of a run: hash of its input, its function (and a partial's keywords) and
+    the code (hex, 24 chars; :func:`weakgrid.hashing.content_key`)."""
+    return content_key({"inputs": inputs, "run": _func_name(run) if run is not None else "",
+                        "keywords": getattr(run, "keywords", None)})
 
 
 class ResultCache:
@@ -101,7 +62,14 @@ class ResultCache:
             rec = json.loads(p.read_text())
         except (OSError, ValueError):
             return None
-        return rec if isinstance(rec, dict) and rec.get("key") == key else None
+        if not isinstance(rec, dict) or rec.get("key") != key:
+            return None
+        files = [self.folder / rec["signals_file"]] if rec.get("signals_file") else []
+        if not checksum_ok(rec, files):
+            _log.warning("the cached run %s does not match its checksum (edited or damaged); "
+                         "it is run again", p)
+            return None
+        return rec
 
     def put(self, record: dict, signals=None) -> Path:
         """Store a finished run (atomically; signals first, so a record implies its signals)."""
@@ -110,7 +78,8 @@ class ResultCache:
             replace_atomic(self.folder / f"{key}.parquet",
                            lambda tmp: signals.to_parquet(tmp, index=False))
             record = dict(record, signals_file=f"{key}.parquet")
-        return write_json_atomic(self.path(key), _canon(record))
+        files = [self.folder / record["signals_file"]] if record.get("signals_file") else []
+        return write_json_atomic(self.path(key), with_checksum(record, files))
 
     def signals_path(self, key: str) -> Path:
         return self.folder / f"{key}.parquet"
