@@ -1,0 +1,1 @@
+def from_psse(*a, **k): raise NotImplementedError
