@@ -54,7 +54,7 @@ _ORDER_34 = (_ORDER_31[:5] + ["system switching device"] + _ORDER_31[5:]
 _NAMES = [("system switching device", "system switching device"), ("switching device", "system switching device"),
           ("non-transformer branch", "branch"), ("impedance correction", "impedance correction"),
           ("two-terminal", "two-terminal dc"), ("multi-terminal", "multi-terminal dc"),
-          ("vsc dc", "vsc dc"), ("multi-section", "multi-section line"),
+          ("vsc dc", "vsc dc"), ("voltage source converter", "vsc dc"), ("multi-section", "multi-section line"),
           ("inter-area", "inter-area transfer"), ("fixed shunt", "fixed shunt"),
           ("switched shunt", "switched shunt"), ("induction machine", "induction machine"),
           ("transformer", "transformer"), ("branch", "branch"), ("generator", "generator"),
