@@ -56,7 +56,10 @@ def _raw_mismatch(raw, net):
     mis = S - Sg + (net.bus[:, 2] + 1j * net.bus[:, 3]) / net.Sb
     slack = net.bus[:, 1] == 3
     mis[slack] = 0          # its generator's stored output is rounded
-    return float(np.max(np.abs(mis[k])))
+    # relative to the bus's admittance row: VM, VA are printed to 5 digits, and across a short
+    # branch (large |Y|) that rounding alone makes a large power mismatch
+    scale = np.asarray(np.abs(net.ybus()).sum(axis=1)).ravel()
+    return float(np.max(np.abs(mis[k]) / scale[k]))
 
 
 # --------------------------------------------------------------------------- tokenizer
@@ -86,7 +89,7 @@ SOLVED = ["GENROU__ThreeBusMulti", "AC1A__ThreeBusMulti", "ESST1A__TVC_System_32
 @pytest.mark.parametrize("path", RAWS, ids=lambda p: p.stem)
 def test_power_flow_reproduces_the_raw_solved_voltages(path):
     raw, net, _ = _net(path)
-    solved = _raw_mismatch(raw, net) < 1e-2     # printed to 5 digits: a solved case is ~1e-4
+    solved = _raw_mismatch(raw, net) < 1e-3     # [pu voltage]: a solved case is ~1e-5
     if path.stem in SOLVED:
         assert solved, "a PSS/E-solved case must satisfy its own stored voltages"
     if not solved:
@@ -94,8 +97,9 @@ def test_power_flow_reproduces_the_raw_solved_voltages(path):
     pf = net.solve_power_flow()
     k, Vr = _raw_voltages(raw, net)
     V = pf.V[k]
-    assert np.max(np.abs(np.abs(V) - np.abs(Vr))) < 5e-5          # VM printed to 1e-5
-    assert np.max(np.abs(np.degrees(np.angle(V / Vr)))) < 1e-3     # VA printed to 1e-4 deg
+    # PSS/E solves to 0.1 MW/Mvar (its default tolerance), and prints VM to 1e-5 pu, VA to 1e-4 deg
+    assert np.max(np.abs(np.abs(V) - np.abs(Vr))) < 5e-5
+    assert np.max(np.abs(np.degrees(np.angle(V / Vr)))) < 1e-2
 
 
 def test_240_bus_wecc_reads_with_transformers_and_switched_shunts():
@@ -112,7 +116,8 @@ def test_v32_transformer_with_off_nominal_winding2():
     assert t["windv2"] == pytest.approx(1.04)
     row = maps.transformer_rows[(2, 4, 0, "1")][0]
     assert net.branch[row, 8] == pytest.approx(1.0 / 1.04)
-    assert net.branch[row, 3] == pytest.approx(0.088 * 1.04 ** 2)
+    # CZ = 2: X = 0.088 pu on SBASE1-2 = 550 MVA
+    assert net.branch[row, 3] == pytest.approx(0.088 * 100 / 550 * 1.04 ** 2)
 
 
 def _rewrite(src: Path, dst: Path, fn):
@@ -339,7 +344,7 @@ def test_remote_bus_zero_is_local(tmp_path):
     far.write_text(base.replace("'IEEEST' 1  1  0 ", "'IEEEST' 1  1  103 "))
     with pytest.raises(DataError) as e:
         from_psse(GENROU_RAW, far)
-    assert "far.dyr line 8" in str(e.value) and "BUSR" in str(e.value) and "103" in str(e.value)
+    assert "far.dyr line 6" in str(e.value) and "BUSR" in str(e.value) and "103" in str(e.value)
 
 
 def test_negative_branch_resistance_accepted_with_a_note(tmp_path):
@@ -391,10 +396,16 @@ def test_wrong_version(tmp_path):
 
 
 def test_truncated_raw_record(tmp_path):
-    p = _rewrite(TVC_RAW, tmp_path / "cut.raw", lambda ls: ls[:ls.index(next(s for s in ls if "STEPUP" in s)) + 2])
+    lines = TVC_RAW.read_text().splitlines()
+    k = lines.index(next(s for s in lines if "STEPUP" in s))
+    p = _rewrite(TVC_RAW, tmp_path / "cut.raw", lambda ls: ls[:k + 2])    # 2 of its 4 lines
     with pytest.raises(DataError) as e:
         read_raw(p)
-    _check(e, "cut.raw line 15", "transformer record", "ends inside")
+    _check(e, f"cut.raw line {k + 1}", "transformer record", "ends inside")
+    p = _rewrite(TVC_RAW, tmp_path / "cut2.raw", lambda ls: ls[:k])       # ends in a section
+    with pytest.raises(DataError) as e:
+        read_raw(p)
+    _check(e, "cut2.raw", "ends inside the transformer section")
 
 
 def test_truncated_dyr_record(tmp_path):

@@ -157,6 +157,8 @@ def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = 
                         f"weakgrid has no model for these records ({len(missing)}): {lst}. "
                         "Nothing is substituted: remove these records (the generators then run "
                         "as static generators or without that control) or add the models")
+    for r in records:      # file errors (field counts) first, for every record
+        _values(r, reg[r.model])
     machines = {}      # (bus, id) -> name
     ctl_skip = set()   # generators whose controls are skipped (out of service / infinite bus)
     devices = {}
