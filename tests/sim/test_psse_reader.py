@@ -489,3 +489,15 @@ def test_andes_route_differs_where_issue_26_says():
     Va = sa.network.solve_power_flow().V
     Vp = sp.network.solve_power_flow().V
     np.testing.assert_allclose(np.abs(Va), np.abs(Vp), atol=1e-8)
+
+
+def test_gencls_h0_behind_a_source_impedance_keeps_it(tmp_path):
+    """H = 0 with ZSORCE = 0.25 pu (not negligible): infinite inertia, constant voltage behind
+    ZSORCE, as PSS/E; not an ideal source at the terminal."""
+    d = tmp_path / "h0.dyr"
+    d.write_text("101 'GENCLS' 1 0 0 /\n102 'GENCLS' 1 0.0 0.0 /\n")
+    system, _ = from_psse(GENROU_RAW, d)
+    g = system.components["GENCLS"]
+    assert g.names == ["GENCLS_102_1"] and g._values[0]["M"] >= 1e9
+    assert g._values[0]["xd1"] == pytest.approx(0.25)
+    assert system.components["InfiniteBus"].names == ["GENCLS_101_1"]

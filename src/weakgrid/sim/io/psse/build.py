@@ -9,7 +9,7 @@ replaced: all of them are listed, by bus, id and model, in one :class:`DataError
 PSS/E conventions kept:
 
 * a ``GENCLS`` with ``H = 0`` is PSS/E's infinite bus (infinite inertia, constant internal
-  voltage behind ``ZSORCE``): with a negligible ``|ZSORCE|`` (<= 1e-3 pu) it becomes an
+  voltage behind ``ZSORCE``): with a negligible ``|ZSORCE|`` (<= 1e-3 pu on SBASE) it becomes an
   :class:`~weakgrid.sim.sources.InfiniteBus` (fixed terminal voltage and angle), else a GENCLS
   with an inertia of 1e9 s (its internal voltage and angle then stay constant); noted;
 * machines: ``Sn = MBASE``, ``Vn`` = bus base voltage, ``fn = BASFRQ``; ``ZSORCE`` is given to
@@ -41,7 +41,7 @@ from .dyr import read_dyr
 from .network import build_case
 from .raw import read_raw
 
-#: |ZSORCE| [pu on MBASE] up to which an H = 0 GENCLS is an ideal voltage source at its bus
+#: |ZSORCE| [pu on SBASE] up to which an H = 0 GENCLS is an ideal voltage source at its bus
 INFINITE_BUS_ZMAX = 1e-3
 #: inertia M [s] of an H = 0 GENCLS behind a non-negligible ZSORCE (PSS/E: infinite)
 INFINITE_M = 1e9
@@ -194,11 +194,12 @@ def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = 
         row = maps.gen_row[key]
         name = f"{r.model}_{r.bus}_{r.id}"
         if r.model == "GENCLS" and params.get("M", 1.0) == 0.0:
-            if abs(ctx.zsorce) <= INFINITE_BUS_ZMAX:
+            zsys = abs(ctx.zsorce) * ctx.sbase / ctx.mbase
+            if zsys <= INFINITE_BUS_ZMAX:
                 system._component("InfiniteBus", "device").add_source(name, row)
                 notes.append(f"{r.where}: H = 0, PSS/E's infinite bus; simulated as an ideal voltage "
                              f"source at bus {r.bus} (InfiniteBus: fixed voltage and angle; "
-                             f"|ZSORCE| = {abs(ctx.zsorce):.3g} pu neglected)")
+                             f"|ZSORCE| = {zsys:.3g} pu on SBASE neglected)")
                 ctl_skip.add(key)
                 machines[key] = name
                 continue
