@@ -35,6 +35,10 @@ from ...errors import DataError
 from .raw import RawCase
 
 
+#: PSS/E's default zero-impedance line threshold THRSHZ [pu]: smaller star impedances become ties
+ZERO_Z = 1e-4
+
+
 @dataclass
 class CaseMaps:
     """PSS/E identifiers of the case's rows.
@@ -291,8 +295,10 @@ def build_case(raw: RawCase):
         rows = []
         for w in range(3):
             z = zs[w]
-            if z == 0:
-                z = complex(0.0, 1e-6)   # an ideal winding: negligible impedance
+            if abs(z) < ZERO_Z:      # PSS/E's zero-impedance threshold (THRSHZ): a bus tie
+                notes.append(f"{what} winding {w + 1}: star impedance {z:.3g} pu below {ZERO_Z:g} "
+                             f"pu, taken as a bus tie of reactance {ZERO_Z:g} pu")
+                z = complex(0.0, ZERO_Z)
             rows.append(add_branch(t, f"{what} winding {w + 1}", ends[w], star, z, 0.0, ratio[w],
                                    t[f"ang{w + 1}"], on_w[w]))
         maps.transformer_rows[key] = rows
