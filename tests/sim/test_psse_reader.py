@@ -515,3 +515,37 @@ def test_power_flow_reproduces_andes_shipped_solved_raws(case):
     k, Vr = _raw_voltages(raw, net)
     assert np.max(np.abs(np.abs(pf.V[k]) - np.abs(Vr))) < 5e-5
     assert np.max(np.abs(np.degrees(np.angle(pf.V[k] / Vr)))) < 1e-2
+
+
+def test_load_parts(tmp_path):
+    """P part -> bus load (constant impedance in time), I part -> constant current (ZIP share at
+    the solved voltage), Y part -> shunt; the power flow still reproduces the solved case when
+    the same 250 MW + 30 Mvar are split into the three parts at the solved voltage VM."""
+    raw0 = read_raw(GENROU_RAW)
+    vm = [b for b in raw0.buses if b["i"] == 103][0]["vm"]
+    # 250 = 100 (P) + IP*vm (I) + YP*vm^2 (Y);  30 = 10 + IQ*vm + (-YQ)*vm^2
+    ip, yp, iq, yq = 100 / vm, 50 / vm ** 2, 10 / vm, -10 / vm ** 2
+    line = (f"   103,'1 ',1,   1,   1,   100.000,    10.000,  {ip:.9f},  {iq:.9f},  {yp:.9f},"
+            f"  {yq:.9f},   1,1,0")
+    p = _rewrite(GENROU_RAW, tmp_path / "zip.raw",
+                 lambda ls: [line if s.startswith("   103,'1 ',1") else s for s in ls])
+    raw, net, _ = _net(p)
+    k, Vr = _raw_voltages(raw, net)
+    pf = net.solve_power_flow()
+    assert np.max(np.abs(pf.V[k] - Vr)) < 1e-4
+    i = net.index_of(103)
+    assert net.bus[i, 2] == pytest.approx(100 + ip * vm) and net.bus[i, 4] == pytest.approx(yp)
+    assert net.bus[i, 5] == pytest.approx(yq)
+    system, _ = from_psse(p, DATA / "ThreeBus_GENROU.dyr")
+    z = system.components["ZIP"]
+    v = z._values[0]
+    assert z.names == ["ZIP_103"]
+    assert v["kpi"] == pytest.approx(100 * (ip * vm) / (100 + ip * vm)) and v["kpp"] == 0.0
+    assert v["kqi"] == pytest.approx(100 * (iq * vm) / (10 + iq * vm))
+    system.setup()
+    F, _ = system.residual(0.0, system.z0)
+    assert np.max(np.abs(F)) < 1e-8          # the initial point is an equilibrium
+    # the ZIP's current part: at 0.9 of the initial voltage the I share scales by 0.9, Z by 0.81
+    zc = system.components["ZIP"]
+    P = zc.cp[0] + zc.cp[1] * 0.9 + zc.cp[2] * 0.81
+    assert P[0] * net.Sb == pytest.approx(ip * vm * 0.9 + 100 * 0.81)

@@ -87,6 +87,32 @@ def _params(rec, cls, ctx):
     return params
 
 
+def _current_loads(system, maps, notes):
+    """Keep the constant-current parts of the loads constant current in the time domain: a ZIP
+    per bus with such a part (the constant-power part becomes a constant impedance, as PSS/E's
+    CONL to 100 % admittance; the admittance part is already a shunt)."""
+    net = system.network
+    for b, (pl, ql, ip, iq) in sorted(maps.load_parts.items()):
+        if not (ip or iq):
+            continue
+        shares = []
+        for p, i in ((pl, ip), (ql, iq)):
+            tot = p + i
+            if tot == 0 and i != 0:
+                shares = None
+                break
+            ki = 100.0 * i / tot if tot else 0.0
+            shares += [0.0, ki, 100.0 - ki]
+        if shares is None:
+            notes.append(f"bus {b}: constant-power and constant-current load parts cancel (net load 0); "
+                         "the current part is simulated as constant impedance")
+            continue
+        k = net.index_of(b)
+        system._component("ZIP", "device").add_zip(
+            f"ZIP_{b}", k, (pl + ip) / net.Sb, (ql + iq) / net.Sb,
+            **dict(zip(("kpp", "kpi", "kpz", "kqp", "kqi", "kqz"), shares)))
+
+
 def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = "ideal"):
     """Build a weakgrid :class:`System` from a PSS/E ``.raw`` file and, optionally, a ``.dyr`` file.
 
@@ -147,6 +173,7 @@ def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = 
                                 "the swing bus has no in-service generator: add one or make "
                                 "another bus (with a generator) the swing bus")
     system = System(net)
+    _current_loads(system, maps, notes)
     records = read_dyr(dyr) if dyr is not None else []
     reg = _registry()
     missing = [r for r in records if _model_class(reg, r.model) is None]

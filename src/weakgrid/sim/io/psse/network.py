@@ -3,12 +3,13 @@
 Buses keep their PSS/E numbers. Conversions (all to per unit on ``SBASE`` at the bus base voltages):
 
 * **loads** (in service): the constant-power part ``PL + jQL`` and the constant-current part
-  ``(IP + jIQ)·|V|`` (at the solved voltage ``VM`` of the ``.raw``) become the bus load
-  ``PD + jQD`` [MW, Mvar], which the time domain turns into a constant impedance at the power-flow
-  voltage (as PSS/E's ``CONL`` to 100 % admittance and ANDES's ``PQ`` do); the constant-admittance
-  part ``YP + jYQ`` [MW, Mvar at 1 pu; ``YQ`` < 0 inductive] is a bus shunt ``GS += YP``,
-  ``BS += YQ``. Constant-current parts are noted (their voltage dependence is not kept in the time
-  domain).
+  ``(IP + jIQ)·VM`` (at the solved voltage ``VM`` of the ``.raw``) become the bus load
+  ``PD + jQD`` [MW, Mvar]. In the time domain the constant-power part becomes a constant
+  impedance at the power-flow voltage (as PSS/E's ``CONL`` with 100 % admittance, which the
+  PowerSimulationsDynamics.jl benchmarks apply, and as ANDES's ``PQ``); a constant-current part
+  stays a constant current (a :class:`~weakgrid.sim.loads.ZIP` on the bus, added by
+  :func:`~.build.from_psse`). The constant-admittance part ``YP + jYQ`` [MW, Mvar at 1 pu;
+  ``YQ`` < 0 inductive] is a bus shunt ``GS += YP``, ``BS += YQ``.
 * **fixed shunts**, **switched shunts** (at ``BINIT``, their solved value), **line shunts**
   ``GI + jBI``, ``GJ + jBJ`` of branches and transformer **magnetizing** admittances (at the
   winding-1 bus): bus shunts ``GS``, ``BS`` [MW, Mvar at 1 pu]. A shunt stays on its bus when
@@ -59,6 +60,8 @@ class CaseMaps:
         ``(i, j, k, ckt)`` -> branch rows of a transformer (one, or three for a star).
     star_bus : dict
         ``(i, j, k, ckt)`` -> bus number of a three-winding transformer's star bus.
+    load_parts : dict
+        PSS/E bus number -> ``[PL, QL, IP·VM, IQ·VM]`` [MW, Mvar] of its in-service loads.
     notes : list of str
     """
 
@@ -69,6 +72,7 @@ class CaseMaps:
     branch_row: dict = field(default_factory=dict)
     transformer_rows: dict = field(default_factory=dict)
     star_bus: dict = field(default_factory=dict)
+    load_parts: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
 
 
@@ -164,10 +168,13 @@ def build_case(raw: RawCase):
         B[k, 2] += ld["pl"] + ld["ip"] * vm
         B[k, 3] += ld["ql"] + ld["iq"] * vm
         add_shunt(ld["i"], complex(ld["yp"], ld["yq"]))
+        parts = maps.load_parts.setdefault(ld["i"], [0.0, 0.0, 0.0, 0.0])
+        for j, v in enumerate((ld["pl"], ld["ql"], ld["ip"] * vm, ld["iq"] * vm)):
+            parts[j] += v
         n_i += bool(ld["ip"] or ld["iq"])
     if n_i:
-        notes.append(f"{n_i} loads with a constant-current part (IP, IQ): taken at the solved voltage "
-                     "in the power flow and as constant impedance in the time domain")
+        notes.append(f"{n_i} loads with a constant-current part (IP, IQ): in the power flow at the "
+                     "solved voltage VM of the .raw; in the time domain constant current (ZIP)")
     for sh in raw.fixed_shunts:
         if not on_dead(sh, f"fixed shunt at bus {sh['i']} id '{sh['id']}'", sh["i"]) and sh["status"]:
             add_shunt(sh["i"], complex(sh["gl"], sh["bl"]))
