@@ -549,3 +549,86 @@ def test_load_parts(tmp_path):
     zc = system.components["ZIP"]
     P = zc.cp[0] + zc.cp[1] * 0.9 + zc.cp[2] * 0.81
     assert P[0] * net.Sb == pytest.approx(ip * vm * 0.9 + 100 * 0.81)
+
+
+def _write_version(path: Path, v: int, comments: bool = True):
+    """The GENROU three-bus case, plus a fixed shunt, a switched shunt (BINIT) and a multi-section
+    line grouping, written in the record layouts of PSS/E version ``v`` (29-35)."""
+    from weakgrid.sim.io.psse.raw import section_order
+
+    raw = read_raw(GENROU_RAW)
+    rec = {k: [] for k in section_order(v)}
+    for b in raw.buses:
+        gl_bl = ", 3.0, 20.0" if (v <= 30 and b["i"] == 103) else (", 0.0, 0.0" if v <= 30 else "")
+        tail = ", 1, 1, 1" if v > 30 else ", 1, 1"
+        head = f"{b['i']},'{b['name']}', {b['baskv']}, {b['ide']}{gl_bl}{tail}"
+        if v <= 30:
+            rec["bus"].append(f"{head}, {b['vm']}, {b['va']}, 1")
+        else:
+            rec["bus"].append(f"{head}, {b['vm']}, {b['va']}" + (", 1.1, 0.9, 1.1, 0.9" if v >= 33 else ""))
+    for d in raw.loads:
+        extra = {29: "", 30: "", 31: ", 1", 32: ", 1", 33: ", 1, 0"}.get(v, ", 1, 0, 0.0, 0.0, 0")
+        rec["load"].append(f"{d['i']},'{d['id']}', 1, 1, 1, {d['pl']}, {d['ql']}, 0, 0, 0, 0, 1{extra}")
+    if v > 30:
+        rec["fixed shunt"].append("103,'1 ', 1, 3.0, 20.0")
+    for g in raw.generators:
+        nreg = ", 0" if v >= 34 else ""
+        baslod = ", 0" if v >= 34 else ""
+        rec["generator"].append(
+            f"{g['i']},'{g['id']}', {g['pg']}, {g['qg']}, {g['qt']}, {g['qb']}, {g['vs']}, 0{nreg}, "
+            f"{g['mbase']}, {g['zr']}, {g['zx']}, 0, 0, 1, 1, 100.0, {g['pt']}, {g['pb']}{baslod}, 1, 1.0")
+    for br in raw.branches:
+        if v >= 34:
+            rates = "'LINE', " + ", ".join(["250.0"] * 12)
+        else:
+            rates = "250.0, 250.0, 250.0"
+        met = ", 1" if v >= 31 else ""
+        rec["branch"].append(f"{br['i']}, {br['j']},'{br['ckt']}', {br['r']}, {br['x']}, {br['b']}, {rates}, "
+                             f"0, 0, 0, 0, 1{met}, 0.0, 1, 1.0")
+    rec["multi-section line"].append("101, 102, '&1', 1, 103")
+    sw = {29: "103, 0, 1.1, 0.9, 0, 100.0, '        ', 15.0, 1, 15.0",
+          30: "103, 0, 1.1, 0.9, 0, 100.0, '        ', 15.0, 1, 15.0",
+          34: "103, 0, 0, 1, 1.1, 0.9, 0, 0, 100.0, '        ', 15.0, 1, 1, 15.0",
+          35: "103, '1 ', 0, 0, 1, 1.1, 0.9, 0, 0, 100.0, '        ', 15.0, 1, 1, 15.0"}
+    rec["switched shunt"].append(sw.get(v, "103, 0, 0, 1, 1.1, 0.9, 0, 100.0, '        ', 15.0, 1, 15.0"))
+    L = [f"0, 100.00, {v}, 0, 0, 60.00 / written by the test", "title 1", "title 2"]
+    if v >= 34:
+        L += ["@! system-wide data", "GENERAL, THRSHZ=0.0001", "0 / END OF SYSTEM-WIDE DATA, BEGIN BUS DATA"]
+    order = section_order(v)
+    for k, sec in enumerate(order):
+        L += rec[sec]
+        nxt = order[k + 1].upper() if k + 1 < len(order) else ""
+        L.append(f"0 / END OF {sec.upper()} DATA" + (f", BEGIN {nxt} DATA" if nxt else "") if comments else "0")
+    L.append("Q")
+    path.write_text("\n".join(L) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("v", range(29, 36))
+@pytest.mark.parametrize("comments", [True, False], ids=["comments", "bare-0"])
+def test_every_version_layout_reads_the_same_case(tmp_path, v, comments):
+    """One case written in each version's layout reads to the same network (sections found by
+    their comments, or by the version's order without them)."""
+    ref_raw, ref, _ = _net(_write_version(tmp_path / "ref33.raw", 33))
+    raw, net, maps = _net(_write_version(tmp_path / f"v{v}.raw", v, comments))
+    assert raw.version == v
+    np.testing.assert_allclose(net.bus[:, :10], ref.bus[:, :10])   # GS, BS: fixed + switched shunt
+    i = net.index_of(103)
+    assert net.bus[i, 4] == pytest.approx(3.0) and net.bus[i, 5] == pytest.approx(35.0)
+    np.testing.assert_allclose(net.gen[:, :10], ref.gen[:, :10])
+    np.testing.assert_allclose(net.branch, ref.branch)
+    assert any("multi-section" in n for n in maps.notes)
+
+
+def test_model_parameter_errors_name_the_record(tmp_path):
+    d = tmp_path / "bad.dyr"
+    d.write_text("101 'GENCLS' 1 0 0 /\n102 'GENROU' 1 8.0 0.03 0.4 0.05 6.175 0.05 1.8 1.7 0.3\n"
+                 " 0.55 0.25 0.2 0.1 0.8 /\n102 'SEXS' 1 0.4 -5 20 1 -50 50 /\n")
+    with pytest.raises(DataError) as e:
+        from_psse(GENROU_RAW, d)
+    _check(e, "bad.dyr line 4, SEXS at bus 102 id '1'", "'TB'", "-5")
+    d.write_text("101 'GENCLS' 1 0 0 /\n102 'GENCLS' 1 3 0 /\n102 'SEXS' 1 0.4 5 20 1 -50 50 /\n"
+                 "102 'SEXS' 1 0.4 5 20 1 -50 50 /\n")
+    with pytest.raises(DataError) as e:
+        from_psse(GENROU_RAW, d)
+    _check(e, "bad.dyr line 4", "already has a exciter")

@@ -48,6 +48,21 @@ INFINITE_M = 1e9
 _CONTROL_KINDS = ("exciter", "compensator", "pss", "governor")
 
 
+class _at:
+    """Re-raise a model's DataError (parameter checks) naming the .dyr file, line and record."""
+
+    def __init__(self, rec):
+        self.rec = rec
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, typ, exc, tb):
+        if isinstance(exc, DataError) and not str(exc.element).startswith(self.rec.file):
+            raise DataError(f"{self.rec.where} ({exc.element})", exc.field, exc.value, exc.fix) from None
+        return False
+
+
 def _model_class(reg, model):
     cls = reg.get(model)
     return cls if cls is not None and getattr(cls, "psse_record", None) is not None else None
@@ -234,7 +249,8 @@ def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = 
             notes.append(f"{r.where}: H = 0, PSS/E's infinite inertia; GENCLS with M = {INFINITE_M:g} s "
                          f"(constant internal voltage behind ZSORCE = {ctx.zsorce:.4g} pu)")
         params.update(Sn=ctx.mbase, Vn=ctx.kv, fn=rc.basfrq)
-        system.add_machine(r.model, name, row, **params)
+        with _at(r):
+            system.add_machine(r.model, name, row, **params)
         machines[key] = name
         devices[(r.model, r.bus, r.id)] = name
     add = {"exciter": system.add_exciter, "governor": system.add_governor, "pss": system.add_pss,
@@ -255,7 +271,8 @@ def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = 
             if kind == "governor" and any(p.name == "Tn" for p in cls.params):
                 params.setdefault("Tn", ctx.mbase)
             name = f"{r.model}_{r.bus}_{r.id}"
-            add[kind](r.model, name, machines[key], **params)
+            with _at(r):
+                add[kind](r.model, name, machines[key], **params)
             devices[(r.model, r.bus, r.id)] = name
     for r in by_kind.get("device", []):
         cls = reg[r.model]
@@ -272,7 +289,8 @@ def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = 
         link = link_fn(vals, ctx, gen_row=maps.gen_row, devices=devices, system=system, maps=maps)
         params = _params(r, cls, ctx)
         name = f"{r.model}_{r.bus}_{r.id}"
-        system._component(r.model, "device").add(name, link, params)
+        with _at(r):
+            system._component(r.model, "device").add(name, link, params)
         devices[(r.model, r.bus, r.id)] = name
         machines.setdefault(key, name)
     # static generators: in service, without a machine or converter
