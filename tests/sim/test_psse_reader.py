@@ -367,6 +367,38 @@ def test_static_generators_without_dyr():
         from_psse(GENROU_RAW, static_gens="refuse")
 
 
+#: PSID benchmark cases on the GENROU three-bus network (trip of line 101-102 at 1 s): dyr,
+#: PSS/E's CSV (every 10th row), {CSV column: quantity}, PSID's own tolerance per quantity
+PSSE_CASES = [
+    ("ThreeBus_TGOV1.dyr", "GENROU__ThreeBusMulti.raw", "TEST_TGOV1_every10.csv", {1: "delta"}),
+    ("ThreeBus_GAST.dyr", "GAST__ThreeBusMulti.raw", "GAST_TEST_every10.csv", {1: "delta"}),
+    ("ThreeBus_HYGOV.dyr", "HYGOV__ThreeBusMulti.raw", "HYGOV_RESULTS_every10.csv", {1: "V", 2: "delta"}),
+    ("ThreeBus_IEEEST.dyr", "GENROU__ThreeBusMulti.raw", "IEEEST_SEXS_RESULTS_NOFILT_every10.csv", {1: "vf"}),
+    ("ThreeBus_SEXS.dyr", "GENROU__ThreeBusMulti.raw", "SEXS_RESULTS_every10.csv", {1: "V", 2: "vf"}),
+]
+#: PSID's tolerances: rotor angle 1e-2 rad, voltage 1e-3 pu (HYGOV) / 1e-2 (SEXS), field voltage 1e-2 pu
+TOL = {"delta": np.degrees(1e-2), "V": 1e-3, "vf": 1e-2}
+
+
+@pytest.mark.psse
+@pytest.mark.parametrize("dyr, raw, csv, cols", PSSE_CASES, ids=[c[0][9:-4] for c in PSSE_CASES])
+def test_field_orders_against_psse_results(dyr, raw, csv, cols):
+    """The PSS/E field orders of TGOV1, GAST (with ESAC1A), HYGOV, IEEEST and SEXS, checked by
+    PSS/E's own results: within PSID's tolerance and 5 % of PSS/E's swing of each quantity."""
+    from weakgrid.sim.events import LineTrip
+    from weakgrid.sim.integrate import simulate
+
+    system, _ = from_psse(DATA / "raw" / raw, DATA / dyr)
+    res = simulate(system, 20.0, events=[LineTrip(system.psse_branch_row[(101, 102, "1")], 1.0)])
+    ref = np.loadtxt(DATA / csv, delimiter=",")
+    series = {"delta": np.degrees(res["GENROU_102_1.delta"]), "V": res["bus102.v"],
+              "vf": res["GENROU_102_1.vf"]}
+    for c, q in cols.items():
+        y = series[q]
+        err = np.max(np.abs(np.interp(ref[:, 0], res.t, y) - ref[:, c]))
+        assert err < TOL[q] and err < 0.05 * np.ptp(ref[:, c]), (q, err)
+
+
 def test_genrou_case_matches_psse_rotor_angle():
     """PSS/E's own result (PSID benchmark GENROU, trip of line 101-102 at 1 s): the rotor angle
     within 0.1 deg and 5 % of its swing (4.3 deg)."""
@@ -632,3 +664,23 @@ def test_model_parameter_errors_name_the_record(tmp_path):
     with pytest.raises(DataError) as e:
         from_psse(GENROU_RAW, d)
     _check(e, "bad.dyr line 4", "already has a exciter")
+
+
+def test_240_bus_wecc_dyr_lists_every_record_weakgrid_lacks():
+    """The 240-bus WECC case (448 records): the records of models this library has no PSS/E
+    record layout for are all listed, none dropped (GENROU, SEXS, GAST, TGOV1, HYGOV, IEEEST read)."""
+    recs = read_dyr(DATA / "240busWECC_2018_PSS.dyr")
+    reg = _registry()
+    lacking = [r for r in recs if getattr(reg.get(r.model), "psse_record", None) is None]
+    if not lacking:
+        system, _ = from_psse(DATA / "raw" / "240busWECC_2018_PSS32_fixed_shunts.raw",
+                              DATA / "240busWECC_2018_PSS.dyr")
+        assert len(system.psse_device) + len(system.components.get("InfiniteBus", ()).names
+                                             if "InfiniteBus" in system.components else 0) > 0
+        return
+    with pytest.raises(DataError) as e:
+        from_psse(DATA / "raw" / "240busWECC_2018_PSS32_fixed_shunts.raw", DATA / "240busWECC_2018_PSS.dyr")
+    msg = str(e.value)
+    assert f"({len(lacking)})" in msg
+    for r in lacking:
+        assert f"{r.model} at bus {r.bus} id '{r.id}' ({r.file} line {r.line})" in msg
