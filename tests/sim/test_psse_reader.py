@@ -684,3 +684,33 @@ def test_240_bus_wecc_dyr_lists_every_record_weakgrid_lacks():
     assert f"({len(lacking)})" in msg
     for r in lacking:
         assert f"{r.model} at bus {r.bus} id '{r.id}' ({r.file} line {r.line})" in msg
+
+
+def test_swing_bus_without_generator_refused(tmp_path):
+    p = _rewrite(GENROU_RAW, tmp_path / "noswing.raw",
+                 lambda ls: [s.replace("1.00000,1,  100.0,   318.000", "1.00000,0,  100.0,   318.000", 1)
+                             if s.startswith("   101,'1 '") else s for s in ls])
+    with pytest.raises(DataError) as e:
+        from_psse(p)
+    _check(e, "noswing.raw, bus 101", "IDE", "no in-service generator")
+
+
+def test_isolated_bus_dropped_with_its_devices(tmp_path):
+    def add(lines):
+        out = []
+        for s in lines:
+            if s.startswith(" 0 /End of Bus data"):
+                out.append("   104,'BUS 4', 138.0000,4,   1,   1,   1,1.00000,   0.0000,1.1,0.9,1.1,0.9")
+            if s.startswith(" 0 /End of Load data"):
+                out.append("   104,'1 ',1,   1,   1,   10.000,    3.000,     0.000,     0.000,     0.000,     0.000,   1,1,0")
+            if s.startswith(" 0 /End of Branch data"):
+                out.append("   103,   104,'1 ', 1.0E-2, 1.2E-1,   0.00000,  250.00,  250.00,  250.00,  0.0,  0.0,"
+                           "  0.0,  0.0,1,1,   0.00,   1,1.0000")
+            out.append(s)
+        return out
+    p = _rewrite(GENROU_RAW, tmp_path / "iso.raw", add)
+    system, _ = from_psse(p, DATA / "ThreeBus_GENROU.dyr")
+    assert 104 not in system.network.bus_ids and system.network.nl == 3
+    assert any("IDE = 4" in n for n in system.import_notes)
+    assert any("load at bus 104" in n and "isolated" in n for n in system.import_notes)
+    assert any("branch 103-104" in n and "isolated" in n for n in system.import_notes)
