@@ -201,127 +201,155 @@ def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = 
                         "as static generators or without that control) or add the models")
     for r in records:      # file errors (field counts) first, for every record
         _values(r, reg[r.model])
-    machines = {}      # (bus, id) -> name
-    ctl_skip = set()   # generators whose controls are skipped (out of service / infinite bus)
-    devices = {}
+    b = _Builder(system, rc, maps, notes)
     by_kind = {}
     for r in records:
         by_kind.setdefault(reg[r.model].kind, []).append(r)
-
-    def context(r):
-        key = (r.bus, r.id)
-        if key not in maps.gen:
-            raise DataError(r.where, "IBUS, ID", key,
-                            f"no generator at bus {r.bus} with id '{r.id}' in {rname}: correct the "
-                            f"bus number or id (generators: {sorted(maps.gen)[:20]})")
-        g = maps.gen[key]
-        return PsseContext(bus=r.bus, id=r.id, mbase=g["mbase"], sbase=rc.sbase,
-                           zsorce=complex(g["zr"], g["zx"]), kv=maps.kv[r.bus], fn=rc.basfrq,
-                           where=r.where)
-
     for r in by_kind.get("machine", []):
-        cls = reg[r.model]
-        ctx = context(r)
+        b.machine(r, reg[r.model])
+    for kind in _CONTROL_KINDS:
+        for r in by_kind.get(kind, []):
+            b.control(r, reg[r.model], kind)
+    for r in by_kind.get("device", []):
+        b.device(r, reg[r.model])
+    b.static_generators(static_gens)
+    b.finish(dyr)
+    return system, []
+
+
+class _Builder:
+    """Adds the .dyr records to the system, keeping PSS/E's identifiers and the notes."""
+
+    def __init__(self, system, rc, maps, notes):
+        self.system, self.rc, self.maps, self.notes = system, rc, maps, notes
+        self.rname = Path(rc.path).name
+        self.machines = {}      # (bus, id) -> machine or source name (None: out of service)
+        self.devices = {}       # (model, bus, id) -> name
+        self.ctl_skip = set()   # generators whose controls are skipped (off / infinite bus)
+
+    def context(self, r) -> PsseContext:
         key = (r.bus, r.id)
-        if key in machines:
+        if key not in self.maps.gen:
+            raise DataError(r.where, "IBUS, ID", key,
+                            f"no generator at bus {r.bus} with id '{r.id}' in {self.rname}: correct "
+                            f"the bus number or id (generators: {sorted(self.maps.gen)[:20]})")
+        g = self.maps.gen[key]
+        return PsseContext(bus=r.bus, id=r.id, mbase=g["mbase"], sbase=self.rc.sbase,
+                           zsorce=complex(g["zr"], g["zx"]), kv=self.maps.kv[r.bus],
+                           fn=self.rc.basfrq, where=r.where)
+
+    def machine(self, r, cls):
+        """A machine record: a machine on its generator's row, or PSS/E's infinite bus (H = 0)."""
+        ctx = self.context(r)
+        key = (r.bus, r.id)
+        if key in self.machines:
             raise DataError(r.where, "MODEL", r.model,
                             f"the generator at bus {r.bus} id '{r.id}' already has a machine model "
-                            f"({machines[key]}): keep one")
-        if not maps.gen[key]["stat"]:
-            notes.append(f"{r.where}: its generator is out of service, skipped with its controls")
-            ctl_skip.add(key)
-            machines[key] = None
-            continue
+                            f"({self.machines[key]}): keep one")
+        if not self.maps.gen[key]["stat"]:
+            self.notes.append(f"{r.where}: its generator is out of service, skipped with its controls")
+            self.ctl_skip.add(key)
+            self.machines[key] = None
+            return
         params = _params(r, cls, ctx)
-        row = maps.gen_row[key]
+        row = self.maps.gen_row[key]
         name = f"{r.model}_{r.bus}_{r.id}"
         if r.model == "GENCLS" and params.get("M", 1.0) == 0.0:
             zsys = abs(ctx.zsorce) * ctx.sbase / ctx.mbase
             if zsys <= INFINITE_BUS_ZMAX:
-                system._component("InfiniteBus", "device").add_source(name, row)
-                notes.append(f"{r.where}: H = 0, PSS/E's infinite bus; simulated as an ideal voltage "
-                             f"source at bus {r.bus} (InfiniteBus: fixed voltage and angle; "
-                             f"|ZSORCE| = {zsys:.3g} pu on SBASE neglected)")
-                ctl_skip.add(key)
-                machines[key] = name
-                continue
+                self.system._component("InfiniteBus", "device").add_source(name, row)
+                self.notes.append(f"{r.where}: H = 0, PSS/E's infinite bus; simulated as an ideal "
+                                  f"voltage source at bus {r.bus} (InfiniteBus: fixed voltage and "
+                                  f"angle; |ZSORCE| = {zsys:.3g} pu on SBASE neglected)")
+                self.ctl_skip.add(key)
+                self.machines[key] = name
+                return
             params["M"] = INFINITE_M
-            notes.append(f"{r.where}: H = 0, PSS/E's infinite inertia; GENCLS with M = {INFINITE_M:g} s "
-                         f"(constant internal voltage behind ZSORCE = {ctx.zsorce:.4g} pu)")
-        params.update(Sn=ctx.mbase, Vn=ctx.kv, fn=rc.basfrq)
+            self.notes.append(f"{r.where}: H = 0, PSS/E's infinite inertia; GENCLS with M = "
+                              f"{INFINITE_M:g} s (constant internal voltage behind ZSORCE = "
+                              f"{ctx.zsorce:.4g} pu)")
+        params.update(Sn=ctx.mbase, Vn=ctx.kv, fn=self.rc.basfrq)
         with _at(r):
-            system.add_machine(r.model, name, row, **params)
-        machines[key] = name
-        devices[(r.model, r.bus, r.id)] = name
-    add = {"exciter": system.add_exciter, "governor": system.add_governor, "pss": system.add_pss,
-           "compensator": system.add_compensator}
-    for kind in _CONTROL_KINDS:
-        for r in by_kind.get(kind, []):
-            cls = reg[r.model]
-            ctx = context(r)
-            key = (r.bus, r.id)
-            if key in ctl_skip:
-                notes.append(f"{r.where}: its machine is out of service or an infinite bus, skipped")
-                continue
-            if machines.get(key) is None:
-                raise DataError(r.where, "MODEL", r.model,
-                                f"the generator at bus {r.bus} id '{r.id}' has no machine model in the "
-                                f".dyr: add its machine record (e.g. GENROU) before its {kind}")
-            params = _params(r, cls, ctx)
-            if kind == "governor" and any(p.name == "Tn" for p in cls.params):
-                params.setdefault("Tn", ctx.mbase)
-            name = f"{r.model}_{r.bus}_{r.id}"
-            with _at(r):
-                add[kind](r.model, name, machines[key], **params)
-            devices[(r.model, r.bus, r.id)] = name
-    for r in by_kind.get("device", []):
-        cls = reg[r.model]
-        ctx = context(r)
+            self.system.add_machine(r.model, name, row, **params)
+        self.machines[key] = name
+        self.devices[(r.model, r.bus, r.id)] = name
+
+    def control(self, r, cls, kind):
+        """An exciter, compensator, stabilizer or governor of the machine at (IBUS, ID)."""
+        ctx = self.context(r)
         key = (r.bus, r.id)
-        if not maps.gen[key]["stat"]:
-            notes.append(f"{r.where}: its generator is out of service, skipped")
-            continue
+        if key in self.ctl_skip:
+            self.notes.append(f"{r.where}: its machine is out of service or an infinite bus, skipped")
+            return
+        if self.machines.get(key) is None:
+            raise DataError(r.where, "MODEL", r.model,
+                            f"the generator at bus {r.bus} id '{r.id}' has no machine model in the "
+                            f".dyr: add its machine record (e.g. GENROU) before its {kind}")
+        params = _params(r, cls, ctx)
+        if kind == "governor" and any(p.name == "Tn" for p in cls.params):
+            params.setdefault("Tn", ctx.mbase)      # PSS/E: governor data on MBASE
+        name = f"{r.model}_{r.bus}_{r.id}"
+        add = {"exciter": self.system.add_exciter, "governor": self.system.add_governor,
+               "pss": self.system.add_pss, "compensator": self.system.add_compensator}[kind]
+        with _at(r):
+            add(r.model, name, self.machines[key], **params)
+        self.devices[(r.model, r.bus, r.id)] = name
+
+    def device(self, r, cls):
+        """A converter or other device, linked by its class's ``psse_link``."""
+        ctx = self.context(r)
+        key = (r.bus, r.id)
+        if not self.maps.gen[key]["stat"]:
+            self.notes.append(f"{r.where}: its generator is out of service, skipped")
+            return
         link_fn = getattr(cls, "psse_link", None)
         if link_fn is None:
-            raise DataError(r.where, "MODEL", r.model, f"{r.model} cannot be linked from a .dyr record "
-                            "(its class has no psse_link)")
-        vals = _values(r, cls)
-        link = link_fn(vals, ctx, gen_row=maps.gen_row, devices=devices, system=system, maps=maps)
+            raise DataError(r.where, "MODEL", r.model, f"{r.model} cannot be linked from a .dyr "
+                            "record (its class has no psse_link)")
+        link = link_fn(_values(r, cls), ctx, gen_row=self.maps.gen_row, devices=self.devices,
+                       system=self.system, maps=self.maps)
         params = _params(r, cls, ctx)
         name = f"{r.model}_{r.bus}_{r.id}"
         with _at(r):
-            system._component(r.model, "device").add(name, link, params)
-        devices[(r.model, r.bus, r.id)] = name
-        machines.setdefault(key, name)
-    # static generators: in service, without a machine or converter
-    used = {lk["gen"] for c in system.components.values() for lk in c.links if "gen" in lk}
-    bare = [(key, row) for key, row in maps.gen_row.items()
-            if maps.gen[key]["stat"] and row not in used]
-    if bare and static_gens == "refuse":
-        names = [f"bus {b} id '{i}'" for (b, i), _ in bare]
-        raise DataError(f"{rname}", "generators", names,
-                        f"the generators {names} have no machine record in the .dyr; add one or set "
-                        "their status to 0")
-    for (b, i), row in bare:
-        slack = net.bus[net.index_of(b), 1] == 3
-        src = "InfiniteBus" if slack else "PVSource"
-        name = f"{src}_{b}_{i}"
-        system._component(src, "device").add_source(name, row)
-        machines[(b, i)] = name
-        what = ("an ideal voltage source (infinite bus: fixed voltage and angle)" if slack else
-                "a constant-P, constant-|V| source (no inertia, unlimited reactive power)")
-        notes.append(f"generator at bus {b} id '{i}': no machine record; simulated as {what} ({src})")
-    system.import_notes = notes
-    system.source = "psse"
-    system.psse_version = rc.version
-    system.psse_files = (str(rc.path), None if dyr is None else str(dyr))
-    system.psse_bus_name = dict(maps.bus_name)
-    system.psse_gen_row = dict(maps.gen_row)
-    system.psse_machine = {k: v for k, v in machines.items() if v is not None}
-    system.psse_device = devices
-    system.psse_branch_row = dict(maps.branch_row)
-    system.psse_transformer_rows = dict(maps.transformer_rows)
-    system.psse_star_bus = dict(maps.star_bus)
-    system.conventions = "standard"
-    system.conventions_applied = {}
-    return system, []
+            self.system._component(r.model, "device").add(name, link, params)
+        self.devices[(r.model, r.bus, r.id)] = name
+        self.machines.setdefault(key, name)
+
+    def static_generators(self, static_gens):
+        """In-service generators without a machine or converter: as ANDES simulates them."""
+        system, net = self.system, self.system.network
+        used = {lk["gen"] for c in system.components.values() for lk in c.links if "gen" in lk}
+        bare = [(key, row) for key, row in self.maps.gen_row.items()
+                if self.maps.gen[key]["stat"] and row not in used]
+        if bare and static_gens == "refuse":
+            names = [f"bus {b} id '{i}'" for (b, i), _ in bare]
+            raise DataError(f"{self.rname}", "generators", names,
+                            f"the generators {names} have no machine record in the .dyr; add one or "
+                            "set their status to 0")
+        for (b, i), row in bare:
+            slack = net.bus[net.index_of(b), 1] == 3
+            src = "InfiniteBus" if slack else "PVSource"
+            name = f"{src}_{b}_{i}"
+            system._component(src, "device").add_source(name, row)
+            self.machines[(b, i)] = name
+            what = ("an ideal voltage source (infinite bus: fixed voltage and angle)" if slack else
+                    "a constant-P, constant-|V| source (no inertia, unlimited reactive power)")
+            self.notes.append(f"generator at bus {b} id '{i}': no machine record; simulated as "
+                              f"{what} ({src})")
+
+    def finish(self, dyr):
+        """PSS/E identifiers and the notes, on the system."""
+        s, maps = self.system, self.maps
+        s.import_notes = self.notes
+        s.source = "psse"
+        s.psse_version = self.rc.version
+        s.psse_files = (str(self.rc.path), None if dyr is None else str(dyr))
+        s.psse_bus_name = dict(maps.bus_name)
+        s.psse_gen_row = dict(maps.gen_row)
+        s.psse_machine = {k: v for k, v in self.machines.items() if v is not None}
+        s.psse_device = self.devices
+        s.psse_branch_row = dict(maps.branch_row)
+        s.psse_transformer_rows = dict(maps.transformer_rows)
+        s.psse_star_bus = dict(maps.star_bus)
+        s.conventions = "standard"
+        s.conventions_applied = {}

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...errors import DataError
-from .tokens import Field, split_line
+from .tokens import split_line
 
 VERSIONS = range(29, 36)
 
