@@ -4,7 +4,10 @@ Each ``.dyr`` record ``IBUS 'MODEL' ID values /`` is read by the registry class 
 through its ``psse_record`` (field order, PSS/E's ICONs then CONs) and ``psse_params``
 (conversions, e.g. ``M = 2H``); see :class:`~weakgrid.sim.component.Component`. A record of a
 model weakgrid lacks (no registry class, or one without ``psse_record``) is never dropped nor
-replaced: all of them are listed, by bus, id and model, in one :class:`DataError`.
+replaced: all of them are listed, by bus, id and model, in one :class:`DataError`. Controls
+(exciters, compensators, stabilizers, governors) attach to the machine at ``(IBUS, ID)`` by their
+class's ``kind``; a ``device`` model (a converter) declares ``psse_link(values, ctx, gen_row=,
+devices=, system=, maps=)`` returning its link (e.g. ``{"gen": row}``).
 
 PSS/E conventions kept:
 
