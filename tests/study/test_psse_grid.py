@@ -70,3 +70,40 @@ def test_psse_grid_missing_file_and_branch():
     d["upqc"]["branch"] = "1-3-1"
     with pytest.raises(ParameterError, match="upqc.branch.*I-J-CKT"):
         build_setup(study_from_dict(d, base_dir=DATA))
+
+
+def test_psse_grid_from_a_toml_study_file(tmp_path):
+    """Paths in [grid] are relative to the study file."""
+    import shutil
+
+    from weakgrid.study.studyfile import load_study
+
+    (tmp_path / "case").mkdir()
+    shutil.copy(DATA / "raw" / "PSS2A__OMIB.raw", tmp_path / "case" / "omib.raw")
+    shutil.copy(DATA / "OMIB_GENCLS.dyr", tmp_path / "case" / "omib.dyr")
+    (tmp_path / "study.toml").write_text('''
+[study]
+name = "omib"
+[grid]
+kind = "psse"
+raw = "case/omib.raw"
+dyr = "case/omib.dyr"
+[machine]
+name = "GENCLS_1_1"
+[upqc]
+branch = "1-2-1"
+side = "to"
+rating = 0.1
+[design]
+T = 1e-3
+settings = "case2-paper"
+[controllers]
+compare = ["lqr"]
+[[scenarios]]
+id = "f"
+t_end = 0.5
+events = [{kind = "fault", bus = "2", t_on = 0.1, duration = 0.05, xf = 0.05}]
+''')
+    s = build_setup(load_study(tmp_path / "study.toml"))
+    assert s.derivation.name == "GENCLS_1_1"
+    assert s.system.psse_files[0].endswith("omib.raw")
