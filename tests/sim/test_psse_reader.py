@@ -714,3 +714,15 @@ def test_isolated_bus_dropped_with_its_devices(tmp_path):
     assert any("IDE = 4" in n for n in system.import_notes)
     assert any("load at bus 104" in n and "isolated" in n for n in system.import_notes)
     assert any("branch 103-104" in n and "isolated" in n for n in system.import_notes)
+
+
+def test_system_wide_data_end_within_the_title_lines(tmp_path):
+    """A v35 file whose second line already ends the (empty) system-wide data section: the bus
+    data follow at once (one title line)."""
+    p = _v35_from_v33_genrou(tmp_path / "full.raw")
+    lines = p.read_text().splitlines()
+    short = [lines[0], lines[1], "0 / END OF SYSTEM-WIDE DATA, BEGIN BUS DATA"] + lines[6:]
+    q = tmp_path / "short.raw"
+    q.write_text("\n".join(short) + "\n")
+    raw = read_raw(q)
+    assert raw.title == ["title 1"] and len(raw.buses) == 3 and len(raw.branches) == 3

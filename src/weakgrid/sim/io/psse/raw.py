@@ -232,10 +232,22 @@ def read_raw(path) -> RawCase:
     basfrq = rd.num(f0, 5, "BASFRQ", ln0, rec, default=60.0)
     if not basfrq > 0:
         basfrq = 60.0
-    case = RawCase(str(path), version, sbase, basfrq,
-                   title=[s for _, s in numbered[1:3]])
-    pos = 3
-    if version >= 34:   # system-wide data, up to its ending 0 record
+    def is_zero(line):
+        flds, _ = split_line(line)
+        return len(flds) == 1 and flds[0].text == "0" and not flds[0].quoted
+
+    # two title lines; a writer that ends a (possibly empty) system-wide data section within them
+    # ("0 / END OF SYSTEM-WIDE DATA", seen in v33 files) has no further title
+    pos, title, sysdata_done = 1, [], False
+    while pos < min(3, len(numbered)):
+        if is_zero(numbered[pos][1]):
+            pos += 1
+            sysdata_done = True
+            break
+        title.append(numbered[pos][1])
+        pos += 1
+    case = RawCase(str(path), version, sbase, basfrq, title=title)
+    if version >= 34 and not sysdata_done:   # system-wide data, up to its ending 0 record
         while pos < len(numbered):
             flds, _ = split_line(numbered[pos][1])
             pos += 1
