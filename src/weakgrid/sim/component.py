@@ -107,6 +107,32 @@ class Component:
     outputs: tuple[str, ...] = ()
     #: physical unit class of each state/output for SI conversion (default "pu")
     units: dict[str, str] = {}
+    #: PSS/E ``.dyr`` record layout after ``IBUS 'MODEL' ID`` (ICONs first, then CONs, in the
+    #: order of PSS/E's Program Application Guide): weakgrid parameter names, or names that
+    #: :meth:`psse_params` converts; names starting with "_" are read but are not parameters.
+    #: ``None``: the model has no PSS/E counterpart (its records are refused).
+    psse_record: tuple[str, ...] | None = None
+    #: how many of the last fields of :attr:`psse_record` may be missing (defaults apply)
+    psse_record_optional: int = 0
+
+    @classmethod
+    def psse_params(cls, values: dict, ctx) -> dict:
+        """weakgrid parameters of one PSS/E ``.dyr`` record.
+
+        Parameters
+        ----------
+        values : dict
+            Record values by the names of :attr:`psse_record` (float, or str for quoted text).
+        ctx : weakgrid.sim.io.psse.PsseContext
+            The generator the record belongs to (bus, id, MBASE, ZSORCE, bus kV, ...) and
+            ``where`` (file, line, record) for error messages.
+
+        Returns
+        -------
+        dict
+            Parameter name -> value; names starting with "_" are dropped by the reader.
+        """
+        return dict(values)
 
     def __init__(self):
         self.names: list[str] = []

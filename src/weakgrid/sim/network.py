@@ -77,6 +77,9 @@ class Network:
         self.case = copy.deepcopy({k: case[k] for k in ("baseMVA", "bus", "gen", "branch")})
         # branches with a negative series reactance on purpose (series capacitors)
         self.series_capacitors = {int(k) for k in case.get("series_capacitors", ())}
+        # branches with a negative series resistance on purpose (network equivalents, e.g. PSS/E
+        # and MATPOWER reductions): accepted when declared, the importer notes them
+        self.negative_resistance = {int(k) for k in case.get("negative_resistance", ())}
         self.Sb = float(self.case["baseMVA"])
         if not self.Sb > 0:
             raise DataError("case", "baseMVA", self.Sb, "must be > 0 MVA")
@@ -106,9 +109,10 @@ class Network:
                     raise DataError(el, nm, float(row[col]), "give a finite number (per unit)")
             if row[BR_R] == 0 and row[BR_X] == 0:
                 raise DataError(f"branch {k}", "BR_X", 0.0, "a branch needs a non-zero impedance R + jX")
-            if row[BR_R] < 0:
+            if row[BR_R] < 0 and k not in self.negative_resistance:
                 raise DataError(el, "BR_R", float(row[BR_R]), "a series resistance cannot be negative: "
-                                "check the sign and the per-unit base")
+                                "check the sign and the per-unit base (an equivalent's negative "
+                                f"resistance is accepted when declared: negative_resistance = [{k}])")
             if row[BR_X] < 0 and k not in self.series_capacitors:
                 # standard cases have them (series compensation, star equivalents of
                 # three-winding transformers, e.g. MATPOWER's case300): accepted, not silently

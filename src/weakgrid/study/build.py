@@ -18,6 +18,12 @@ Grid kinds (``[grid] kind``):
   from the file (named ``GENROU_<idx>`` …), the UPQC is an existing ``Line`` (``upqc.branch`` =
   its idx; ``upqc.side = "to"`` when its bus2 is the shunt bus) or inserted into one
   (``upqc.insert = {branch = idx, side, r, x}``, pu on the system base).
+* ``psse`` — ``raw`` (PSS/E ``.raw``, versions 29-35) and ``dyr`` (optional), paths relative to
+  the study file, read by weakgrid's own reader (:func:`weakgrid.sim.io.psse.from_psse`):
+  buses keep their PSS/E numbers (a bus is its number, or its name from the ``.raw``), machines
+  and controls come from the ``.dyr`` (named ``GENROU_<bus>_<id>`` …), the UPQC is an existing
+  branch (``upqc.branch = "I-J-CKT"``, e.g. ``"101-102-1"``, or ``{from, to}``) or inserted into
+  one (``upqc.insert = {branch = "I-J-CKT", side, r, x}``, pu on the system base).
 
 Buses are referred to by external number (inline/matpower), or by pandapower name or index.
 The UPQC is either an existing series branch (``upqc.branch``: a branch name, a row, or
@@ -255,6 +261,8 @@ def _network(study, load):
         return network, bus_id, {}, rows[0], None
     if g["kind"] == "andes":
         return _andes_network(study, g, up)
+    if g["kind"] == "psse":
+        return _psse_network(study, g, up)
     if g["kind"] == "inline":
         case, names, bus_id = _inline_case(g, load)
         f_hz = float(g.get("f_hz", 60.0))
@@ -327,6 +335,60 @@ def _andes_network(study, g, up):
         names[up["name"]] = k_up
         return system.network, bus_id, names, k_up, system
     return system.network, bus_id, names, names[ref], system
+
+
+def _psse_network(study, g, up):
+    """A PSS/E ``.raw`` (+ ``.dyr``) case read natively, with its machines and controls."""
+    from ..sim.io.psse import from_psse
+
+    paths = {}
+    for k in ("raw", "dyr"):
+        if g.get(k):
+            p = study.resolve(g[k])
+            if not p.exists():
+                raise ParameterError(f"grid.{k}", g[k], f"no such file ({p}); paths are relative "
+                                     "to the study file")
+            paths[k] = p
+    system, _ = from_psse(paths["raw"], paths.get("dyr"), include_events=False)
+    if "f_hz" in g:
+        system.network.f_hz = float(g["f_hz"])
+    net = system.network
+    bus_id = {str(int(b)): int(b) for b in net.bus_ids}
+    for b, name in system.psse_bus_name.items():
+        if name and name not in bus_id:
+            bus_id[name] = int(b)
+    names = {f"{i}-{j}-{c}": int(r) for (i, j, c), r in system.psse_branch_row.items()}
+    for (i, j, k, c), rows in system.psse_transformer_rows.items():
+        if k == 0:
+            names[f"{i}-{j}-{c}"] = int(rows[0])
+    ins = up.get("insert")
+    ref = ins.get("branch", ins.get("index")) if ins else up["branch"]
+    where = "upqc.insert.branch" if ins else "upqc.branch"
+    if isinstance(ref, dict):
+        a = _bus_ref(ref.get("from"), bus_id, net, f"{where}.from")
+        b = _bus_ref(ref.get("to"), bus_id, net, f"{where}.to")
+        rows = [r for r in names.values() if {int(net.branch[r, F_BUS]), int(net.branch[r, T_BUS])} == {a, b}]
+        if len(rows) != 1:
+            raise ParameterError(where, ref, f"{len(rows)} branches between buses {a} and {b}; "
+                                 "name it as \"I-J-CKT\"")
+        k_ref = rows[0]
+        if int(net.branch[k_ref, F_BUS]) != a:
+            raise ParameterError(where, ref, f"the branch runs from bus {int(net.branch[k_ref, F_BUS])}: "
+                                 "give that bus as 'from' and set upqc.side = \"to\" if the other "
+                                 "end is the shunt bus")
+    else:
+        if str(ref) not in names:
+            raise ParameterError(where, ref, "no PSS/E branch \"I-J-CKT\" of that name; e.g. "
+                                 f"{list(names)[:8]}")
+        k_ref = names[str(ref)]
+    if ins:     # a new bus and series branch (pu on the system base), appended to the tables
+        case, k_up, _, _ = insert_upqc_matpower(net.case, k_ref, ins["side"], ins.get("r", 0.0), ins["x"])
+        case.update(series_capacitors=sorted(net.series_capacitors),
+                    negative_resistance=sorted(net.negative_resistance))
+        system.network = Network(case, f_hz=net.f_hz)
+        names[up["name"]] = k_up
+        return system.network, bus_id, names, k_up, system
+    return net, bus_id, names, k_ref, system
 
 
 def build_setup(study, load: str | None = None, upqc: str | None = None,

@@ -9,7 +9,8 @@ studies live in ``weakgrid/data/studies/`` and can be named instead of a path.
 Tables (defaults in brackets)::
 
     [study]       name, title [""], reproduce [false] (part of `weakgrid reproduce`), notes [[]]
-    [grid]        kind = "inline" | "pandapower" | "matpower"; see weakgrid.study.grid
+    [grid]        kind = "inline" | "pandapower" | "matpower" | "andes" | "psse"; see
+                  weakgrid.study.build (psse: raw, dyr [none], paths relative to the study file)
     [[dynamics.generator]]  name, bus, machine = {model, …}, exciter/governor/pss [none]
     [[dynamics.gti]]        name, bus, C, Vc0, chi, B, ks_max, tau, mode ["energy"]
     [machine]     name (the controlled GTI or SG)
@@ -43,7 +44,7 @@ __all__ = ["Study", "load_study", "study_from_dict", "get_path", "set_path", "sh
 
 TOP = {"study", "grid", "dynamics", "machine", "upqc", "design", "controllers", "scenarios",
        "report", "figures", "claims", "sweep", "simulation"}
-GRID_KINDS = ("inline", "pandapower", "matpower", "andes")
+GRID_KINDS = ("inline", "pandapower", "matpower", "andes", "psse")
 STRUCTURES = ("conventional", "reduced")
 EVENT_KINDS = ("fault", "line_trip", "load_step")
 
@@ -268,6 +269,15 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         _inline_grid(g)
     elif g["kind"] == "pandapower":
         _need(g, "network", "grid", str)
+    elif g["kind"] == "psse":
+        _keys(g, {"kind", "raw", "dyr", "f_hz"}, "grid")
+        for k in ("raw", "dyr"):
+            if k in g or k == "raw":
+                v = _need(g, k, "grid", str)
+                ext = "." + k
+                if not v.lower().endswith(ext):
+                    raise ParameterError(f"grid.{k}", v, f"give the PSS/E {ext} file (path relative "
+                                         "to the study file)")
     else:
         _need(g, "file", "grid", str)
     if "f_hz" in g:
@@ -295,7 +305,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
             _num(gt, k, w, positive=k != "tau")
     m = _need(d, "machine", "study file", dict)
     _keys(m, {"name"}, "machine")
-    if _need(m, "name", "machine", str) not in names and g["kind"] != "andes":
+    if _need(m, "name", "machine", str) not in names and g["kind"] not in ("andes", "psse"):
         raise ParameterError("machine.name", m["name"], f"no generator or GTI of that name in "
                              f"[dynamics]; choose one of {names}")
     up = _need(d, "upqc", "study file", dict)

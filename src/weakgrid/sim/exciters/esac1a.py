@@ -48,6 +48,9 @@ class ESAC1A(MachineControl):
 
     kind = "exciter"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("TR", "TB", "TC", "KA", "TA", "VAMAX", "VAMIN", "TE", "KF", "TF", "KC", "KD",
+                   "KE", "E1", "SE1", "E2", "SE2", "VRMAX", "VRMIN")
     params = (
         Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
         Param("TB", 1.0, "s", "lag time constant", "nonneg"),

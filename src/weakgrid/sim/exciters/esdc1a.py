@@ -45,6 +45,9 @@ class ESDC1A(MachineControl):
 
     kind = "exciter"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("TR", "KA", "TA", "TB", "TC", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF1",
+                   "Switch", "E1", "SE1", "E2", "SE2")
     params = (
         Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
         Param("KA", 80.0, "pu", "regulator gain", "pos"),

@@ -47,6 +47,9 @@ class ESST1A(MachineControl):
 
     kind = "exciter"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("UELc", "VOSc", "TR", "VIMAX", "VIMIN", "TC", "TB", "TC1", "TB1", "KA", "TA",
+                   "VAMAX", "VAMIN", "VRMAX", "VRMIN", "KC", "KF", "TF", "KLR", "ILR")
     params = (
         Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
         Param("VIMAX", 0.8, "pu", "maximum input error", ""),

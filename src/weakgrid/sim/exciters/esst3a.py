@@ -60,6 +60,9 @@ class ESST3A(MachineControl):
 
     kind = "exciter"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("TR", "VIMAX", "VIMIN", "KM", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KG",
+                   "KP", "KI", "VBMAX", "KC", "XL", "VGMAX", "THETAP", "TM", "VMMAX", "VMMIN")
     params = (
         Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
         Param("VIMAX", 0.8, "pu", "maximum input error", ""),

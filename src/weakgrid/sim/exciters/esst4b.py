@@ -48,6 +48,15 @@ class ESST4B(MachineControl):
 
     kind = "exciter"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("TR", "KPR", "KIR", "VRMAX", "VRMIN", "TA", "KPM", "KIM", "VMMAX", "VMMIN",
+                   "KG", "KP", "KI", "VBMAX", "KC", "XL", "THETAP")
+
+    @classmethod
+    def psse_params(cls, values, ctx):
+        """PSS/E ESST4B (IEEE 421.5-2005 ST4B) has no VGMAX: the inner feedback is unlimited."""
+        return {**values, "VGMAX": 999.0}
+
     params = (
         Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
         Param("KPR", 1.0, "pu", "proportional gain of the voltage regulator", "nonneg"),

@@ -76,6 +76,9 @@ class EXAC1(MachineControl):
 
     kind = "exciter"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("TR", "TB", "TC", "KA", "TA", "VRMAX", "VRMIN", "TE", "KF", "TF", "KC", "KD",
+                   "KE", "E1", "SE1", "E2", "SE2")
     params = (
         Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
         Param("TB", 1.0, "s", "lag time constant", "nonneg"),

@@ -29,6 +29,8 @@ class EXAC4(MachineControl):
 
     kind = "exciter"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("TR", "VIMAX", "VIMIN", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KC")
     params = (
         Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
         Param("VIMAX", 5.0, "pu", "maximum input error", ""),

@@ -30,6 +30,20 @@ class EXDC2(MachineControl):
 
     kind = "exciter"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("TR", "KA", "TA", "TB", "TC", "VRMAX", "VRMIN", "KE", "TE", "KF1", "TF1",
+                   "_SWITCH", "E1", "SE1", "E2", "SE2")
+
+    @classmethod
+    def psse_params(cls, values, ctx):
+        """PSS/E EXDC2/IEEEX1: ``KF`` -> ``KF1``; ``SWITCH`` must be 0 (this model has no switch)."""
+        from ..errors import DataError
+
+        if values["_SWITCH"] != 0:
+            raise DataError(ctx.where, "SWITCH", values["_SWITCH"],
+                            f"{cls.__name__} is modelled with SWITCH = 0 only; set it to 0")
+        return dict(values)
+
     params = (
         Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
         Param("TA", 0.04, "s", "regulator time constant", "pos"),

@@ -34,6 +34,9 @@ class EXST1(MachineControl):
 
     kind = "exciter"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("TR", "VIMAX", "VIMIN", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KC", "KF",
+                   "TF")
     params = (
         Param("TR", 0.01, "s", "sensing time constant", "nonneg"),
         Param("VIMAX", 0.2, "pu", "maximum input error", ""),

@@ -28,6 +28,9 @@ class IEEET1(MachineControl):
 
     kind = "exciter"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("TR", "KA", "TA", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF", "Switch", "E1",
+                   "SE1", "E2", "SE2")
     params = (
         Param("TR", 0.02, "s", "sensing time constant", "nonneg"),
         Param("KA", 5.0, "pu", "regulator gain", "pos"),

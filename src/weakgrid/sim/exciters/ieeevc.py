@@ -32,6 +32,8 @@ class IEEEVC(MachineControl):
 
     kind = "compensator"
     order = 1.5          # after the machines (reads Vt, Pe, Qe), before the exciters (read Ecomp)
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("rc", "xc")
     params = (
         Param("rc", 0.0, "pu (machine base)", "active (resistive) compensation", ""),
         Param("xc", 0.0, "pu (machine base)", "reactive compensation", ""),

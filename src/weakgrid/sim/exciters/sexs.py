@@ -23,6 +23,8 @@ class SEXS(MachineControl):
 
     kind = "exciter"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("TATB", "TB", "K", "TE", "EMIN", "EMAX")
     params = (
         Param("TATB", 0.4, "-", "ratio TA/TB", "nonneg"),
         Param("TB", 5.0, "s", "lag time constant of the lead-lag", "pos"),

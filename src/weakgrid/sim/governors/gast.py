@@ -34,6 +34,8 @@ class GAST(MachineControl):
 
     kind = "governor"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("R", "T1", "T2", "T3", "AT", "KT", "VMAX", "VMIN", "Dt")
     params = (
         Param("Tn", 0.0, "MVA", "turbine rating (0: machine Sn)", "nonneg"),
         Param("wref0", 1.0, "pu", "speed reference", "pos"),

@@ -59,6 +59,8 @@ class HYGOV(MachineControl):
 
     kind = "governor"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("R", "r", "Tr", "Tf", "Tg", "VELM", "GMAX", "GMIN", "Tw", "At", "Dt", "qNL")
     params = (
         Param("Tn", 0.0, "MVA", "turbine rating (0: machine Sn)", "nonneg"),
         Param("wref0", 1.0, "pu", "speed reference", "pos"),

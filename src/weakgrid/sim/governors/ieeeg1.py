@@ -36,6 +36,21 @@ class IEEEG1(MachineControl):
 
     kind = "governor"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("_JBUS", "_M", "K", "T1", "T2", "T3", "UO", "UC", "PMAX", "PMIN", "T4", "K1",
+                   "K2", "T5", "K3", "K4", "T6", "K5", "K6", "T7", "K7", "K8")
+
+    @classmethod
+    def psse_params(cls, values, ctx):
+        """PSS/E IEEEG1: ICONs JBUS, M name the low-pressure machine of a cross-compound unit;
+        only JBUS = 0 (single shaft) is read from a .dyr."""
+        from ..errors import DataError
+
+        if values["_JBUS"] != 0:
+            raise DataError(ctx.where, "JBUS", values["_JBUS"],
+                            "cross-compound IEEEG1 (JBUS != 0) is not read from PSS/E files; use 0")
+        return dict(values)
+
     params = (
         Param("Tn", 0.0, "MVA", "turbine rating (0: sum of machine ratings)", "nonneg"),
         Param("wref0", 1.0, "pu", "speed reference", "pos"),

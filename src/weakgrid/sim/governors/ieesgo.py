@@ -28,6 +28,8 @@ class IEESGO(MachineControl):
 
     kind = "governor"
     order = 2
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("T1", "T2", "T3", "T4", "T5", "T6", "K1", "K2", "K3", "PMAX", "PMIN")
     params = (
         Param("Tn", 0.0, "MVA", "turbine rating (0: machine Sn)", "nonneg"),
         Param("wref0", 1.0, "pu", "speed reference", "pos"),

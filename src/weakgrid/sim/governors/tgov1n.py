@@ -16,5 +16,7 @@ from .tgov1 import TGOV1
 class TGOV1N(TGOV1):
     """TGOV1 with ``pref``/``paux`` summed after the droop gain; parameters as TGOV1."""
 
+    psse_record = None   # an ANDES variant: PSS/E has no TGOV1N
+
     def _pd(self, wd):
         return self.pref0 + self.paux - wd / self.p["R"]

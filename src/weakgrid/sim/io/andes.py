@@ -19,7 +19,16 @@ done by weakgrid exactly as ANDES does (impedances by ``(Vn^2/Sn)/(Vb^2/Sb)``,
 powers and inertias by ``Sn/Sb``). PQ loads become constant impedances in the
 time domain, as with ANDES's default ``p2z = q2z = 1``.
 
-PSS/E data: ``andes.load(raw, addfile=dyr, setup=False)`` parses a ``.raw`` +
+PSS/E data: read them with :func:`weakgrid.sim.io.psse.from_psse`, weakgrid's own reader
+(``.raw`` versions 29-35, each ``.dyr`` record by its model's PSS/E field order, PSS/E's
+conventions: ``H = 0`` infinite bus, remote bus 0 = local, ``MBASE``/``ZSORCE``, negative branch
+resistance, switched shunts at ``BINIT``; nothing substituted, nothing dropped). The ANDES route
+below stays for ANDES's own formats and for peer comparisons with ANDES: ANDES 2.0's parser
+changes PSS/E data without a word (issue 26: a ``GENCLS`` with ``H = 0`` becomes a machine with
+``M = 6 s``, ``ESAC1A`` is read in the wrong field order, ``GENSAL`` and several exciters and
+governors are replaced by other models, a text field such as ``'EG'`` crashes it).
+
+``andes.load(raw, addfile=dyr, setup=False)`` parses a ``.raw`` +
 ``.dyr`` pair into the same ANDES models, which this module then imports. Two gaps of
 ANDES 2.0's parser are handled here: non-transformer branches are read on the system base
 (:func:`psse_branch_sn`; the parser leaves them at 100 MVA), and ``.dyr`` models the parser

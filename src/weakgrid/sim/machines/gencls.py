@@ -28,6 +28,22 @@ class GENCLS(SyncMachine):
     Sn [MVA], Vn [kV], fn [Hz], M = 2H [s], D [pu], ra [pu], xd1 = x'd [pu].
     """
 
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("H", "D")
+
+    @classmethod
+    def psse_params(cls, values, ctx):
+        """PSS/E GENCLS: ``M = 2H``; the source impedance is ``ZSORCE`` (``ra + j xd1``, pu on
+        MBASE). ``H = 0`` (PSS/E's infinite bus) gives ``M = 0``, which the reader turns into an
+        infinite bus."""
+        from ..errors import DataError
+
+        v = {"M": 2.0 * values["H"], "D": values["D"], "ra": ctx.zsorce.real, "xd1": ctx.zsorce.imag}
+        if not v["xd1"] > 0:
+            raise DataError(ctx.where, "ZSORCE", ctx.zsorce,
+                            "GENCLS takes its reactance from the generator record's ZX (> 0 pu on MBASE)")
+        return v
+
     params = BASE_PARAMS
     states = ("delta", "omega")
     outputs = ("Pe", "Qe", "te", "Id", "Iq", "vf")

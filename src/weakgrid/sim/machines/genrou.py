@@ -49,6 +49,20 @@ class GENROU(SyncMachine):
     xl, xd, xq, xd2, xq1, xq2 [pu]; Td10, Td20, Tq10, Tq20 [s]; S10, S12 [pu].
     """
 
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("Td10", "Td20", "Tq10", "Tq20", "H", "D", "xd", "xq", "xd1", "xq1", "xd2",
+                   "xl", "S10", "S12")
+
+    @classmethod
+    def psse_params(cls, values, ctx):
+        """PSS/E GENROU: ``M = 2H``, ``xq2 = xd2`` (X''q = X''d in PSS/E's model), ``ra`` =
+        ``Re(ZSORCE)`` (pu on MBASE; the record has no armature resistance)."""
+        v = dict(values)
+        v["M"] = 2.0 * v.pop("H")
+        v["xq2"] = v["xd2"]
+        v["ra"] = ctx.zsorce.real
+        return v
+
     params = BASE_PARAMS + (
         Param("xl", 0.0, "pu (machine base)", "leakage reactance", "nonneg", "z"),
         Param("xd", 1.9, "pu (machine base)", "d-axis synchronous reactance", "pos", "z"),

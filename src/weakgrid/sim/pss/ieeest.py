@@ -31,6 +31,19 @@ class IEEEST(MachineControl):
 
     kind = "pss"
     order = 1
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("MODE", "_BUSR", "A1", "A2", "A3", "A4", "A5", "A6", "T1", "T2", "T3", "T4",
+                   "T5", "T6", "KS", "LSMAX", "LSMIN", "VCU", "VCL")
+
+    @classmethod
+    def psse_params(cls, values, ctx):
+        """PSS/E IEEEST: ICONs input code (MODE) and remote bus; remote bus 0 = the machine's own
+        bus (the only one this model measures)."""
+        from ..io.psse.conventions import local_bus
+
+        local_bus(values, "_BUSR", ctx)
+        return dict(values)
+
     params = (
         Param("MODE", 1.0, "-", "input signal (1 speed, 3 Pe, 4 accelerating power, 5 voltage)", "pos"),
         Param("A1", 0.0, "s", "filter pole coefficient (s)", "nonneg"),

@@ -35,6 +35,20 @@ class ST2CUT(MachineControl):
 
     kind = "pss"
     order = 1
+    #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
+    psse_record = ("MODE", "_BUSR", "MODE2", "_BUSR2", "K1", "K2", "T1", "T2", "T3", "T4", "T5",
+                   "T6", "T7", "T8", "T9", "T10", "LSMAX", "LSMIN", "VCU", "VCL")
+
+    @classmethod
+    def psse_params(cls, values, ctx):
+        """PSS/E ST2CUT: ICONs input codes and remote buses of its two inputs; remote bus 0 =
+        the machine's own bus (the only one this model measures)."""
+        from ..io.psse.conventions import local_bus
+
+        local_bus(values, "_BUSR", ctx)
+        local_bus(values, "_BUSR2", ctx)
+        return dict(values)
+
     params = (
         Param("MODE", 1.0, "-", "input signal 1 (0 none, 1 speed, 3 Pe, 4 accelerating power, 5 voltage)", "nonneg"),
         Param("MODE2", 0.0, "-", "input signal 2 (same codes)", "nonneg"),
