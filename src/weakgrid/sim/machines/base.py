@@ -91,3 +91,21 @@ class SyncMachine(Component):
         sig["Vt"][..., m] = sig["Ecomp"][..., m] = np.abs(V)
         sig["theta"][..., m] = np.angle(V)
         sig["XadIfd"][..., m] = XadIfd
+
+
+def saturated_rotor_angle(psi2, It, k, xq, xq2):
+    r"""Steady-state rotor angle [rad] of a machine whose q-axis sub-transient flux obeys
+    :math:`\psi''_q (1 + k) = (x_q - x''_q) I_q` (``k = Se * (xq-xl)/(xd-xl)`` with q-axis
+    saturation as in GENROU, ``k = 0`` without it, GENSAL).
+
+    ``psi2 = V + (ra + j x'') It`` is the sub-transient flux phasor and ``It`` the terminal
+    current phasor (network frame, system base). With ``x = delta - angle(psi2)`` and
+    ``ang = angle(psi2) - angle(It)`` the condition reads
+    ``tan x = b cos(ang) / (b sin(ang) - a)``, ``a = |psi2| (1 + k)``, ``b = |It| (x''q - xq)``
+    (the OpenIPSL / ANDES GENROU initialization). For ``k = 0`` it is the angle of
+    ``V + (ra + j xq) It``.
+    """
+    ang = np.angle(psi2) - np.angle(It)
+    a = np.abs(psi2) * (1 + k)
+    b = np.abs(It) * (xq2 - xq)
+    return np.arctan(b * np.cos(ang) / (b * np.sin(ang) - a)) + np.angle(psi2)
