@@ -7,6 +7,9 @@ curve ``Se(x) = B*x^A`` through ``(1.0, S10)`` and ``(1.2, S12)``
 (:func:`weakgrid.sim.blocks.exp_saturation_coeffs`: ``B = S10``,
 ``A = ln(S12/S10)/ln 1.2``; ``S10 = 0`` disables it).
 
+Shaft: PSS/E's by default (``psse_shaft = 1``, :mod:`~weakgrid.sim.machines.shaft`);
+GENROU's default is ANDES's (``psse_shaft = 0``).
+
 Data checks: GENROU's, and ``S12 >= S10`` when ``S10 > 0`` (an exponential through
 both points that grows with flux; ``S12 = 0`` has none).
 """
@@ -15,6 +18,7 @@ from __future__ import annotations
 
 from ..blocks import exp_saturation, exp_saturation_coeffs
 from ..errors import DataError
+from .base import with_default
 from .genrou import GENROU
 
 
@@ -25,6 +29,8 @@ class GENROE(GENROU):
     -----
     Parameters and states as :class:`~weakgrid.sim.machines.genrou.GENROU`.
     """
+
+    params = with_default(GENROU.params, "psse_shaft", 1.0)
 
     #: PSS/E .dyr record (Program Application Guide, as GENROU): T'do, T''do, T'qo, T''qo,
     #: H, D, Xd, Xq, X'd, X'q, X''d, Xl, S(1.0), S(1.2)

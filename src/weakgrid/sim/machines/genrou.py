@@ -20,6 +20,8 @@ reactances must be equal, ``xd2 == xq2``)::
 Saturation coefficients ``A, B`` come from ``(1.0, S10)`` and ``(1.2, S12)``
 through :func:`weakgrid.sim.blocks.quad_saturation_coeffs` (``S10 = 0`` disables it).
 The steady-state initialization follows the OpenIPSL/ANDES procedure.
+Shaft: ANDES's by default; ``psse_shaft = 1`` gives PSS/E's (mechanical input as power,
+divided by the speed; :mod:`~weakgrid.sim.machines.shaft`), as a PSS/E case means it.
 
 Data checks: ``xd2 < xd1 <= xd`` and ``xq2 < xq1 <= xq`` (``xq1 = xq``, no q-axis
 transient effect, occurs in ANDES's wecc data), ``xl < xd1, xq1``; ``xl >= xd2`` (ANDES's
@@ -213,7 +215,7 @@ class GENROU(SyncMachine):
         vf = ctx.sig["vf"][..., m]
         tm = ctx.sig["tm"][..., m]
         ctx.out[self._pre + "vf"] = vf
-        d_delta, d_omega = swing(omega, tm, self._te, p["M"], p["D"], self.wb)
+        d_delta, d_omega = swing(omega, tm, self._te, p["M"], p["D"], self.wb, self._psse_shaft)
         f = ctx.f
         f[..., sl[0]] = d_delta
         f[..., sl[1]] = d_omega

@@ -27,6 +27,10 @@ only X''d); ``xd2 <= xd1 <= xd``; ``xl < xd1``; ``xq2 <= xq``; ``S12 >= S10``.
 enters nothing (``gd1 = 1``, ``gd2 = 0``) and the machine is a one-winding d axis; it is
 accepted. ``xl >= xd2`` is unusual but well defined and accepted with a warning, as for
 GENROU.
+
+Shaft: PSS/E's, ``M dw/dt = (Pm - D dw)/omega - te`` (``psse_shaft = 1``, the default of
+the PSS/E-only models GENSAL, GENSAE, GENROE; ``psse_shaft = 0`` gives ANDES's
+``M dw/dt = tm - te - D dw`` of GENROU and GENCLS).
 """
 
 from __future__ import annotations
@@ -38,7 +42,7 @@ import numpy as np
 from ..blocks import quad_saturation_coeffs
 from ..errors import DataError
 from ..params import Param
-from .base import BASE_PARAMS, SyncMachine, saturated_rotor_angle
+from .base import BASE_PARAMS, SyncMachine, saturated_rotor_angle, with_default
 from .shaft import swing
 
 
@@ -51,10 +55,11 @@ class GENSAL(SyncMachine):
     Sn, Vn, fn, M = 2H, D, ra, xd1 as in :class:`~weakgrid.sim.machines.gencls.GENCLS`;
     xl, xd, xq, xd2, xq2 [pu]; Td10 = T'do, Td20 = T''do, Tq20 = T''qo [s]; S10, S12 [pu].
     States: ``delta`` [rad], ``omega`` [pu], ``e1q`` (E'q), ``e2d`` (psi_kd), ``psi2q``
-    (psi''_q) [pu].
+    (psi''_q) [pu]. The shaft is PSS/E's by default (``psse_shaft = 1``: the mechanical
+    input is power, divided by the speed; :mod:`~weakgrid.sim.machines.shaft`).
     """
 
-    params = BASE_PARAMS + (
+    params = with_default(BASE_PARAMS, "psse_shaft", 1.0) + (
         Param("xl", 0.0, "pu (machine base)", "leakage reactance", "nonneg", "z"),
         Param("xd", 1.9, "pu (machine base)", "d-axis synchronous reactance", "pos", "z"),
         Param("xq", 1.7, "pu (machine base)", "q-axis synchronous reactance", "pos", "z"),
@@ -223,7 +228,7 @@ class GENSAL(SyncMachine):
         vf = ctx.sig["vf"][..., self._mi]
         tm = ctx.sig["tm"][..., self._mi]
         ctx.out[self._pre + "vf"] = vf
-        d_delta, d_omega = swing(omega, tm, self._te, p["M"], p["D"], self.wb)
+        d_delta, d_omega = swing(omega, tm, self._te, p["M"], p["D"], self.wb, self._psse_shaft)
         f = ctx.f
         f[..., sl[0]] = d_delta
         f[..., sl[1]] = d_omega
