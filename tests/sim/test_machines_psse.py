@@ -331,9 +331,8 @@ def test_rotor_angle_matches_psse_through_the_psse_reader(cls, dyr, csv):
     from weakgrid.sim.network import F_BUS, T_BUS
 
     system, _ = psse.from_psse(str(DATA / "ThreeBusMulti.raw"), str(DATA / dyr))
-    net = system.network
-    ids = [(net.bus_ids[int(r[F_BUS]) - 1], net.bus_ids[int(r[T_BUS]) - 1]) for r in net.branch]
-    row = [k for k, ft in enumerate(ids) if set(ft) == {101, 102}]
+    net = system.network                  # MATPOWER form: external (PSS/E) bus numbers
+    row = [k for k, r in enumerate(net.branch) if {int(r[F_BUS]), int(r[T_BUS])} == {101, 102}]
     assert len(row) == 1
     if not system.is_setup:
         system.setup()
