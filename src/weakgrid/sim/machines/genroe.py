@@ -40,13 +40,12 @@ class GENROE(GENROU):
     @classmethod
     def psse_params(cls, values, ctx=None):
         """PSS/E record values -> weakgrid parameters: ``M = 2H``, ``xq2 = xd2`` (PSS/E's
-        single X''), ``ra`` = R of the machine's ZSORCE when the reader gives it."""
+        single X''), ``ra = Re(ZSORCE)`` (pu on MBASE; the record has no armature resistance)."""
         v = dict(values)
         v["M"] = 2.0 * v.pop("H")
         v["xq2"] = v["xd2"]
-        zs = getattr(ctx, "zsorce", None)
-        if zs is not None:
-            v.setdefault("ra", float(zs.real))
+        if ctx is not None:
+            v["ra"] = float(ctx.zsorce.real)
         return v
 
     def setup(self, system):

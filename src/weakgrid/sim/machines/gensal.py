@@ -18,7 +18,9 @@ effects on the stator neglected as PSS/E does)::
 Saturation acts on the d axis only, as a function of E'q: ``Se(x) = B*(x-A)^2/x`` for
 ``x > A`` through ``(1.0, S10)`` and ``(1.2, S12)``
 (:func:`weakgrid.sim.blocks.quad_saturation_coeffs`, PSS/E's quadratic curve; ``S10 = 0``
-disables it). Unsaturated, GENSAL is GENROU with ``xq1 = xq`` (no q-axis transient
+disables it). This is PSS/E's GENSAL: on PSID's PSS/E benchmark weakgrid's GENSAL is
+0.0015 deg from PSS/E's rotor angle; the same machine with GENROU-like ``Se(|psi''|)*psi2d``
+instead is 0.5 deg off (on a 1.3 deg swing). Unsaturated, GENSAL is GENROU with ``xq1 = xq`` (no q-axis transient
 winding): ``psi2q`` is GENROU's ``(1-gq1)*e2q`` and GENROU's ``e1d`` stays 0.
 
 Data checks (PSS/E's GENSAL rules): one sub-transient reactance ``xq2 == xd2`` (PSS/E has
@@ -86,13 +88,12 @@ class GENSAL(SyncMachine):
     @classmethod
     def psse_params(cls, values, ctx=None):
         """PSS/E record values -> weakgrid parameters: ``M = 2H``, ``xq2 = xd2`` (PSS/E's
-        single X''), ``ra`` = R of the machine's ZSORCE when the reader gives it."""
+        single X''), ``ra = Re(ZSORCE)`` (pu on MBASE; the record has no armature resistance)."""
         v = dict(values)
         v["M"] = 2.0 * v.pop("H")
         v["xq2"] = v["xd2"]
-        zs = getattr(ctx, "zsorce", None)
-        if zs is not None:
-            v.setdefault("ra", float(np.real(zs)))
+        if ctx is not None:
+            v["ra"] = float(ctx.zsorce.real)
         return v
 
     # ------------------------------------------------------------------ setup
