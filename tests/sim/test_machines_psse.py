@@ -111,6 +111,29 @@ def test_initial_point_is_an_equilibrium_two_machines(model, params):
     assert s.components[model].n == 1
 
 
+def _open_circuit_field(model, params, V):
+    """Field voltage (= XadIfd) of the machine held at |V| with no current (open circuit)."""
+    case = two_machine_case(x_line=0.3, p=0.0)
+    case["bus"][:, 7] = V                                 # VM
+    case["gen"][:, 5] = V                                 # VG
+    s = System(case)
+    s.add_machine(model, "G1", 0, **params)
+    s._component("InfiniteBus", "device").add_source("INF", 1)
+    s.setup()
+    assert abs(s.network.pf.Qg[0]) < 1e-9 and abs(s.network.pf.Pg[0]) < 1e-9
+    return s.sig_defaults["vf0"][0]
+
+
+@pytest.mark.parametrize("model, params", [("GENSAL", SAL), ("GENSAE", SAL), ("GENROE", ROU),
+                                           ("GENROU", ROU), ("GENROE", {**ROU, "S10": 0.5, "S12": 1.3})])
+@pytest.mark.parametrize("V, field", [(1.0, "S10"), (1.2, "S12")])
+def test_open_circuit_field_current_is_the_saturation_definition(model, params, V, field):
+    """PSS/E's S(1.0), S(1.2): the extra field current on open circuit at 1.0 / 1.2 pu
+    terminal voltage, Efd = V (1 + S(V)) -- the definition of the data, through the whole
+    initialization of each model."""
+    assert _open_circuit_field(model, params, V) == pytest.approx(V * (1 + params[field]), rel=1e-12)
+
+
 def _trip(s, t_end=5.0, dt=0.005):
     return simulate(s, t_end, dt=dt, events=[LineTrip(0, 1.0)])
 
