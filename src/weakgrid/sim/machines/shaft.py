@@ -10,15 +10,16 @@ with :math:`\omega_b = 2\pi f_n` [rad/s], :math:`M = 2H` [s] and damping ``D``
 Torques are in pu on the system base; speed in pu of nominal.
 
 PSS/E's shaft (every PSS/E ``GEN*`` model; machine parameter ``psse_shaft = 1``) takes
-the mechanical input as *power* ``Pm`` and divides the accelerating power by the speed:
+the mechanical input as *power* ``Pm``: the mechanical torque is ``(Pm - D dw)/omega``
+(the electrical torque ``te`` is the air-gap torque as in ANDES's form):
 
 .. math::
 
     M\dot\omega = \frac{P_m - D(\omega - 1)}{\omega} - \tau_e
 
 Both forms agree at rated speed (same initial point); they differ by :math:`\sim P_m\,\Delta\omega`
-in a swing. On PSID's PSS/E benchmark (line trip, 20 s) ANDES's form leaves 0.6–1.4 % of
-PSS/E's rotor-angle swing, PSS/E's 0.07–0.13 %.
+in a swing. On PSID's PSS/E benchmark (line trip, 20 s; GENROU, GENROE, GENSAL, GENSAE)
+ANDES's form leaves 0.5–1.4 % of PSS/E's rotor-angle swing, PSS/E's 0.05–0.13 %.
 """
 
 from __future__ import annotations
