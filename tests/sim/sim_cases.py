@@ -57,3 +57,26 @@ def build_gti_upqc_sg(structure="conventional", mode="energy", p_gti=50.0):
     up.add_upqc("U", branch=0, structure=structure, gti="PV" if structure == "reduced" else None, Vmax=0.2)
     s.setup()
     return s
+
+
+def psse_three_bus_case():
+    """PSID's PSS/E benchmark network ``ThreeBusMulti.raw`` (tests/data/psse_machines/), by hand.
+
+    PSS/E v33 raw, SBASE 100 MVA, 60 Hz, all buses 138 kV: bus 101 slack at 1.05 pu (its
+    GENCLS with H = 0 is PSS/E's infinite bus), bus 102 PV at 1.02 pu with 100 MW (MBASE
+    100 MVA, ZSORCE j0.25), bus 103 with a 250 MW + 30 Mvar load (constant impedance in
+    the time domain, as PSID's tests convert it); three lines 0.01 + j0.12 pu, no charging:
+    row 0 = 101-102 (the line PSID's tests trip), 1 = 101-103, 2 = 102-103.
+    """
+    bus = np.array([
+        [101, 3, 0, 0, 0, 0, 1, 1.05, 0.0, 138, 1, 1.1, 0.9],
+        [102, 2, 0, 0, 0, 0, 1, 1.02, -0.944, 138, 1, 1.1, 0.9],
+        [103, 1, 250, 30, 0, 0, 1, 0.99341, -8.7697, 138, 1, 1.1, 0.9],
+    ], dtype=float)
+    gen = np.array([
+        [101, 153.335, 73.271, 100, -100, 1.05, 100, 1, 318, 0] + [0] * 11,
+        [102, 100.0, -3.247, 100, -100, 1.02, 100, 1, 318, 0] + [0] * 11,
+    ], dtype=float)
+    branch = np.array([[f, t, 0.01, 0.12, 0.0, 250, 250, 250, 0, 0, 1, -360, 360]
+                       for f, t in ((101, 102), (101, 103), (102, 103))], dtype=float)
+    return {"baseMVA": 100.0, "bus": bus, "gen": gen, "branch": branch}

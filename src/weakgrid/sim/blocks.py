@@ -282,6 +282,41 @@ def quad_saturation(x, A, B):
     return np.where(x >= A, B * (x - A) ** 2, 0.0)
 
 
+def exp_saturation_coeffs(E1, SE1, E2, SE2):
+    r"""Coefficients ``(A, B)`` of the exponential saturation :math:`S(x) = B\,x^A` (PSS/E GENROE, GENSAE).
+
+    The curve passes through ``(E1, SE1)`` and ``(E2, SE2)``:
+    :math:`A = \ln(SE2/SE1)/\ln(E2/E1)`, :math:`B = SE1/E1^A` (PSS/E: ``E1 = 1.0``,
+    ``E2 = 1.2``, so ``B = S(1.0)`` and ``A = ln(S(1.2)/S(1.0)) / ln 1.2``).
+    ``SE1 = 0`` disables saturation (``A = B = 0``, i.e. :math:`S \equiv 0`). The models
+    refuse ``SE2 < SE1`` (a curve falling with flux) before calling this; ``SE2 = 0`` with
+    ``SE1 > 0`` has no exponential through both points and gives ``A = B = 0`` here.
+
+    Parameters
+    ----------
+    E1, SE1, E2, SE2 : array_like
+        Saturation points [pu] (``0 < E1 != E2``) and values [pu/pu].
+
+    Returns
+    -------
+    A, B : ndarray
+        Exponent [-] and factor [pu/pu].
+    """
+    E1, SE1, E2, SE2 = (np.asarray(v, dtype=float) for v in (E1, SE1, E2, SE2))
+    on = (SE1 > 0) & (SE2 > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        A = np.where(on, np.log(np.where(on, SE2 / SE1, 1.0)) / np.log(E2 / E1), 0.0)
+        B = np.where(on, SE1 / E1 ** A, 0.0)
+    return A, B
+
+
+def exp_saturation(x, A, B):
+    r"""Exponential saturation factor :math:`S(x) = B\,x^A` for ``x > 0`` else 0."""
+    x = np.asarray(x, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(x > 0, B * np.abs(x) ** A, 0.0)
+
+
 class LagRate:
     r"""First-order lag :math:`K/(1+sT)` with a rate limit, ANDES 2.0 convention.
 

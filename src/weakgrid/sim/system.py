@@ -84,7 +84,7 @@ def colour_columns(P):
 def _registry():
     from .exciters import EXDC2, SEXS
     from .governors import HYGOV, TGOV1
-    from .machines import GENCLS, GENROU
+    from .machines import GENCLS, GENROE, GENROU, GENSAE, GENSAL
     from .pss import IEEEST
     from .loads import ZIP
     from .renewables import ESD1, PVD1, REECA1, REECB1, REGCA1, REPCA1
@@ -96,7 +96,7 @@ def _registry():
     from .pss import ST2CUT
     from .renewables import WTARA1, WTDTA1, WTPTA1, WTTQA1
 
-    return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
+    return {c.__name__: c for c in (GENCLS, GENROU, GENSAL, GENSAE, GENROE, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
                                     ESST1A, ESAC1A, ESDC1A, IEEET3, ESST4B, EXAC4, AC8B, IEEEVC,
                                     IEEEG1, IEESGO, TG2, TGOV1N, GAST, ST2CUT)

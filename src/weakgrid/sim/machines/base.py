@@ -17,7 +17,15 @@ BASE_PARAMS = (
     Param("xd1", 0.302, "pu (machine base)", "d-axis transient reactance x'd", "pos", "z"),
     Param("gammap", 1.0, "-", "share of its static generator's P (devices on one row sum to 1)", "nonneg"),
     Param("gammaq", 1.0, "-", "share of its static generator's Q (devices on one row sum to 1)", "nonneg"),
+    Param("psse_shaft", 0.0, "-", "1: PSS/E's shaft, M dw/dt = (Pm - D dw)/omega - te (mechanical input "
+          "is power); 0: ANDES's, M dw/dt = tm - te - D dw (see machines.shaft)", "flag"),
 )
+
+
+def with_default(params, name, default):
+    """``params`` with the default of ``name`` replaced (a model's own convention)."""
+    return tuple(Param(p.name, default, p.unit, p.info, p.rule, p.base) if p.name == name else p
+                 for p in params)
 
 
 class SyncMachine(Component):
@@ -58,6 +66,8 @@ class SyncMachine(Component):
         # two machines on one bus: their currents must accumulate (scatter_add with unique=False)
         self._uniq = len(set(self.bus.tolist())) == self.n
         self._bi = fast_index(self.bus) if self._uniq else self.bus
+        psse = self.p["psse_shaft"] > 0
+        self._psse_shaft = psse if psse.any() else None    # None: ANDES's shaft everywhere (fast path)
 
     def pattern(self, system):
         return None  # grouped with its controls by the system
@@ -91,3 +101,21 @@ class SyncMachine(Component):
         sig["Vt"][..., m] = sig["Ecomp"][..., m] = np.abs(V)
         sig["theta"][..., m] = np.angle(V)
         sig["XadIfd"][..., m] = XadIfd
+
+
+def saturated_rotor_angle(psi2, It, k, xq, xq2):
+    r"""Steady-state rotor angle [rad] of a machine whose q-axis sub-transient flux obeys
+    :math:`\psi''_q (1 + k) = (x_q - x''_q) I_q` (``k = Se * (xq-xl)/(xd-xl)`` with q-axis
+    saturation as in GENROU, ``k = 0`` without it, GENSAL).
+
+    ``psi2 = V + (ra + j x'') It`` is the sub-transient flux phasor and ``It`` the terminal
+    current phasor (network frame, system base). With ``x = delta - angle(psi2)`` and
+    ``ang = angle(psi2) - angle(It)`` the condition reads
+    ``tan x = b cos(ang) / (b sin(ang) - a)``, ``a = |psi2| (1 + k)``, ``b = |It| (x''q - xq)``
+    (the OpenIPSL / ANDES GENROU initialization). For ``k = 0`` it is the angle of
+    ``V + (ra + j xq) It``.
+    """
+    ang = np.angle(psi2) - np.angle(It)
+    a = np.abs(psi2) * (1 + k)
+    b = np.abs(It) * (xq2 - xq)
+    return np.arctan(b * np.cos(ang) / (b * np.sin(ang) - a)) + np.angle(psi2)

@@ -101,6 +101,7 @@ class GENCLS(SyncMachine):
         omega = ctx.x[..., self._sls[1]]
         tm = ctx.sig["tm"][..., self.m]
         ctx.out["GENCLS.vf"] = ctx.sig["vf"][..., self.m]
-        d_delta, d_omega = swing(omega, tm, self._te, self.p["M"], self.p["D"], self.wb)
+        d_delta, d_omega = swing(omega, tm, self._te, self.p["M"], self.p["D"], self.wb,
+                                 self._psse_shaft)
         ctx.f[..., self._sls[0]] = d_delta
         ctx.f[..., self._sls[1]] = d_omega

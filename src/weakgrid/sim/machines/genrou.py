@@ -20,6 +20,8 @@ reactances must be equal, ``xd2 == xq2``)::
 Saturation coefficients ``A, B`` come from ``(1.0, S10)`` and ``(1.2, S12)``
 through :func:`weakgrid.sim.blocks.quad_saturation_coeffs` (``S10 = 0`` disables it).
 The steady-state initialization follows the OpenIPSL/ANDES procedure.
+Shaft: ANDES's by default; ``psse_shaft = 1`` gives PSS/E's (mechanical input as power,
+divided by the speed; :mod:`~weakgrid.sim.machines.shaft`), as a PSS/E case means it.
 
 Data checks: ``xd2 < xd1 <= xd`` and ``xq2 < xq1 <= xq`` (``xq1 = xq``, no q-axis
 transient effect, occurs in ANDES's wecc data), ``xl < xd1, xq1``; ``xl >= xd2`` (ANDES's
@@ -86,7 +88,8 @@ class GENROU(SyncMachine):
         for i in range(self.n):
             if abs(p["xd2"][i] - p["xq2"][i]) > 1e-12 * max(1.0, abs(p["xd2"][i])):
                 raise DataError(self.element(i), "xq2", self._values[i]["xq2"],
-                                "GENROU needs xq2 == xd2 (round rotor, as in PSS/E and ANDES); set xq2 = xd2")
+                                f"{self.type_name} needs xq2 == xd2 (round rotor, as in PSS/E and ANDES); "
+                                "set xq2 = xd2")
             if not p["xl"][i] < min(p["xd1"][i], p["xq1"][i]):
                 raise DataError(self.element(i), "xl", self._values[i]["xl"],
                                 "leakage reactance must be < xd1 and < xq1")
@@ -104,7 +107,8 @@ class GENROU(SyncMachine):
         self.gd2 = (p["xd1"] - p["xd2"]) / (p["xd1"] - xl) ** 2
         self.gq2 = (p["xq1"] - p["xq2"]) / (p["xq1"] - xl) ** 2
         self.gqd = (p["xq"] - xl) / (p["xd"] - xl)
-        self.SA, self.SB = quad_saturation_coeffs(1.0, p["S10"], 1.2, p["S12"])
+        self.SA, self.SB = self._sat_coeffs(p["S10"], p["S12"])
+        self._pre = f"{self.type_name}."
         # constants of compute
         self._c_e2d = self.gd2 * (p["xd1"] - xl)
         self._c_e2q = 1 - self.gq1
@@ -124,6 +128,11 @@ class GENROU(SyncMachine):
         self._nosat = bool(np.all(self.SB == 0))
         self._xd1l_iTd20 = self._xd1l * self._iTd20
         self._xq1l_iTq20 = self._xq1l * self._iTq20
+
+    @staticmethod
+    def _sat_coeffs(S10, S12):
+        """``(A, B)`` of the saturation curve through ``(1.0, S10)``, ``(1.2, S12)``."""
+        return quad_saturation_coeffs(1.0, S10, 1.2, S12)
 
     def _sat(self, psi2):
         if (psi2 > 0).all():   # fast path: same values as below for psi2 > 0
@@ -207,10 +216,10 @@ class GENROU(SyncMachine):
         f[..., sl[3]] = XaqI1q * self._iTq10
         f[..., sl[4]] = (e1q - e2d) * self._iTd20 - self._xd1l_iTd20 * Id
         f[..., sl[5]] = (e1d - e2q) * self._iTq20 + self._xq1l_iTq20 * Iq
-        o = ctx.out
-        o["GENROU.Pe"], o["GENROU.Qe"], o["GENROU.te"] = Pe, Qe, self._te
-        o["GENROU.Id"], o["GENROU.Iq"], o["GENROU.XadIfd"] = Id, Iq, XadIfd
-        o["GENROU.psi2"], o["GENROU.Se"] = psi2, Se
+        o, k = ctx.out, self._pre
+        o[k + "Pe"], o[k + "Qe"], o[k + "te"] = Pe, Qe, self._te
+        o[k + "Id"], o[k + "Iq"], o[k + "XadIfd"] = Id, Iq, XadIfd
+        o[k + "psi2"], o[k + "Se"] = psi2, Se
 
     def finish(self, ctx):
         p = self.p
@@ -219,8 +228,8 @@ class GENROU(SyncMachine):
         omega = ctx.x[..., sl[1]]
         vf = ctx.sig["vf"][..., m]
         tm = ctx.sig["tm"][..., m]
-        ctx.out["GENROU.vf"] = vf
-        d_delta, d_omega = swing(omega, tm, self._te, p["M"], p["D"], self.wb)
+        ctx.out[self._pre + "vf"] = vf
+        d_delta, d_omega = swing(omega, tm, self._te, p["M"], p["D"], self.wb, self._psse_shaft)
         f = ctx.f
         f[..., sl[0]] = d_delta
         f[..., sl[1]] = d_omega
