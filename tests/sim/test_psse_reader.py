@@ -321,13 +321,15 @@ def test_gensal_is_never_replaced_by_genrou():
 
 def test_every_unsupported_record_listed_in_one_error(tmp_path):
     d = tmp_path / "many.dyr"
-    d.write_text("101 'GENCLS' 1 0 0 /\n102 'GENSAL' 1 1 2 3 /\n102 'SCRX' 1 1 2 /\n"
-                 "102 'STAB1' 1 1 /\n")
+    # models no branch of weakgrid has (GENTPJ, ESST5B, PSS3B): each listed, none dropped
+    d.write_text("101 'GENCLS' 1 0 0 /\n102 'GENTPJ' 1 1 2 3 /\n102 'ESST5B' 1 1 2 /\n"
+                 "102 'PSS3B' 1 1 /\n")
     with pytest.raises(DataError) as e:
         from_psse(GENROU_RAW, d)
     msg = str(e.value)
-    for what in ("GENSAL at bus 102 id '1' (many.dyr line 2)", "SCRX at bus 102 id '1' (many.dyr line 3)",
-                 "STAB1 at bus 102 id '1' (many.dyr line 4)"):
+    for what in ("GENTPJ at bus 102 id '1' (many.dyr line 2)",
+                 "ESST5B at bus 102 id '1' (many.dyr line 3)",
+                 "PSS3B at bus 102 id '1' (many.dyr line 4)"):
         assert what in msg
 
 

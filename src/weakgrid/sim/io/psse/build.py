@@ -15,7 +15,9 @@ PSS/E conventions kept:
   voltage behind ``ZSORCE``): with a negligible ``|ZSORCE|`` (<= 1e-3 pu on SBASE) it becomes an
   :class:`~weakgrid.sim.sources.InfiniteBus` (fixed terminal voltage and angle), else a GENCLS
   with an inertia of 1e9 s (its internal voltage and angle then stay constant); noted;
-* machines: ``Sn = MBASE``, ``Vn`` = bus base voltage, ``fn = BASFRQ``; ``ZSORCE`` is given to
+* machines: ``Sn = MBASE``, ``Vn`` = bus base voltage, ``fn = BASFRQ``, PSS/E's swing equation
+  (``psse_shaft = 1``: the mechanical input is a power, ``M dω/dt = (Pm − D Δω)/ω − te``);
+  ``ZSORCE`` is given to
   ``psse_params`` (``GENCLS``: ``ra + j xd1``; ``GENROU``: ``ra``); governors: turbine base
   ``Tn = MBASE``;
 * a remote-bus ICON of 0 means the machine's own bus (each model's ``psse_params`` refuses a
@@ -271,7 +273,8 @@ class _Builder:
             self.notes.append(f"{r.where}: H = 0, PSS/E's infinite inertia; GENCLS with M = "
                               f"{INFINITE_M:g} s (constant internal voltage behind ZSORCE = "
                               f"{ctx.zsorce:.4g} pu)")
-        params.update(Sn=ctx.mbase, Vn=ctx.kv, fn=self.rc.basfrq)
+        # PSS/E's swing equation: the mechanical input is a power, M dw/dt = (Pm - D dw)/w - te
+        params.update(Sn=ctx.mbase, Vn=ctx.kv, fn=self.rc.basfrq, psse_shaft=1.0)
         with _at(r):
             self.system.add_machine(r.model, name, row, **params)
         self.machines[key] = name
