@@ -19,8 +19,6 @@ import sys
 import time
 from pathlib import Path
 
-from ..game.checkpoint import (CheckpointError, StaleCheckpointError, load_checkpoint,
-                               save_checkpoint)
 
 CHECKPOINT_SECONDS = 1.0  # work shorter than this writes no checkpoint unless stopped
 
@@ -60,6 +58,8 @@ def training_key(problem, settings, command: str = "train", **extra) -> str:
 
 def load_kept(path: Path, key: str, load, command: str, log=print):
     """What ``load(path, key)`` finds in the checkpoint ``path``, or None (said why)."""
+    from ..game.checkpoint import CheckpointError, StaleCheckpointError
+
     path = Path(path)
     if not path.exists():
         return None
@@ -144,6 +144,8 @@ class TrainingCheckpoint:
     """
 
     def __init__(self, path, key, restart=False, command="train", what="", log=print):
+        from ..game.checkpoint import load_checkpoint, save_checkpoint
+
         self.path, self.command, self.what, self.log = Path(path), command, what, log
         self.start = None if restart else load_kept(self.path, key, load_checkpoint,
                                                     command, log)

@@ -27,7 +27,7 @@ def add_parser(sub):
                     "the bracket and every trial; writes the controller at gamma*.",
         formatter_class=HelpFormatter)
     add_problem_arguments(p)
-    d = SearchSettings()
+    d = SearchSettings   # the class: its fields' defaults
     p.add_argument("--rtol", type=positive_float, default=d.rtol, help="relative width of the bracket")
     p.add_argument("--max-trials", type=positive_int, default=d.max_trials, help="cap on gammas tried")
     p.add_argument("--rollout-steps", type=positive_int, default=d.rollout_steps,

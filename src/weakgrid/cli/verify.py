@@ -29,7 +29,7 @@ def add_parser(sub):
                     "the DP's worst-case disturbance).",
         formatter_class=HelpFormatter)
     add_problem_arguments(p)
-    d = DPSettings()
+    d = DPSettings   # the class: its fields' defaults (no validation, no NumPy)
     p.add_argument("--controller", type=input_file, default=None,
                    help="a controller file to verify (default: train the problem's)")
     p.add_argument("--points", type=positive_int, default=d.n_points[0], help="grid nodes per state "
@@ -66,8 +66,8 @@ def _pct(v):
 
 def run(args) -> int:
     """Run ``weakgrid verify`` with the parsed ``args``; return the exit status."""
-    import numpy as np
     from ..game.checkpoint import load_dp_checkpoint, save_dp_checkpoint
+    import numpy as np
     from ..game.dynamic_programming import solve_game_dp
     from ..game.errors import ParameterError
     from ..game.optimality import closed_loop_gap, default_starts, value_error

@@ -1,11 +1,9 @@
 """Settings of the grid dynamic programming (:mod:`weakgrid.game.dynamic_programming`), NumPy
-only: the CLI reads their defaults without loading SciPy."""
+when used: the CLI reads their defaults without loading NumPy or SciPy."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-
-import numpy as np
 
 from .errors import ParameterError
 
@@ -49,6 +47,8 @@ class DPSettings:
     interpolation: str = "cubic"
 
     def __post_init__(self):
+        import numpy as np   # here, not at import: the CLI reads the defaults only
+
         n = tuple(int(v) for v in np.atleast_1d(self.n_points))
         if any(v < 3 for v in n):
             raise ParameterError("n_points", list(n), "use at least 3 nodes per state")
@@ -85,6 +85,8 @@ class DPSettings:
             raise ParameterError("newton_steps", self.newton_steps, "use an integer ≥ 1")
 
     def to_dict(self):
+        import numpy as np
+
         return {"n_points": list(self.n_points), "hold_steps": self.hold_steps,
                 "margin": self.margin if np.ndim(self.margin) == 0 else list(self.margin),
                 "prior": self.prior if isinstance(self.prior, str) else [list(r) for r in

@@ -6,8 +6,6 @@ them as attributes so that callers (the CLI, a γ search) can act on them.
 
 from __future__ import annotations
 
-import numpy as np
-
 
 class WeakgridError(Exception):
     """Base class of every error raised by weakgrid."""
@@ -75,6 +73,8 @@ class GammaTooSmallError(WeakgridError):
             f"points{where} (worst at x = {[round(float(v), 6) for v in worst_state]}, "
             f"largest eigenvalue {worst_eig:.3g})"
         )
+        import numpy as np   # here: the errors are imported by the CLI before any NumPy work
+
         return cls(gamma, reason, n_bad, n_points, np.asarray(worst_state), worst_eig)
 
 

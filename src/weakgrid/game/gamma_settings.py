@@ -1,11 +1,10 @@
-"""Settings of the minimum-γ search (:mod:`weakgrid.game.gamma_search`), NumPy only: the CLI
+"""Settings of the minimum-γ search (:mod:`weakgrid.game.gamma_search`), standard library only: the CLI
 reads their defaults without loading the solvers."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
-
-import numpy as np
 
 from .errors import ParameterError
 
@@ -40,16 +39,16 @@ class SearchSettings:
     starts: tuple = ("continuation", "game-riccati", "initial")
 
     def __post_init__(self):
-        if not (np.isfinite(self.rtol) and 0 < self.rtol < 1):
+        if not (math.isfinite(self.rtol) and 0 < self.rtol < 1):
             raise ParameterError("rtol", self.rtol, "use a relative tolerance in (0, 1), "
                                  "e.g. 1e-3")
         if int(self.max_trials) != self.max_trials or self.max_trials < 2:
             raise ParameterError("max_trials", self.max_trials, "use an integer ≥ 2")
         if int(self.rollout_steps) != self.rollout_steps or self.rollout_steps < 1:
             raise ParameterError("rollout_steps", self.rollout_steps, "use an integer ≥ 1")
-        if not (np.isfinite(self.escape_factor) and self.escape_factor >= 1):
+        if not (math.isfinite(self.escape_factor) and self.escape_factor >= 1):
             raise ParameterError("escape_factor", self.escape_factor, "use a number ≥ 1")
-        if not (np.isfinite(self.return_fraction) and 0 < self.return_fraction <= 1):
+        if not (math.isfinite(self.return_fraction) and 0 < self.return_fraction <= 1):
             raise ParameterError("return_fraction", self.return_fraction,
                                  "use a fraction in (0, 1]")
         bad = [s for s in self.starts if s not in ("continuation", "game-riccati", "initial")]

@@ -1,12 +1,14 @@
 """weakgrid.models — the paper's design models (Section II), control laws and presets.
 
 Names are imported from their modules on first use (PEP 562), so that ``weakgrid --help`` and
-a look-up of the preset names do not load SciPy. Importing the package registers the design
-model (10) and its C emitter (NumPy only), as before.
+a look-up of the preset names load nothing but the standard library. The design model (10)
+and its C emitter are registered (:func:`_register`) at the first use of any name of the
+package, and by :func:`load_controller`.
 """
 
-from . import design as _design  # noqa: F401  (registers the system kind "upqc-design")
-from . import export as _export  # noqa: F401  (registers the C emitter of (10))
+
+def _register():
+    from . import design, export  # noqa: F401  (system kind "upqc-design" and its C emitter)
 
 _WHERE = {
     "design": ("UPQCDesignModel", "gti_design_model", "sg_design_model"),
@@ -21,6 +23,7 @@ def load_controller(path):
     """Read a controller file written by ``weakgrid train`` (design models registered)."""
     from ..game.controller import load_controller as _load_controller
 
+    _register()
     return _load_controller(path)
 
 
@@ -30,6 +33,7 @@ def __getattr__(name):
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     import importlib
 
+    _register()
     value = getattr(importlib.import_module(f".{mod}", __name__), name)
     globals()[name] = value
     return value
