@@ -33,11 +33,21 @@ GENROU = dict(Sn=200, M=8.0, D=0.0, ra=0.0, xl=0.15, xd=1.8, xq=1.7, xd1=0.3, xq
 SCRX = dict(TATB=0.4, TB=5.0, K=20.0, TE=1.0, EMIN=-50.0, EMAX=50.0, CSWITCH=1, rc_rfd=0.0)
 SCRX_FAST = dict(TATB=0.1, TB=1.0, K=200.0, TE=0.05, EMIN=-1.0, EMAX=3.0, CSWITCH=0, rc_rfd=0.0)
 
+# PSID's benchmark record (ThreeBus_ST6B.dyr), ILR raised to IEEE 421.5's typical 4.164 (with
+# the shipped 2.15 the field-current limiter would be active at this operating point)
+ST6B_REC = [0, 0.012, 50.038, 45.094, 0.0, 0.0, 4.81, -3.85, 1.0, 1.0, 1.0577, 17.33, 2.15, 4.81, -3.85, 1.0, 0.02]
+ST6B = dict(OEL=0, TR=0.012, KPA=50.038, KIA=45.094, KDA=0.0, TDA=0.0, VAMAX=4.81, VAMIN=-3.85, KFF=1.0,
+            KM=1.0, KCI=1.0577, KLR=17.33, ILR=4.164, VRMAX=4.81, VRMIN=-3.85, KG=1.0, TG=0.02)
+
 CASES = {
     "SCRX solid": ("SCRX", SCRX),
     "SCRX bus": ("SCRX", dict(SCRX, CSWITCH=0)),
     "SCRX bus crowbar": ("SCRX", dict(SCRX, CSWITCH=0, rc_rfd=1.0)),
     "SCRX TE=0": ("SCRX", dict(SCRX_FAST, TE=0.0)),
+    "ST6B": ("ST6B", ST6B),
+    "ST6B TG=0 TR=0": ("ST6B", dict(ST6B, TG=0.0, TR=0.0)),
+    "ST6B PID": ("ST6B", dict(ST6B, KDA=0.5, TDA=0.05, OEL=1)),
+    "ST6B KIA=0": ("ST6B", dict(ST6B, KIA=0.0)),
 }
 
 
@@ -178,3 +188,112 @@ def test_scrx_crowbar_with_negative_initial_field_current_is_refused():
     with pytest.raises(DataError) as e:
         c.init(s, np.zeros(s.nx), sig)
     assert e.value.field == "rc_rfd"
+
+
+# ------------------------------------------------------------------ ST6B
+def test_st6b_record_reads_psid_benchmark():
+    from weakgrid.sim.exciters import ST6B as cls
+
+    assert len(cls.psse_record) == len(ST6B_REC) == 17 and cls.psse_record[0] == "OEL"
+    v = dict(zip(cls.psse_record, map(float, ST6B_REC)))
+    assert v == dict(ST6B, ILR=2.15)
+
+
+def _vref_step(model, params, dv=0.01, t=20.0):
+    s = _system(model, params)
+    c = s.components[model]
+    c.vref0 = c.vref0 + dv
+    return s, c, simulate(s, t, dt=1 / 60)
+
+
+@pytest.mark.parametrize("model, params", [("ST6B", ST6B), ("ST6B", dict(ST6B, TG=0.0))])
+def test_integral_regulator_removes_the_voltage_error(model, params):
+    """KIA > 0: after a reference step the terminal voltage settles at the new reference."""
+    s, c, r = _vref_step(model, params)
+    assert r["bus1.v"][-1] == pytest.approx(c.vref0[0], abs=2e-5)
+    assert abs(r["bus1.v"][-1] - r["bus1.v"][0]) > 5e-3
+
+
+@pytest.mark.parametrize("tg", [0.02, 0.0])
+def test_st6b_steady_state_gain(tg):
+    """KIA = 0: with the input stepped by dv the exciter's equilibrium has VA = KPA*vi + PI0 and
+    the inner loop Efd = Vt*VR, VR = (KFF+KM)*VA - KM*KG*Efd, i.e. Efd = Vt*(KFF+KM)*VA/(1 +
+    KM*KG*Vt) (the same with the static feedback TG = 0)."""
+    prm = dict(ST6B, KIA=0.0, KPA=10.0, KFF=0.5, KM=2.0, KG=0.8, TG=tg, KDA=0.3, TDA=0.1)
+    s = _system("ST6B", prm)
+    c = s.components["ST6B"]
+    vt, v = s.sig_defaults["Vt0"][0], s.sig_defaults["Ecomp0"][0]
+    dv = 0.01
+    pi0 = _x(s, "ST6B", "PI")
+    va = prm["KPA"] * dv + pi0
+    efd = vt * (prm["KFF"] + prm["KM"]) * va / (1 + prm["KM"] * prm["KG"] * vt)
+    z = s.z0.copy()
+    z[c.idx("PD")] = dv                    # derivative filter at rest on the new input
+    z[c.idx("VG")] = prm["KG"] * efd
+    ctx, _ = _exciter_alone(s, "ST6B", z, vs=dv)
+    for st in c.states:
+        assert abs(ctx.f[c.idx(st)][0]) < 1e-12, st
+    assert ctx.out["ST6B.VA"][0] == pytest.approx(va, rel=1e-12)
+    assert ctx.sig["vf"][0] == pytest.approx(efd, rel=1e-12)
+    # and the initial point: VR = vf0/Vt, VA = (VR + KM*KG*vf0)/(KFF + KM), vref = v
+    vf0 = s.sig_defaults["vf0"][0]
+    assert pi0 == pytest.approx((vf0 / vt + prm["KM"] * prm["KG"] * vf0) / (prm["KFF"] + prm["KM"]), rel=1e-12)
+    assert c.vref0[0] == pytest.approx(v, abs=1e-15)
+
+
+def test_st6b_limits_are_reached_and_held():
+    """A close fault drives the PID output and its integrator to VAMAX and VR to VRMAX; the
+    recovery overshoot drives the PID to VAMIN; the PI integrator stays within its limits."""
+    prm = dict(ST6B, VAMIN=0.9)
+    s = _system("ST6B", prm)
+    r = simulate(s, 5.0, events=[Fault(1, 1.0, 1.15, xf=0.05)])
+    va, pi, vr = r["G.avr.VA"], r["G.avr.PI"], r["G.avr.VR"]
+    assert va.max() == pytest.approx(prm["VAMAX"], abs=1e-9) and pi.max() == pytest.approx(prm["VAMAX"], abs=1e-9)
+    assert va.min() == pytest.approx(prm["VAMIN"], abs=1e-9) and pi.min() >= prm["VAMIN"] - 1e-9
+    assert vr.max() == pytest.approx(prm["VRMAX"], abs=1e-9)
+    assert np.allclose(r["G.vf"], vr * r["bus1.v"], atol=1e-9)
+
+
+def test_st6b_field_current_limiter_takes_over():
+    """With ILR = 3 the fault's field current (XadIfd ~ 4 pu) closes the limiter: VR follows
+    max(KLR*(KCI*ILR - XadIfd), VRMIN) through the low-value gate, down to VRMIN."""
+    prm = dict(ST6B, ILR=3.0)
+    s = _system("ST6B", prm)
+    r = simulate(s, 5.0, events=[Fault(1, 1.0, 1.15, xf=0.05)])
+    vr, vr1, xad = r["G.avr.VR"], r["G.avr.VR1"], r["G.XadIfd"]
+    assert np.allclose(vr1, np.maximum(prm["KLR"] * (prm["KCI"] * prm["ILR"] - xad), prm["VRMIN"]), atol=1e-9)
+    on = vr1 < prm["VRMAX"]
+    assert np.sum(on) > 5 and np.sum(np.abs(vr - vr1) < 1e-12) > 5      # the limiter branch binds
+    assert np.all(vr <= vr1 + 1e-12)
+    assert vr.min() == pytest.approx(prm["VRMIN"], abs=1e-9)
+
+
+@pytest.mark.parametrize("field, side", [("VRMAX", +1), ("VAMAX", +1), ("ILR", +1)])
+def test_st6b_operating_point_beyond_a_limit_is_refused(field, side):
+    """VR0 = vf0/Vt above VRMAX, the PID's VA0 above VAMAX, or the field-current limiter closed
+    at the operating point (ILR below (XadIfd + VR/KLR)/KCI, PSID's benchmark case): DataError
+    naming the field; limits="warn" warns."""
+    s0 = _system("ST6B", ST6B)
+    vt, vf0, xad = (s0.sig_defaults[k][0] for k in ("Vt0", "vf0", "XadIfd"))
+    at = {"VRMAX": vf0 / vt, "VAMAX": _x(s0, "ST6B", "PI"),
+          "ILR": (xad + vf0 / vt / ST6B["KLR"]) / ST6B["KCI"]}[field]
+    with pytest.raises(DataError) as e:
+        _system("ST6B", dict(ST6B, **{field: at - side * 1e-3}))
+    assert "ST6B 'G.avr'" in str(e.value) and e.value.field == field
+    _system("ST6B", dict(ST6B, **{field: at + side * 1e-3}))        # just inside: accepted
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        try:
+            _system("ST6B", dict(ST6B, **{field: at - side * 1e-3}), limits="warn")
+        except DataError as e2:
+            assert "initial point" in str(e2)
+    assert any(field in str(x.message) for x in w)
+
+
+@pytest.mark.parametrize("bad, field", [(dict(OEL=3), "OEL"), (dict(KDA=0.5, TDA=0.0), "TDA"),
+                                        (dict(KFF=1.0, KM=-1.0), "KM"), (dict(KPA=-1.0), "KPA"),
+                                        (dict(TG=0.0, KM=-0.5, KFF=2.0), "TG")])
+def test_st6b_bad_data_names_the_field(bad, field):
+    with pytest.raises(DataError) as e:
+        _system("ST6B", dict(ST6B, **bad))
+    assert e.value.field == field
