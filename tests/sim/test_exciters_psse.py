@@ -22,7 +22,7 @@ import pytest
 from sim_cases import two_machine_case
 
 from weakgrid.sim.errors import DataError
-from weakgrid.sim.events import Fault
+from weakgrid.sim.events import Fault, LoadStep
 from weakgrid.sim.integrate import simulate
 from weakgrid.sim.system import System, _registry
 
@@ -39,6 +39,14 @@ ST6B_REC = [0, 0.012, 50.038, 45.094, 0.0, 0.0, 4.81, -3.85, 1.0, 1.0, 1.0577, 1
 ST6B = dict(OEL=0, TR=0.012, KPA=50.038, KIA=45.094, KDA=0.0, TDA=0.0, VAMAX=4.81, VAMIN=-3.85, KFF=1.0,
             KM=1.0, KCI=1.0577, KLR=17.33, ILR=4.164, VRMAX=4.81, VRMIN=-3.85, KG=1.0, TG=0.02)
 
+# PSID's benchmark record (ThreeBus_ST8C.dyr): 4 ICONs (OEL, UEL, SCL, SW1), 24 CONs
+ST8C_REC = [0, 0, 0, 0, 0.01, 5.0, 5.0, 99.99, 0.0, 4.0, 0.1, 99.9962, -99.866, 1.35, 0.003, 99.3449, -99.1691,
+            0.5, 0.005, 0.1, 4.0, 0.0, 0.0, 0.0, 99.0, 0.0, 0.0, 99.0]
+ST8C = dict(OEL=0, UEL=0, SCL=0, SW1=0, TR=0.01, KPR=5.0, KIR=5.0, VPIMAX=99.99, VPIMIN=0.0, KPA=4.0, KIA=0.1,
+            VAMAX=99.9962, VAMIN=-99.866, KA=1.35, TA=0.003, VRMAX=99.3449, VRMIN=-99.1691, KF=0.5, TF=0.005,
+            KC1=0.1, KP=4.0, KI1=0.0, XL=0.0, THETAP=0.0, VB1MAX=99.0, KC2=0.0, KI2=0.0, VB2MAX=99.0)
+ST8C_COMPOUND = dict(ST8C, KI1=0.5, XL=0.05, THETAP=10.0, KI2=0.3, KC2=0.01)
+
 CASES = {
     "SCRX solid": ("SCRX", SCRX),
     "SCRX bus": ("SCRX", dict(SCRX, CSWITCH=0)),
@@ -48,11 +56,18 @@ CASES = {
     "ST6B TG=0 TR=0": ("ST6B", dict(ST6B, TG=0.0, TR=0.0)),
     "ST6B PID": ("ST6B", dict(ST6B, KDA=0.5, TDA=0.05, OEL=1)),
     "ST6B KIA=0": ("ST6B", dict(ST6B, KIA=0.0)),
+    "ST8C": ("ST8C", ST8C),
+    "ST8C independent source": ("ST8C", dict(ST8C, SW1=2)),
+    "ST8C compound": ("ST8C", ST8C_COMPOUND),
+    "ST8C TA=TF=TR=0": ("ST8C", dict(ST8C, TA=0.0, TF=0.0, TR=0.0)),
+    "ST8C KIR=KIA=0": ("ST8C", dict(ST8C, KIR=0.0, KIA=0.0)),
 }
 
 
-def _system(model, params, p=0.8, limits="raise", pss=None):
-    s = System(two_machine_case(p=p))
+def _system(model, params, p=0.8, limits="raise", pss=None, vg=1.0):
+    case = two_machine_case(p=p)
+    case["gen"][0, 5] = vg                       # the machine's voltage set point [pu]
+    s = System(case)
     s.add_generator("G", 0, machine=("GENROU", GENROU), exciter=(model, params), pss=pss)
     s.add_generator("S", 1, machine=("GENCLS", dict(Sn=1000, M=20.0, xd1=0.1)))
     return s.setup(limits=limits)
@@ -206,7 +221,7 @@ def _vref_step(model, params, dv=0.01, t=20.0):
     return s, c, simulate(s, t, dt=1 / 60)
 
 
-@pytest.mark.parametrize("model, params", [("ST6B", ST6B), ("ST6B", dict(ST6B, TG=0.0))])
+@pytest.mark.parametrize("model, params", [("ST6B", ST6B), ("ST6B", dict(ST6B, TG=0.0)), ("ST8C", ST8C)])
 def test_integral_regulator_removes_the_voltage_error(model, params):
     """KIA > 0: after a reference step the terminal voltage settles at the new reference."""
     s, c, r = _vref_step(model, params)
@@ -296,4 +311,126 @@ def test_st6b_operating_point_beyond_a_limit_is_refused(field, side):
 def test_st6b_bad_data_names_the_field(bad, field):
     with pytest.raises(DataError) as e:
         _system("ST6B", dict(ST6B, **bad))
+    assert e.value.field == field
+
+
+# ------------------------------------------------------------------ ST8C
+def test_st8c_record_reads_psid_benchmark():
+    from weakgrid.sim.exciters import ST8C as cls
+
+    assert len(cls.psse_record) == len(ST8C_REC) == 28 and cls.psse_record[:4] == ("OEL", "UEL", "SCL", "SW1")
+    assert dict(zip(cls.psse_record, map(float, ST8C_REC))) == ST8C
+
+
+def _fex(IN):
+    IN = float(IN)
+    if IN <= 0:
+        return 1.0
+    if IN <= 0.433:
+        return 1 - 0.577 * IN
+    if IN <= 0.75:
+        return np.sqrt(0.75 - IN * IN)
+    return 1.732 * (1 - IN) if IN <= 1 else 0.0
+
+
+@pytest.mark.parametrize("prm, vg", [(ST8C_COMPOUND, 1.03), (dict(ST8C, SW1=2), 1.03), (ST8C, 1.03)],
+                         ids=["terminal compound", "independent", "terminal"])
+def test_st8c_source_voltages(prm, vg):
+    """VE1 = |KP e^{j THETAP} Vt + j(KI1 + KP e^{j THETAP} XL) It| (SW1 < 2) or KP (SW1 = 2),
+    VB1 = VE1 FEX(KC1 XadIfd/VE1); VE2 = KI2 |It|, VB2 = VE2 FEX(KC2 XadIfd/VE2); It in pu of the
+    machine; and the initial bridge output VR = (vf0 - VB2)/VB1."""
+    s = _system("ST8C", prm, vg=vg)
+    sig = s.sig_defaults
+    V = sig["Vt0"][0] * np.exp(1j * sig["theta0"][0])
+    It = np.conj((sig["Pe0"][0] + 1j * sig["Qe0"][0]) / V) * s.Sb / GENROU["Sn"]
+    xad = sig["XadIfd"][0]
+    kpc = prm["KP"] * np.exp(1j * np.radians(prm["THETAP"]))
+    ve1 = abs(kpc * V + 1j * (prm["KI1"] + kpc * prm["XL"]) * It) if prm["SW1"] < 2 else prm["KP"]
+    vb1 = min(ve1 * _fex(prm["KC1"] * xad / ve1), prm["VB1MAX"])
+    ve2 = prm["KI2"] * abs(It)
+    vb2 = min(ve2 * _fex(prm["KC2"] * xad / ve2), prm["VB2MAX"]) if ve2 > 0 else 0.0
+    _, ctx = s.residual(0.0, s.z0)
+    assert ctx.out["ST8C.VB1"][0] == pytest.approx(vb1, rel=1e-12)
+    assert ctx.out["ST8C.VB2"][0] == pytest.approx(vb2, rel=1e-12, abs=1e-15)
+    assert _x(s, "ST8C", "VR") == pytest.approx((sig["vf0"][0] - vb2) / vb1, rel=1e-12)
+    if prm is ST8C_COMPOUND:
+        assert vb2 > 0.01
+
+
+def test_st8c_steady_state_gain():
+    """KIR = KIA = 0: with the input stepped by dv the exciter's equilibrium has IFDREF = KPR dv +
+    PR0, VA = KPA (IFDREF - KF XadIfd) + PA0, VR = KA VA and Efd = VR VB1 + VB2; at the initial
+    point the field-current error is zero (PR0 = KF XadIfd0) and vref = v."""
+    prm = dict(ST8C_COMPOUND, KIR=0.0, KIA=0.0)
+    s = _system("ST8C", prm)
+    c = s.components["ST8C"]
+    xad = s.sig_defaults["XadIfd"][0]
+    pr0, pa0 = _x(s, "ST8C", "PR"), _x(s, "ST8C", "PA")
+    assert pr0 == pytest.approx(prm["KF"] * xad, rel=1e-12)
+    dv = 0.01
+    va = prm["KPA"] * (prm["KPR"] * dv + pr0 - prm["KF"] * xad) + pa0
+    z = s.z0.copy()
+    z[c.idx("VR")] = prm["KA"] * va
+    ctx, _ = _exciter_alone(s, "ST8C", z, vs=dv)
+    for st in c.states:
+        assert abs(ctx.f[c.idx(st)][0]) < 1e-12, st
+    vb1, vb2 = ctx.out["ST8C.VB1"][0], ctx.out["ST8C.VB2"][0]
+    assert ctx.out["ST8C.VA"][0] == pytest.approx(va, rel=1e-12)
+    assert ctx.sig["vf"][0] == pytest.approx(prm["KA"] * va * vb1 + vb2, rel=1e-12)
+
+
+@pytest.mark.parametrize("extra, event, limits", [
+    (dict(VPIMAX=2.5, VAMAX=2.5, VRMAX=3.0), Fault(1, 1.0, 1.15, xf=0.05),
+     {"IFDREF": "VPIMAX", "VA": "VAMAX", "VR": "VRMAX"}),
+    (dict(VAMIN=0.15, VRMIN=0.21), Fault(1, 1.0, 1.15, xf=0.05), {"VA": "VAMIN", "VR": "VRMIN"}),
+    (dict(VPIMIN=0.6), LoadStep(1, 1.0, dQ=-80.0), {"IFDREF": "VPIMIN"}),
+], ids=["upper", "lower", "VPIMIN"])
+def test_st8c_limits_are_reached_and_held(extra, event, limits):
+    """A close fault (upper limits; after its clearing, lower ones) or a capacitive step (voltage
+    rise: the field-current reference falls) drives each regulator to its limit; the outputs and
+    the non-windup states stay within them."""
+    prm = dict(ST8C, **extra)
+    s = _system("ST8C", prm)
+    r = simulate(s, 5.0, events=[event])
+    for sig, fld in limits.items():
+        y = r[f"G.avr.{sig}"]
+        lim = prm[fld]
+        got = y.max() if fld.endswith("MAX") else y.min()
+        assert got == pytest.approx(lim, abs=1e-9), (sig, fld)
+        assert np.sum(np.abs(y - lim) < 1e-9) > 2, (sig, fld)
+    for st, (lo, hi) in (("PR", ("VPIMIN", "VPIMAX")), ("PA", ("VAMIN", "VAMAX")), ("VR", ("VRMIN", "VRMAX"))):
+        y = r[f"G.avr.{st}"]
+        assert y.min() >= prm[lo] - 1e-9 and y.max() <= prm[hi] + 1e-9, st
+    assert np.allclose(r["G.vf"], r["G.avr.VR"] * r["G.avr.VB1"] + r["G.avr.VB2"], atol=1e-9)
+
+
+@pytest.mark.parametrize("field, state", [("VRMAX", "VR"), ("VAMAX", "PA"), ("VPIMAX", "PR")])
+def test_st8c_operating_point_beyond_a_limit_is_refused(field, state):
+    s0 = _system("ST8C", ST8C)
+    at = _x(s0, "ST8C", state)
+    with pytest.raises(DataError) as e:
+        _system("ST8C", dict(ST8C, **{field: at - 1e-3}))
+    assert "ST8C 'G.avr'" in str(e.value) and e.value.field == field
+    _system("ST8C", dict(ST8C, **{field: at + 1e-3}))
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        try:
+            _system("ST8C", dict(ST8C, **{field: at - 1e-3}), limits="warn")
+        except DataError as e2:
+            assert "initial point" in str(e2)
+    assert any(field in str(x.message) for x in w)
+
+
+def test_st8c_static_firing_beyond_vrmax_is_refused():
+    s0 = _system("ST8C", dict(ST8C, TA=0.0))
+    with pytest.raises(DataError) as e:
+        _system("ST8C", dict(ST8C, TA=0.0, VRMAX=_x(s0, "ST8C", "VR") - 1e-3))
+    assert e.value.field == "VRMAX"
+
+
+@pytest.mark.parametrize("bad, field", [(dict(SW1=3), "SW1"), (dict(OEL=-1), "OEL"), (dict(KP=0.0), "KP"),
+                                        (dict(KA=0.0), "KA"), (dict(KC1=-0.1), "KC1")])
+def test_st8c_bad_data_names_the_field(bad, field):
+    with pytest.raises(DataError) as e:
+        _system("ST8C", dict(ST8C, **bad))
     assert e.value.field == field
