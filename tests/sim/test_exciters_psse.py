@@ -47,6 +47,12 @@ ST8C = dict(OEL=0, UEL=0, SCL=0, SW1=0, TR=0.01, KPR=5.0, KIR=5.0, VPIMAX=99.99,
             KC1=0.1, KP=4.0, KI1=0.0, XL=0.0, THETAP=0.0, VB1MAX=99.0, KC2=0.0, KI2=0.0, VB2MAX=99.0)
 ST8C_COMPOUND = dict(ST8C, KI1=0.5, XL=0.05, THETAP=10.0, KI2=0.3, KC2=0.01)
 
+# IEEE 421.5 typical AC6A data (PSS/E ESAC6A record order)
+ESAC6A = dict(TR=0.0, KA=536.0, TA=0.086, TK=0.18, TB=9.0, TC=3.0, VAMAX=75.0, VAMIN=-75.0, VRMAX=44.0,
+              VRMIN=-36.0, TE=1.0, VFELIM=19.0, KH=92.0, VHMAX=75.0, TH=0.08, TJ=0.02, KC=0.173, KD=1.91,
+              KE=1.6, E1=7.4, SE1=0.214, E2=5.55, SE2=0.044)
+ESAC6A_TIGHT = dict(ESAC6A, VAMAX=8.0, VAMIN=-5.0, VRMAX=6.0, VRMIN=-4.0, VFELIM=5.0, VHMAX=3.0, KH=5.0)
+
 CASES = {
     "SCRX solid": ("SCRX", SCRX),
     "SCRX bus": ("SCRX", dict(SCRX, CSWITCH=0)),
@@ -61,6 +67,9 @@ CASES = {
     "ST8C compound": ("ST8C", ST8C_COMPOUND),
     "ST8C TA=TF=TR=0": ("ST8C", dict(ST8C, TA=0.0, TF=0.0, TR=0.0)),
     "ST8C KIR=KIA=0": ("ST8C", dict(ST8C, KIR=0.0, KIA=0.0)),
+    "ESAC6A": ("ESAC6A", ESAC6A),
+    "ESAC6A limiter conducting": ("ESAC6A", dict(ESAC6A, VFELIM=3.0, KH=2.0)),
+    "ESAC6A zero time constants": ("ESAC6A", dict(ESAC6A, TA=0.0, TR=0.0, TB=0.0, TC=0.0, TH=0.0, TJ=0.0)),
 }
 
 
@@ -433,4 +442,93 @@ def test_st8c_static_firing_beyond_vrmax_is_refused():
 def test_st8c_bad_data_names_the_field(bad, field):
     with pytest.raises(DataError) as e:
         _system("ST8C", dict(ST8C, **bad))
+    assert e.value.field == field
+
+
+# ------------------------------------------------------------------ ESAC6A
+def test_esac6a_record_layout():
+    from weakgrid.sim.exciters import ESAC6A as cls
+
+    rec = [ESAC6A[k] for k in ("TR", "KA", "TA", "TK", "TB", "TC", "VAMAX", "VAMIN", "VRMAX", "VRMIN", "TE",
+                                 "VFELIM", "KH", "VHMAX", "TH", "TJ", "KC", "KD", "KE", "E1", "SE1", "E2", "SE2")]
+    assert len(cls.psse_record) == 23 and dict(zip(cls.psse_record, rec)) == ESAC6A
+
+
+@pytest.mark.parametrize("prm", [ESAC6A, dict(ESAC6A, VFELIM=3.0, KH=2.0)], ids=["limiter open", "conducting"])
+def test_esac6a_initial_point_and_regulator_gain(prm):
+    """Initial point: VE*FEX(KC XadIfd/VE) = vf0, VFE = KE VE + VE SE(VE) + KD XadIfd, VH = clip(KH
+    (VFE - VFELIM), 0, VHMAX), VA = VR = VFE + VH and vref = v + VA/KA. Regulator path gain: with
+    the input stepped by dv and the two lead-lags at their new rest, VR = KA (vi0 + dv) and
+    TE dVE/dt = KA dv."""
+    s = _system("ESAC6A", prm)
+    c = s.components["ESAC6A"]
+    sig = s.sig_defaults
+    xad, vf0, v = sig["XadIfd"][0], sig["vf0"][0], sig["Ecomp0"][0]
+    ve = _x(s, "ESAC6A", "VE")
+    in_ = prm["KC"] * xad / ve
+    assert ve * (1 - 0.577 * in_) == pytest.approx(vf0, rel=1e-10)           # IN < 0.433 here
+    _, ctx = s.residual(0.0, s.z0)
+    vfe, vh, va = (float(ctx.out[f"ESAC6A.{k}"][0]) for k in ("VFE", "VH", "VA"))
+    assert vh == pytest.approx(min(max(prm["KH"] * (vfe - prm["VFELIM"]), 0.0), prm["VHMAX"]), abs=1e-12)
+    assert (vh > 0) == (prm["VFELIM"] < 5)
+    assert va == pytest.approx(vfe + vh, rel=1e-12)
+    assert c.vref0[0] == pytest.approx(v + va / prm["KA"], rel=1e-12)
+    dv = 1e-3
+    vi1 = c.vref0[0] - v + dv
+    z = s.z0.copy()
+    z[c.idx("LA")] = prm["KA"] * vi1
+    z[c.idx("LL")] = prm["KA"] * vi1
+    ctx, _ = _exciter_alone(s, "ESAC6A", z, vs=dv)
+    for st in ("LG", "LA", "LL", "LH"):
+        assert abs(ctx.f[c.idx(st)][0]) < 1e-9, st
+    assert ctx.out["ESAC6A.VR"][0] == pytest.approx(prm["KA"] * vi1, rel=1e-12)
+    assert ctx.f[c.idx("VE")][0] * prm["TE"] == pytest.approx(prm["KA"] * dv, rel=1e-9)
+
+
+def test_esac6a_upper_limits_are_reached_and_held():
+    """A close fault: VA to VAMAX (its lead-lag state held there), VR to the moving ceiling
+    Vt*VRMAX, the field-current limiter output VH to VHMAX and back to its floor 0."""
+    prm = ESAC6A_TIGHT
+    r = simulate(_system("ESAC6A", prm), 5.0, events=[Fault(1, 1.0, 1.15, xf=0.05)])
+    va, la, vr, vh, vt = (r[k] for k in ("G.avr.VA", "G.avr.LA", "G.avr.VR", "G.avr.VH", "bus1.v"))
+    assert va.max() == pytest.approx(prm["VAMAX"], abs=1e-9) and la.max() <= prm["VAMAX"] + 1e-9
+    assert np.sum(np.abs(vr - prm["VRMAX"] * vt) < 1e-9) > 3 and np.all(vr <= prm["VRMAX"] * vt + 1e-9)
+    assert vh.max() == pytest.approx(prm["VHMAX"], abs=1e-9) and vh.min() == 0.0
+
+
+def test_esac6a_lower_limits_are_reached_and_held():
+    """A capacitive step raises the voltage: VA to VAMIN, VR to Vt*VRMIN, VE to its floor 0
+    (the field voltage then 0)."""
+    prm = dict(ESAC6A_TIGHT, TB=1.0, TC=1.0)
+    r = simulate(_system("ESAC6A", prm), 5.0, events=[LoadStep(1, 1.0, dQ=-80.0)])
+    va, vr, ve, vt = (r[k] for k in ("G.avr.VA", "G.avr.VR", "G.avr.VE", "bus1.v"))
+    assert va.min() == pytest.approx(prm["VAMIN"], abs=1e-9) and r["G.avr.LA"].min() >= prm["VAMIN"] - 1e-9
+    assert np.sum(np.abs(vr - prm["VRMIN"] * vt) < 1e-9) > 3 and np.all(vr >= prm["VRMIN"] * vt - 1e-9)
+    assert ve.min() == pytest.approx(0.0, abs=1e-9) and np.sum(ve < 1e-9) > 3
+    assert r["G.vf"].min() == pytest.approx(0.0, abs=1e-9)
+
+
+@pytest.mark.parametrize("field, ta", [("VRMAX", 0.086), ("VAMAX", 0.086), ("VAMAX", 0.0)])
+def test_esac6a_operating_point_beyond_a_limit_is_refused(field, ta):
+    s0 = _system("ESAC6A", dict(ESAC6A, TA=ta))
+    va0 = _x(s0, "ESAC6A", "LA")
+    at = va0 / s0.sig_defaults["Vt0"][0] if field == "VRMAX" else va0
+    with pytest.raises(DataError) as e:
+        _system("ESAC6A", dict(ESAC6A, TA=ta, **{field: at - 1e-3}))
+    assert "ESAC6A 'G.avr'" in str(e.value) and field in e.value.field
+    _system("ESAC6A", dict(ESAC6A, TA=ta, **{field: at + 1e-3}))
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        try:
+            _system("ESAC6A", dict(ESAC6A, TA=ta, **{field: at - 1e-3}), limits="warn")
+        except DataError as e2:
+            assert "initial point" in str(e2)
+    assert any(field in str(x.message) for x in w)
+
+
+@pytest.mark.parametrize("bad, field", [(dict(KA=0.0), "KA"), (dict(TE=0.0), "TE"), (dict(KH=-1.0), "KH"),
+                                        (dict(TH=-0.1), "TH")])
+def test_esac6a_bad_data_names_the_field(bad, field):
+    with pytest.raises(DataError) as e:
+        _system("ESAC6A", dict(ESAC6A, **bad))
     assert e.value.field == field

@@ -19,8 +19,9 @@ from .ac8b import AC8B
 from .scrx import SCRX
 from .st6b import ST6B
 from .st8c import ST8C
+from .esac6a import ESAC6A
 
 __all__ = ["EXDC2", "SEXS", "ESST3A", "EXST1", "IEEEX1", "IEEET1", "EXAC1", "ESDC2A", "IEEEVC",
            "ESST1A", "ESAC1A", "ESDC1A", "IEEET3"]
 __all__ += ["ESST4B", "EXAC4", "AC8B"]
-__all__ += ["SCRX", "ST6B", "ST8C"]
+__all__ += ["SCRX", "ST6B", "ST8C", "ESAC6A"]
