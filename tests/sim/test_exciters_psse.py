@@ -53,6 +53,14 @@ ESAC6A = dict(TR=0.0, KA=536.0, TA=0.086, TK=0.18, TB=9.0, TC=3.0, VAMAX=75.0, V
               KE=1.6, E1=7.4, SE1=0.214, E2=5.55, SE2=0.044)
 ESAC6A_TIGHT = dict(ESAC6A, VAMAX=8.0, VAMIN=-5.0, VRMAX=6.0, VRMIN=-4.0, VFELIM=5.0, VHMAX=3.0, KH=5.0)
 
+# PSS/E EXAC2 typical data (record order)
+EXAC2 = dict(TR=0.0, TB=0.0, TC=0.0, KA=400.0, TA=0.02, VAMAX=8.0, VAMIN=-8.0, KB=25.0, VRMAX=105.0, VRMIN=-95.0,
+             TE=0.6, KL=1.0, KH=1.0, KF=0.03, TF=1.0, KC=0.28, KD=0.35, KE=1.0, VLR=4.4, E1=4.4, SE1=0.037,
+             E2=3.3, SE2=0.012)
+EXPIC1 = dict(TR=0.02, KA=5.0, TA1=2.0, VR1=5.0, VR2=-5.0, TA2=0.05, TA3=0.5, TA4=0.1, VRMAX=6.0, VRMIN=-4.0,
+              KF=0.05, TF1=0.5, TF2=0.1, EFDMAX=7.0, EFDMIN=-5.0, KE=1.0, TE=0.4, E1=2.8, SE1=0.08, E2=3.7,
+              SE2=0.33, KP=1.2, KI=0.3, KC=0.1)
+
 CASES = {
     "SCRX solid": ("SCRX", SCRX),
     "SCRX bus": ("SCRX", dict(SCRX, CSWITCH=0)),
@@ -70,6 +78,13 @@ CASES = {
     "ESAC6A": ("ESAC6A", ESAC6A),
     "ESAC6A limiter conducting": ("ESAC6A", dict(ESAC6A, VFELIM=3.0, KH=2.0)),
     "ESAC6A zero time constants": ("ESAC6A", dict(ESAC6A, TA=0.0, TR=0.0, TB=0.0, TC=0.0, TH=0.0, TJ=0.0)),
+    "EXAC2": ("EXAC2", EXAC2),
+    "EXAC2 lead-lag TR": ("EXAC2", dict(EXAC2, TR=0.02, TB=1.0, TC=0.5, KH=0.5, KL=2.0)),
+    "EXAC2 TA=0 ANDES TR": ("EXAC2", dict(EXAC2, TA=0.0, TR=0.02, TR_used=0.0)),
+    "EXPIC1": ("EXPIC1", EXPIC1),
+    "EXPIC1 VB=1": ("EXPIC1", dict(EXPIC1, KP=0.0, KI=0.0, KC=0.0)),
+    "EXPIC1 TE=0 TF2=0": ("EXPIC1", dict(EXPIC1, TE=0.0, TF2=0.0)),
+    "EXPIC1 zero time constants": ("EXPIC1", dict(EXPIC1, TR=0.0, TA1=0.0, TA2=0.0, TA3=0.0, TA4=0.0)),
 }
 
 
@@ -230,10 +245,11 @@ def _vref_step(model, params, dv=0.01, t=20.0):
     return s, c, simulate(s, t, dt=1 / 60)
 
 
-@pytest.mark.parametrize("model, params", [("ST6B", ST6B), ("ST6B", dict(ST6B, TG=0.0)), ("ST8C", ST8C)])
+@pytest.mark.parametrize("model, params", [("ST6B", ST6B), ("ST6B", dict(ST6B, TG=0.0)), ("ST8C", ST8C),
+                                           ("EXPIC1", EXPIC1)])
 def test_integral_regulator_removes_the_voltage_error(model, params):
     """KIA > 0: after a reference step the terminal voltage settles at the new reference."""
-    s, c, r = _vref_step(model, params)
+    s, c, r = _vref_step(model, params, t=30.0 if model == "EXPIC1" else 20.0)
     assert r["bus1.v"][-1] == pytest.approx(c.vref0[0], abs=2e-5)
     assert abs(r["bus1.v"][-1] - r["bus1.v"][0]) > 5e-3
 
@@ -531,4 +547,184 @@ def test_esac6a_operating_point_beyond_a_limit_is_refused(field, ta):
 def test_esac6a_bad_data_names_the_field(bad, field):
     with pytest.raises(DataError) as e:
         _system("ESAC6A", dict(ESAC6A, **bad))
+    assert e.value.field == field
+
+
+# ------------------------------------------------------------------ EXAC2
+def test_exac2_record_layout():
+    from weakgrid.sim.exciters import EXAC2 as cls
+
+    order = ("TR", "TB", "TC", "KA", "TA", "VAMAX", "VAMIN", "KB", "VRMAX", "VRMIN", "TE", "KL", "KH", "KF", "TF",
+             "KC", "KD", "KE", "VLR", "E1", "SE1", "E2", "SE2")
+    assert cls.psse_record == order
+
+
+def test_exac2_initial_point_and_gate():
+    """VR = VFE, the gate passes VH = VA - KH*VFE = VFE/KB (the limiter VL = KL*(VLR - VFE) above
+    it), VA = VFE/KB + KH*VFE, vref = v + VA/KA; the rate feedback at rest. Then with the
+    regulator state raised by dVA (exciter alone), VR = KB*(VH + dVA) while VH < VL, and
+    KB*VL once VA passes the limiter."""
+    prm = dict(EXAC2, TB=1.0, TC=0.5, KH=0.5, KL=2.0, VLR=3.0)
+    s = _system("EXAC2", prm)
+    c = s.components["EXAC2"]
+    _, ctx = s.residual(0.0, s.z0)
+    vfe, vh, vl, vr = (float(ctx.out[f"EXAC2.{k}"][0]) for k in ("VFE", "VH", "VL", "VR"))
+    va0 = _x(s, "EXAC2", "VA")
+    assert vr == pytest.approx(vfe, rel=1e-12) and vh == pytest.approx(vfe / prm["KB"], rel=1e-12)
+    assert va0 == pytest.approx(vfe / prm["KB"] + prm["KH"] * vfe, rel=1e-12)
+    assert vl == pytest.approx(prm["KL"] * (prm["VLR"] - vfe), rel=1e-12) and vl > vh
+    assert c.vref0[0] == pytest.approx(s.sig_defaults["Ecomp0"][0] + va0 / prm["KA"], rel=1e-12)
+    for dva, gate in ((0.01, "VH"), (vl - vh + 0.05, "VL")):
+        z = s.z0.copy()
+        z[c.idx("VA")] = va0 + dva
+        ctx, _ = _exciter_alone(s, "EXAC2", z)
+        expect = prm["KB"] * (vh + dva if gate == "VH" else vl)
+        assert ctx.out["EXAC2.VR"][0] == pytest.approx(expect, rel=1e-12), gate
+        assert ctx.f[c.idx("VE")][0] * prm["TE"] == pytest.approx(expect - vfe, rel=1e-9)
+
+
+def test_exac2_limits_are_reached_and_held():
+    """A close fault: the regulator to VAMAX (held), the field-current limiter takes over the
+    gate (VR = KB*KL*(VLR - VFE) while VL < VH) and VR swings between VRMAX and VRMIN. A
+    capacitive step: VA down to VAMIN."""
+    prm = dict(EXAC2, VAMAX=3.5, VAMIN=-0.5, VRMAX=4.0, VRMIN=0.0, VLR=2.6)
+    r = simulate(_system("EXAC2", prm), 5.0, events=[Fault(1, 1.0, 1.15, xf=0.05)])
+    va, vr, vh, vl = (r[f"G.avr.{k}"] for k in ("VA", "VR", "VH", "VL"))
+    assert va.max() == pytest.approx(prm["VAMAX"], abs=1e-9)
+    assert vr.max() == pytest.approx(prm["VRMAX"], abs=1e-9) and vr.min() == pytest.approx(prm["VRMIN"], abs=1e-9)
+    gate = vl < vh
+    assert np.sum(gate) > 3
+    inside = gate & (vr < prm["VRMAX"] - 1e-9) & (vr > prm["VRMIN"] + 1e-9)
+    assert np.sum(inside) > 0 and np.allclose(vr[inside], prm["KB"] * vl[inside], rtol=1e-12)
+    prm = dict(prm, VAMIN=1.8, VRMIN=0.5)
+    r = simulate(_system("EXAC2", prm), 5.0, events=[LoadStep(1, 1.0, dQ=-80.0)])
+    assert r["G.avr.VA"].min() == pytest.approx(prm["VAMIN"], abs=1e-9)
+    assert r["G.avr.VR"].min() == pytest.approx(prm["VRMIN"], abs=1e-9)
+    assert np.sum(np.abs(r["G.avr.VA"] - prm["VAMIN"]) < 1e-9) > 3
+
+
+@pytest.mark.parametrize("field, what", [("VLR", "limiter"), ("VAMAX", "VA"), ("VRMAX", "VR")])
+def test_exac2_operating_point_beyond_a_limit_is_refused(field, what):
+    """The field-current limiter closed at the operating point (ANDES raises VLR to open it),
+    VA0 above VAMAX, VR0 = VFE above VRMAX: DataError naming the field; limits="warn" warns."""
+    s0 = _system("EXAC2", EXAC2)
+    _, ctx = s0.residual(0.0, s0.z0)
+    vfe = float(ctx.out["EXAC2.VFE"][0])
+    at = {"limiter": vfe + vfe / (EXAC2["KB"] * EXAC2["KL"]), "VA": _x(s0, "EXAC2", "VA"), "VR": vfe}[what]
+    with pytest.raises(DataError) as e:
+        _system("EXAC2", dict(EXAC2, **{field: at - 1e-3}))
+    assert "EXAC2 'G.avr'" in str(e.value) and e.value.field == field
+    _system("EXAC2", dict(EXAC2, **{field: at + 1e-3}))
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        try:
+            _system("EXAC2", dict(EXAC2, **{field: at - 1e-3}), limits="warn")
+        except DataError as e2:
+            assert "initial point" in str(e2)
+    assert any(field in str(x.message) for x in w)
+
+
+@pytest.mark.parametrize("bad, field", [(dict(KB=0.0), "KB"), (dict(TF=0.0), "TF"), (dict(TR_used=0.5), "TR_used"),
+                                        (dict(KL=-1.0), "KL")])
+def test_exac2_bad_data_names_the_field(bad, field):
+    with pytest.raises(DataError) as e:
+        _system("EXAC2", dict(EXAC2, **bad))
+    assert e.value.field == field
+
+
+# ------------------------------------------------------------------ EXPIC1
+def test_expic1_record_layout():
+    from weakgrid.sim.exciters import EXPIC1 as cls
+
+    assert len(cls.psse_record) == 24 and cls.psse_record[:5] == ("TR", "KA", "TA1", "VR1", "VR2")
+    assert cls.psse_record[-3:] == ("KP", "KI", "KC") and set(cls.psse_record) <= set(EXPIC1)
+
+
+@pytest.mark.parametrize("prm", [EXPIC1, dict(EXPIC1, KP=0.0, KI=0.0, KC=0.0), dict(EXPIC1, TE=0.0)],
+                         ids=["source", "VB=1", "TE=0"])
+def test_expic1_initial_point(prm):
+    """VB = |KP Vt + j KI It| FEX(KC XadIfd/VE) (1 if KP = KI = 0; It in pu of the machine),
+    E0 = KE vf0 + vf0 SE(vf0) (vf0 if TE = 0), VR = VA = E0/VB, no voltage error, feedback at rest."""
+    from weakgrid.sim.blocks import quad_saturation, quad_saturation_coeffs
+
+    s = _system("EXPIC1", prm, vg=1.02)
+    c = s.components["EXPIC1"]
+    sig = s.sig_defaults
+    V = sig["Vt0"][0] * np.exp(1j * sig["theta0"][0])
+    It = np.conj((sig["Pe0"][0] + 1j * sig["Qe0"][0]) / V) * s.Sb / GENROU["Sn"]
+    ve = abs(prm["KP"] * V + 1j * prm["KI"] * It)
+    vb = 1.0 if prm["KP"] == prm["KI"] == 0 else ve * _fex(prm["KC"] * sig["XadIfd"][0] / ve)
+    vf0 = sig["vf0"][0]
+    A, B = quad_saturation_coeffs(prm["E1"], prm["SE1"], prm["E2"], prm["SE2"])
+    e0 = vf0 if prm["TE"] == 0 else prm["KE"] * vf0 + float(quad_saturation(vf0, A, B))
+    _, ctx = s.residual(0.0, s.z0)
+    assert ctx.out["EXPIC1.VB"][0] == pytest.approx(vb, rel=1e-12)
+    assert ctx.out["EXPIC1.E0"][0] == pytest.approx(e0, rel=1e-12)
+    assert ctx.out["EXPIC1.VR"][0] == pytest.approx(e0 / vb, rel=1e-12)
+    assert _x(s, "EXPIC1", "PI") == pytest.approx(e0 / vb, rel=1e-12) and _x(s, "EXPIC1", "VF") == 0.0
+    assert c.vref0[0] == pytest.approx(sig["Ecomp0"][0], abs=1e-15)
+
+
+def test_expic1_regulator_gain():
+    """Exciter alone, the error stepped by dv: the PI output jumps by KA*TA1*dv and its integrator
+    moves at KA*dv; with the filters at rest on the new VA, VR = VA and E0 = VB*VR."""
+    prm = EXPIC1
+    s = _system("EXPIC1", prm)
+    c = s.components["EXPIC1"]
+    dv = 0.01
+    va = _x(s, "EXPIC1", "PI") + prm["KA"] * prm["TA1"] * dv
+    z = s.z0.copy()
+    for st in ("X1", "LL", "VF1"):
+        z[c.idx(st)] = va
+    ctx, _ = _exciter_alone(s, "EXPIC1", z, vs=dv)
+    assert ctx.out["EXPIC1.VA"][0] == pytest.approx(va, rel=1e-12)
+    assert ctx.f[c.idx("PI")][0] == pytest.approx(prm["KA"] * dv, rel=1e-12)
+    for st in ("X1", "LL", "VF1", "VF"):
+        assert abs(ctx.f[c.idx(st)][0]) < 1e-12, st
+    assert ctx.out["EXPIC1.VR"][0] == pytest.approx(va, rel=1e-12)
+    assert ctx.out["EXPIC1.E0"][0] == pytest.approx(va * ctx.out["EXPIC1.VB"][0], rel=1e-12)
+
+
+@pytest.mark.parametrize("event, side", [(Fault(1, 1.0, 1.15, xf=0.05), "upper"), (LoadStep(1, 1.0, dQ=-80.0), "lower")])
+def test_expic1_limits_are_reached_and_held(event, side):
+    """Upper (a close fault) and lower (a capacitive step): the PI output at VR1 / VR2 (at VR2 its
+    integrator too, held),
+    VR at VRMAX / VRMIN, the exciter input E0 at EFDMAX / EFDMIN."""
+    prm = dict(EXPIC1, VR1=3.0, VR2=0.5, VRMAX=2.5, VRMIN=0.6, EFDMAX=2.2, EFDMIN=0.8)
+    r = simulate(_system("EXPIC1", prm), 6.0, events=[event])
+    pick = (np.max, "VR1", "VRMAX", "EFDMAX") if side == "upper" else (np.min, "VR2", "VRMIN", "EFDMIN")
+    f, a, b, e = pick
+    assert f(r["G.avr.VA"]) == pytest.approx(prm[a], abs=1e-9)
+    if side == "lower":     # the integrator itself reaches VR2 and is held there
+        assert f(r["G.avr.PI"]) == pytest.approx(prm[a], abs=1e-9)
+    assert f(r["G.avr.VR"]) == pytest.approx(prm[b], abs=1e-9)
+    assert f(r["G.avr.E0"]) == pytest.approx(prm[e], abs=1e-9)
+    for k, lo, hi in (("PI", "VR2", "VR1"), ("VR", "VRMIN", "VRMAX"), ("E0", "EFDMIN", "EFDMAX")):
+        y = r[f"G.avr.{k}"]
+        assert y.min() >= prm[lo] - 1e-9 and y.max() <= prm[hi] + 1e-9, k
+
+
+@pytest.mark.parametrize("field, out", [("VR1", "PI"), ("VRMAX", "VR"), ("EFDMAX", "E0")])
+def test_expic1_operating_point_beyond_a_limit_is_refused(field, out):
+    s0 = _system("EXPIC1", EXPIC1)
+    _, ctx = s0.residual(0.0, s0.z0)
+    at = _x(s0, "EXPIC1", "PI") if out == "PI" else float(ctx.out[f"EXPIC1.{out}"][0])
+    with pytest.raises(DataError) as e:
+        _system("EXPIC1", dict(EXPIC1, **{field: at - 1e-3}))
+    assert "EXPIC1 'G.avr'" in str(e.value) and e.value.field == field
+    _system("EXPIC1", dict(EXPIC1, **{field: at + 1e-3}))
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        try:
+            _system("EXPIC1", dict(EXPIC1, **{field: at - 1e-3}), limits="warn")
+        except DataError as e2:
+            assert "initial point" in str(e2)
+    assert any(field in str(x.message) for x in w)
+
+
+@pytest.mark.parametrize("bad, field", [(dict(KF=0.05, TF1=0.0), "TF1"), (dict(TA2=0.0, TA4=0.0, TF2=0.0), "TA2"),
+                                        (dict(KA=0.0), "KA"), (dict(KP=1.0, KI=0.0, KC=5.0), "KP")])
+def test_expic1_bad_data_names_the_field(bad, field):
+    with pytest.raises(DataError) as e:
+        _system("EXPIC1", dict(EXPIC1, **bad))
     assert e.value.field == field

@@ -20,8 +20,10 @@ from .scrx import SCRX
 from .st6b import ST6B
 from .st8c import ST8C
 from .esac6a import ESAC6A
+from .exac2 import EXAC2
+from .expic1 import EXPIC1
 
 __all__ = ["EXDC2", "SEXS", "ESST3A", "EXST1", "IEEEX1", "IEEET1", "EXAC1", "ESDC2A", "IEEEVC",
            "ESST1A", "ESAC1A", "ESDC1A", "IEEET3"]
 __all__ += ["ESST4B", "EXAC4", "AC8B"]
-__all__ += ["SCRX", "ST6B", "ST8C", "ESAC6A"]
+__all__ += ["SCRX", "ST6B", "ST8C", "ESAC6A", "EXAC2", "EXPIC1"]
