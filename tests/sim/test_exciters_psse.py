@@ -897,3 +897,20 @@ def test_st8c_psid_benchmark_record(sw1, tmp_path):
         vt = s.sig_defaults["Vt0"][0]
         assert _x(s, "ST8C", "VR") == pytest.approx(xa3 * 4.0 / (4.0 * vt) * _fex(0.1 * xa4 / 0.5 / 4.0)
                                                     / _fex(0.1 * xa4 / 0.5 / (4.0 * vt)), rel=1e-9)
+
+
+@pytest.mark.parametrize("model, prm", [("ESAC6A", ESAC6A), ("EXAC2", EXAC2), ("EXPIC1", EXPIC1)])
+def test_record_layout_read_by_the_reader(model, prm, tmp_path):
+    """A record written in the declared PSS/E order, on PSID's three-bus SCRX case (its SCRX
+    record replaced): read by the native reader into these parameters, starting at rest."""
+    cls = _registry()[model]
+    rec = " ".join(repr(float(prm[k])) for k in cls.psse_record)
+    base = (DATA / "psse_exciters" / "ThreeBus_SCRX.dyr").read_text().splitlines()[:4]
+    edit = lambda _t: "\n".join(base) + f"\n    102 '{model}' 1  {rec} /\n"   # noqa: E731
+    system = _from_psid("SCRX", "ThreeBus_SCRX.dyr", tmp_path, edit=edit)
+    s = _system_setup(system)
+    c = s.components[model]
+    assert c.names == [f"{model}_102_1"]
+    assert {k: float(c.p[k][0]) for k in cls.psse_record} == {k: float(prm[k]) for k in cls.psse_record}
+    F, ctx = s.residual(0.0, s.z0)
+    assert np.max(np.abs(F)) < 1e-9
