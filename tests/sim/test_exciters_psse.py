@@ -685,7 +685,8 @@ def test_expic1_regulator_gain():
     assert ctx.out["EXPIC1.E0"][0] == pytest.approx(va * ctx.out["EXPIC1.VB"][0], rel=1e-12)
 
 
-@pytest.mark.parametrize("event, side", [(Fault(1, 1.0, 1.15, xf=0.05), "upper"), (LoadStep(1, 1.0, dQ=-80.0), "lower")])
+@pytest.mark.parametrize("event, side", [(Fault(1, 1.0, 1.15, xf=0.05), "upper"),
+                                         (LoadStep(1, 1.0, dQ=-80.0), "lower")])
 def test_expic1_limits_are_reached_and_held(event, side):
     """Upper (a close fault) and lower (a capacitive step): the PI output at VR1 / VR2 (at VR2 its
     integrator too, held),
