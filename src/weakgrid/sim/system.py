@@ -95,6 +95,7 @@ def _registry():
     from .governors import GAST, IEEEG1, IEESGO, TG2, TGOV1N
     from .pss import ST2CUT
     from .renewables import WTARA1, WTDTA1, WTPTA1, WTTQA1
+    from .exciters import ESAC6A, EXAC2, EXPIC1, SCRX, ST6B, ST8C
 
     return {c.__name__: c for c in (GENCLS, GENROU, GENSAL, GENSAE, GENROE, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
@@ -102,7 +103,8 @@ def _registry():
                                     IEEEG1, IEESGO, TG2, TGOV1N, GAST, ST2CUT)
             + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ESD1, ZIP)
             + (WTDTA1, WTARA1, WTPTA1, WTTQA1)    # after REECA1: the ANDES importer links in this order
-            + (InfiniteBus, PVSource)}
+            + (InfiniteBus, PVSource)
+            + (SCRX, ST6B, ST8C, ESAC6A, EXAC2, EXPIC1)}
 
 
 class System:

@@ -16,7 +16,14 @@ from .sexs import SEXS
 from .esst4b import ESST4B
 from .exac4 import EXAC4
 from .ac8b import AC8B
+from .scrx import SCRX
+from .st6b import ST6B
+from .st8c import ST8C
+from .esac6a import ESAC6A
+from .exac2 import EXAC2
+from .expic1 import EXPIC1
 
 __all__ = ["EXDC2", "SEXS", "ESST3A", "EXST1", "IEEEX1", "IEEET1", "EXAC1", "ESDC2A", "IEEEVC",
            "ESST1A", "ESAC1A", "ESDC1A", "IEEET3"]
 __all__ += ["ESST4B", "EXAC4", "AC8B"]
+__all__ += ["SCRX", "ST6B", "ST8C", "ESAC6A", "EXAC2", "EXPIC1"]

@@ -81,6 +81,7 @@ def _supported():
 #: reproduces ANDES}; applied by ``from_andes(..., conventions="andes")``.
 ANDES_CONVENTIONS = {
     "EXAC1": {"TR_used": 0.0},    # the summing junction takes the unfiltered voltage (TR unused)
+    "EXAC2": {"TR_used": 0.0},    # as its EXAC1
     "ESDC2A": {"TR_used": 0.0},   # idem
     "REGCA1": {"LVPL_strict": 0.0},  # LVPL resets S0 only while dS0/dt >= 0 (S0 may stay above it)
     "IEEEX1": {"VR_Vt": 0.0},     # regulator limits VRMAX, VRMIN, not times Vt

@@ -132,6 +132,22 @@ def fix_andes_esdc1a(ss):
         blk.upper, blk.lower = m.VRU, m.VRL
 
 
+def fix_andes_exac2(ss):
+    """Point ANDES 2.0's EXAC2 regulator lag at its own limits ``VAMAX``, ``VAMIN``.
+
+    ANDES's EXAC2 derives from its EXAC1 and sets ``LA.lower = VAMIN``, ``LA.upper = VAMAX``
+    after the anti-windup lag ``LA`` was built: the block's limiter keeps EXAC1's ``VRMIN``,
+    ``VRMAX`` (``ss.EXAC2.LA.lim.upper`` is ``VRMAX``), so its regulator is held at the exciter
+    limits instead of the regulator's. This re-points the limiter, i.e. the AC2 diagram. Use as
+    ``run_andes_ss(..., configure=...)`` (after ``ss.setup()``); a no-op without EXAC2 devices.
+    ANDES's code is not changed.
+    """
+    if "EXAC2" not in ss.models or ss.EXAC2.n == 0:
+        return
+    m = ss.EXAC2
+    m.LA.lim.upper, m.LA.lim.lower = m.VAMAX, m.VAMIN
+
+
 def run_andes_ss(ss, tf, h, tol=1e-8, hold_step=False, configure=None):
     """Set up, solve the power flow and simulate ``ss`` in ANDES at the fixed step ``h``.
 
