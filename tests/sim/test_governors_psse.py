@@ -217,3 +217,99 @@ def test_degov_against_psse(TD, csv, psid_tol):
     err = np.max(np.abs(w - ref[:, 1]))
     assert err < psid_tol * 1.02
     assert err < 0.052 * np.ptp(ref[:, 1])
+
+
+# ============================================================================== PIDGOV
+#: PIDGOV of PSID's ThreeBus_PIDGOV_*.dyr, as shipped (Flag 0 = PowerFlag, 1 = GateFlag)
+PIDGOV_PSID = dict(Flag=0, Rperm=0.05, Treg=0.01, Kp=5.0, Ki=1.0, Kd=0.1, Ta=0.5, Tb=0.99, Dturb=0.001,
+                   G0=0.1, G1=0.7, P1=0.3, G2=0.9, P2=0.5, P3=0.9, Gmax=1.0, Gmin=0.05, Atw=1.0,
+                   Tw=0.6, Velmax=0.04, Velmin=-0.04)
+#: the same with P3 = 1.1 at full gate, so that the 100-MW unit can start (gate 0.983)
+PIDGOV = dict(PIDGOV_PSID, P3=1.1)
+#: a loop that settles alone in the island (PSID's gains are for a unit on a stiff grid)
+PIDGOV_ISLAND = dict(PIDGOV, Dturb=0.0, Kp=1.0, Ki=0.3, Kd=0.2, Ta=0.1, Tb=0.2, Velmax=0.2, Velmin=-0.2)
+
+
+def test_pidgov_psid_case_cannot_start():
+    """ThreeBus_PIDGOV_*.dyr: 100 MW on 100 MVA needs gate 1.025 (P3 = 0.9 at full gate) > Gmax."""
+    with pytest.raises(DataError) as e:
+        threebus_system(("PIDGOV", PIDGOV_PSID)).setup()
+    assert e.value.field == "Gmax" and "1.025" in str(e.value)
+
+
+@pytest.mark.parametrize("flag", [0, 1])
+def test_pidgov_initial_point_is_an_equilibrium(flag):
+    s = threebus_system(("PIDGOV", dict(PIDGOV, Flag=flag))).setup()
+    worst, dw = at_rest(s)
+    assert worst < 1e-9 and dw < 1e-10
+    gov = s.components["PIDGOV"]
+    g = s.z0[gov.idx("GATE")][0]
+    assert g == pytest.approx(0.9 + (1.0 - 0.5) / (1.1 - 0.5) * 0.1, rel=1e-9)   # inverse of the table
+    res = simulate(s, 10.0, dt=1 / 120, events=[LineTrip(0, 1.0)])          # PSID case 58's event
+    assert res.ok and abs(res["G.omega"][-1] - 1) < 2e-5
+
+
+def test_pidgov_droop_on_power():
+    s = island_system(("PIDGOV", PIDGOV_ISLAND))
+    dP = 10.0
+    res = simulate(s, 60.0, dt=0.02, events=[LoadStep(2, 0.5, dP=dP)])
+    pe1 = island_pe(s, dP)
+    expected = -PIDGOV["Rperm"] * (pe1 - P0 / 100) * 100.0 / SN
+    assert res["G.omega"][-1] - 1 == pytest.approx(expected, rel=1e-5)
+
+
+def test_pidgov_droop_on_gate():
+    """Flag 1: omega_ss - 1 = -Rperm*(gate_ss - gate0), gate_ss the gate giving PMECH = te*omega."""
+    from weakgrid.sim.governors._gate import power_gate
+
+    s = island_system(("PIDGOV", dict(PIDGOV_ISLAND, Flag=1)))
+    res = simulate(s, 60.0, dt=0.02, events=[LoadStep(2, 0.5, dP=10.0)], tol=1e-11)
+    gov = s.components["PIDGOV"]
+    te1 = island_pe(s, 10.0) * 100.0 / SN
+    g0 = power_gate(gov, np.array([P0 / SN]))[0]
+    dw = 0.0
+    for _ in range(50):     # PMECH = te*omega in the steady state (tm = PMECH/omega)
+        dw = -PIDGOV["Rperm"] * (power_gate(gov, np.array([te1 * (1 + dw)]))[0] - g0)
+    assert abs(dw) > 5e-4
+    assert res["G.omega"][-1] - 1 == pytest.approx(dw, rel=1e-5)
+
+
+@pytest.mark.parametrize("dP, field", [(20.0, "Gmax"), (-30.0, "Gmin")])
+def test_pidgov_gate_limits(dP, field):
+    s0 = island_system(("PIDGOV", PIDGOV_ISLAND))
+    g0 = s0.z0[s0.components["PIDGOV"].idx("GATE")][0]
+    lim = dict(Gmax=g0 + 0.01, Gmin=g0 - 0.02)
+    s = island_system(("PIDGOV", dict(PIDGOV_ISLAND, **lim)))
+    res = simulate(s, 8.0, dt=0.01, events=[LoadStep(2, 0.5, dP=dP)])
+    gate = res["G.gov.GATE"]
+    assert np.max(gate) <= lim["Gmax"] + 1e-9 and np.min(gate) >= lim["Gmin"] - 1e-9
+    assert gate[-1] == pytest.approx(lim[field], abs=1e-9)
+
+
+@pytest.mark.parametrize("dP, field", [(30.0, "Velmax"), (-30.0, "Velmin")])
+def test_pidgov_gate_velocity_limits(dP, field):
+    """The gate moves at exactly Velmax / Velmin while the servo demand is beyond them."""
+    vel = dict(Velmax=0.01, Velmin=-0.01)
+    s = island_system(("PIDGOV", dict(PIDGOV_ISLAND, **vel)))
+    dt = 0.01
+    res = simulate(s, 3.0, dt=dt, events=[LoadStep(2, 0.5, dP=dP)], tol=1e-11)
+    dt_ = np.diff(res.t)
+    rate = np.diff(res["G.gov.GATE"])[dt_ > 0] / dt_[dt_ > 0]      # (an event records t twice)
+    assert np.max(rate) <= vel["Velmax"] + 1e-8 and np.min(rate) >= vel["Velmin"] - 1e-8
+    assert np.sum(np.abs(rate - vel[field]) < 1e-8) > 100            # held over 1 s and more
+
+
+@pytest.mark.parametrize("params, field", [
+    (dict(PIDGOV, Gmax=0.5, Gmin=0.6), "Gmax"),
+    (dict(PIDGOV, Velmax=-0.1), "Velmax"),
+    (dict(PIDGOV, G1=0.05), "G1"),
+    (dict(PIDGOV, P2=0.2), "P2"),
+    (dict(PIDGOV, G2=1.0), "G2"),
+    (dict(PIDGOV, Tb=0.0), "Tb"),
+    (dict(PIDGOV, Flag=2), "Flag"),
+    (dict(PIDGOV, Gmin=0.95), "Gmin"),          # the initial gate 0.917 (60 MW) below Gmin
+])
+def test_pidgov_bad_data(params, field):
+    with pytest.raises(DataError) as e:
+        island_system(("PIDGOV", params))
+    assert e.value.field == field

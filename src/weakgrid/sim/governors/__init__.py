@@ -9,7 +9,9 @@ from .tgov1n import TGOV1N
 from .gast import GAST
 from .degov1 import DEGOV1
 from .degov import DEGOV
+from .pidgov import PIDGOV
 
 __all__ = ["TGOV1", "TGOV1N", "HYGOV", "IEEEG1", "IEESGO", "TG2"]
 __all__ += ["GAST"]
 __all__ += ["DEGOV1", "DEGOV"]
+__all__ += ["PIDGOV"]
