@@ -313,3 +313,85 @@ def test_pidgov_bad_data(params, field):
     with pytest.raises(DataError) as e:
         island_system(("PIDGOV", params))
     assert e.value.field == field
+
+
+# ============================================================================== WPIDHY
+#: WPIDHY of PSID's ThreeBus_WPIDHY.dyr (100 MW needs the full gate, GATMX = 1)
+WPIDHY = dict(TREG=0.01, REG=-0.05, KP=3.0, KI=0.5, KD=3.0, TA=0.02, TB=0.01, VELMX=0.025, VELMN=-0.025,
+              GATMX=1.0, GATMN=0.2, TW=3.25, PMAX=52001., PMIN=0.0, D=0.0, G0=0.12, G1=0.545, P1=0.4,
+              G2=0.827, P2=0.83, P3=1.0)
+#: gains that settle alone in the island (KD is the speed-to-gate gain, see the model)
+WPIDHY_ISLAND = dict(WPIDHY, KD=2.0, KP=0.5, KI=0.05, TW=1.0, VELMX=0.2, VELMN=-0.2)
+
+
+def test_wpidhy_initial_point_is_an_equilibrium():
+    s = threebus_system(("WPIDHY", WPIDHY)).setup()
+    worst, dw = at_rest(s)
+    assert worst < 1e-9 and dw < 1e-10
+    assert s.z0[s.components["WPIDHY"].idx("GATE")][0] == pytest.approx(1.0, abs=1e-12)
+    res = simulate(s, 10.0, dt=1 / 120, events=[LineTrip(0, 1.0)])          # PSID case 60's event
+    assert res.ok and np.max(res["G.gov.GATE"]) <= 1.0 + 1e-9
+
+
+def test_wpidhy_droop():
+    """omega_ss - 1 = REG*(Pe_ss - Pe0) on the machine base (REG < 0)."""
+    s = island_system(("WPIDHY", WPIDHY_ISLAND))
+    res = simulate(s, 250.0, dt=0.1, events=[LoadStep(2, 0.5, dP=10.0)], tol=1e-11)
+    expected = WPIDHY["REG"] * (island_pe(s, 10.0) - P0 / 100) * 100.0 / SN
+    assert abs(expected) > 3e-3
+    assert res["G.omega"][-1] - 1 == pytest.approx(expected, rel=1e-5)
+
+
+def _wpidhy_gate0():
+    s = island_system(("WPIDHY", WPIDHY_ISLAND))
+    return s.z0[s.components["WPIDHY"].idx("GATE")][0]
+
+
+@pytest.mark.parametrize("dP, field", [(20.0, "GATMX"), (-30.0, "GATMN")])
+def test_wpidhy_gate_limits(dP, field):
+    g0 = _wpidhy_gate0()
+    lim = dict(GATMX=g0 + 0.01, GATMN=g0 - 0.02)
+    s = island_system(("WPIDHY", dict(WPIDHY_ISLAND, **lim)))
+    res = simulate(s, 10.0, dt=0.01, events=[LoadStep(2, 0.5, dP=dP)])
+    gate = res["G.gov.GATE"]
+    assert np.max(gate) <= lim["GATMX"] + 1e-9 and np.min(gate) >= lim["GATMN"] - 1e-9
+    assert gate[-1] == pytest.approx(lim[field], abs=1e-9)
+
+
+@pytest.mark.parametrize("dP, field", [(30.0, "VELMX"), (-30.0, "VELMN")])
+def test_wpidhy_gate_velocity_limits(dP, field):
+    vel = dict(VELMX=0.01, VELMN=-0.01)
+    s = island_system(("WPIDHY", dict(WPIDHY_ISLAND, **vel)))
+    res = simulate(s, 3.0, dt=0.01, events=[LoadStep(2, 0.5, dP=dP)], tol=1e-11)
+    dt_ = np.diff(res.t)
+    rate = np.diff(res["G.gov.GATE"])[dt_ > 0] / dt_[dt_ > 0]
+    assert np.max(rate) <= vel["VELMX"] + 1e-8 and np.min(rate) >= vel["VELMN"] - 1e-8
+    assert np.sum(np.abs(rate - vel[field]) < 1e-8) > 100
+
+
+@pytest.mark.parametrize("dP, field", [(20.0, "PMAX"), (-30.0, "PMIN")])
+def test_wpidhy_power_limits(dP, field):
+    """The turbine power is clipped at PMAX / PMIN (a static limit after the water column)."""
+    lim = dict(PMAX=P0 / SN + 0.02, PMIN=P0 / SN - 0.03)
+    s = island_system(("WPIDHY", dict(WPIDHY_ISLAND, **lim)))
+    res = simulate(s, 10.0, dt=0.01, events=[LoadStep(2, 0.5, dP=dP)])
+    pm = res["G.gov.PMECH"]
+    assert np.max(pm) <= lim["PMAX"] + 1e-12 and np.min(pm) >= lim["PMIN"] - 1e-12
+    assert pm[-1] == pytest.approx(lim[field], abs=1e-12)
+    assert res["G.tm"][-1] == pytest.approx(lim[field] / res["G.omega"][-1] * SN / 100, rel=1e-12)
+
+
+@pytest.mark.parametrize("params, field", [
+    (dict(WPIDHY, TA=0.0), "KD"),
+    (dict(WPIDHY, GATMX=0.1), "GATMX"),
+    (dict(WPIDHY, VELMN=0.1), "VELMX"),
+    (dict(WPIDHY, P1=0.9), "P2"),
+    (dict(WPIDHY, G0=0.6), "G1"),
+    (dict(WPIDHY, PMAX=0.5), "PMAX"),            # tm0 = 0.6 pu beyond PMAX, at setup
+    (dict(WPIDHY, GATMN=0.95), "GATMN"),
+    (dict(WPIDHY, KI=0.0), "KI"),
+])
+def test_wpidhy_bad_data(params, field):
+    with pytest.raises(DataError) as e:
+        island_system(("WPIDHY", params))
+    assert e.value.field == field
