@@ -395,3 +395,166 @@ def test_wpidhy_bad_data(params, field):
     with pytest.raises(DataError) as e:
         island_system(("WPIDHY", params))
     assert e.value.field == field
+
+
+# =============================================================================== GGOV1
+#: typical GGOV1 data (WECC / PSS/E example values; Ldref raised so that the 100-MW unit of the
+#: three-bus case starts below its load limit: fsr0 = 1/1.5 + 0.2 = 0.867 < TLIM = 0.933)
+GGOV1 = dict(Rselect=1, Flag=1, R=0.04, Tpelec=1.0, maxerr=0.05, minerr=-0.05, Kpgov=10.0, Kigov=2.0,
+             Kdgov=0.0, Tdgov=1.0, Vmax=1.0, Vmin=0.15, Tact=0.5, Kturb=1.5, Wfnl=0.2, Tb=0.1, Tc=0.0,
+             Teng=0.0, Tfload=3.0, Kpload=2.0, Kiload=0.67, Ldref=1.1, Dm=0.0, Ropen=0.1, Rclose=-0.1,
+             Kimw=0.0, Aset=0.01, Ka=10.0, Ta=0.1, Trate=0.0, db=0.0, Tsa=4.0, Tsb=5.0, Rup=99.0,
+             Rdown=-99.0)
+
+
+@pytest.mark.parametrize("params", [
+    GGOV1, dict(GGOV1, Rselect=0, R=0.0), dict(GGOV1, Rselect=-1), dict(GGOV1, Rselect=-2),
+    dict(GGOV1, Flag=0, Dm=0.05, Teng=0.1, Tc=0.05, Kdgov=0.5, db=0.001, Kimw=0.01, Trate=120.0)],
+    ids=["Pe", "isochronous", "governor-output", "valve-stroke", "Flag0-Dm-Teng-Tc-Kd-db-Kimw-Trate"])
+def test_ggov1_initial_point_is_an_equilibrium(params):
+    s = threebus_system(("GGOV1", params)).setup()
+    worst, dw = at_rest(s)
+    assert worst < 1e-9 and dw < 1e-10
+    res = simulate(s, 10.0, dt=1 / 120, events=[LineTrip(0, 1.0)])
+    assert res.ok and abs(res["G.omega"][-1] - 1) < 1e-4
+
+
+def _ggov1_valve(gov, te, dw, i=0):
+    """Valve stroke giving PMECH = te*omega in the steady state (tm = PMECH/omega)."""
+    p = {k: v[i] for k, v in gov.p.items()}
+    w = 1 + dw
+    wf = (te * w + p["Dm"] * w) / p["Kturb"] + p["Wfnl"]
+    return wf / (w if p["Flag"] > 0 else 1.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("rselect", [1, -1, -2, 0])
+def test_ggov1_droop(rselect):
+    """Rselect 1: dw = -R*dPe; -1 / -2: dw = -R*dFSR = -R*dVAL (the steady valve is the one whose
+    power balances the new load, solved by fixed point); 0: isochronous (dw = 0)."""
+    params = dict(GGOV1, Rselect=rselect, Trate=80.0)
+    s = island_system(("GGOV1", params))
+    res = simulate(s, 60.0, dt=0.02, events=[LoadStep(2, 0.5, dP=10.0)], tol=1e-11)
+    gov = s.components["GGOV1"]
+    kT = 80.0 / 100.0
+    te0, te1 = P0 / 100 / kT, island_pe(s, 10.0) / kT             # turbine base (lossless: te = Pe)
+    R = params["R"]
+    if rselect == 1:
+        dw = -R * (te1 - te0)
+    elif rselect == 0:
+        dw = 0.0
+    else:
+        dw = 0.0
+        for _ in range(50):
+            dw = -R * (_ggov1_valve(gov, te1, dw) - _ggov1_valve(gov, te0, 0.0))
+    assert res["G.omega"][-1] - 1 == pytest.approx(dw, rel=1e-5, abs=1e-8)     # (1e-9 after 120 s)
+    assert res["G.gov.FSR"][-1] == pytest.approx(_ggov1_valve(gov, te1, dw), rel=1e-7)
+
+
+@pytest.mark.slow
+def test_ggov1_supervisory_controller_held_at_its_limit():
+    """Kimw > 0 in an island: Pe cannot return to Pmwset, the load controller integrates to
+    -1.1*R and is held there; the speed settles at -R*dPe - 1.1*R."""
+    params = dict(GGOV1, Kimw=0.2)
+    s = island_system(("GGOV1", params))
+    res = simulate(s, 60.0, dt=0.05, events=[LoadStep(2, 0.5, dP=10.0)], tol=1e-11)
+    R = params["R"]
+    assert res["G.gov.PMW"][-1] == pytest.approx(-1.1 * R, abs=1e-12)
+    assert np.min(res["G.gov.PMW"]) >= -1.1 * R - 1e-12
+    expected = -R * (island_pe(s, 10.0) - P0 / 100) - 1.1 * R
+    assert res["G.omega"][-1] - 1 == pytest.approx(expected, rel=1e-6)
+
+
+@pytest.mark.slow
+def test_ggov1_load_limiter_takes_control():
+    """A load limit just above the initial exhaust temperature: after the load step the load
+    limiter is the low value, and its integral brings the temperature exactly to TLIM."""
+    fsr0 = 0.6 / 1.5 + 0.2
+    Ldref = (fsr0 + 0.02 - 0.2) * 1.5                 # TLIM = fsr0 + 0.02
+    s = island_system(("GGOV1", dict(GGOV1, Ldref=Ldref)))
+    res = simulate(s, 80.0, dt=0.05, events=[LoadStep(2, 0.5, dP=10.0)], tol=1e-11)
+    fsr, fsrt, fsrn = res["G.gov.FSR"], res["G.gov.FSRT"], res["G.gov.FSRN"]
+    assert fsr[-1] == pytest.approx(fsrt[-1], abs=1e-9)
+    assert res["G.gov.ERR"][-1] > 0.01 and fsrn[-1] > fsr[-1]   # the governor asks for more fuel
+    assert res["G.gov.TEXM"][-1] == pytest.approx(fsr0 + 0.02, abs=1e-8)
+    assert np.max(fsrn - fsr) < 0.5                   # the governor PID did not wind up
+
+
+@pytest.mark.parametrize("dP, field", [(40.0, "Vmax"), (-45.0, "Vmin")])
+def test_ggov1_valve_limits(dP, field):
+    fsr0 = 0.6 / 1.5 + 0.2
+    lim = dict(Vmax=fsr0 + 0.03, Vmin=fsr0 - 0.03, Ropen=1.0, Rclose=-1.0)
+    s = island_system(("GGOV1", dict(GGOV1, **lim)))
+    res = simulate(s, 10.0, dt=0.01, events=[LoadStep(2, 0.5, dP=dP)])
+    val = res["G.gov.VAL"]
+    assert np.max(val) <= lim["Vmax"] + 1e-9 and np.min(val) >= lim["Vmin"] - 1e-9
+    assert val[-1] == pytest.approx(lim[field], abs=1e-9)
+    assert res["G.gov.FSR"][-1] == pytest.approx(lim[field], abs=1e-9)
+
+
+@pytest.mark.parametrize("dP, field", [(30.0, "Ropen"), (-30.0, "Rclose")])
+def test_ggov1_valve_rate_limits(dP, field):
+    rates = dict(Ropen=0.02, Rclose=-0.02)
+    s = island_system(("GGOV1", dict(GGOV1, Aset=1.0, **rates)))
+    res = simulate(s, 3.0, dt=0.01, events=[LoadStep(2, 0.5, dP=dP)], tol=1e-11)
+    dt_ = np.diff(res.t)
+    rate = np.diff(res["G.gov.VAL"])[dt_ > 0] / dt_[dt_ > 0]
+    assert np.max(rate) <= rates["Ropen"] + 1e-8 and np.min(rate) >= rates["Rclose"] - 1e-8
+    assert np.sum(np.abs(rate - rates[field]) < 1e-8) > 100
+
+
+@pytest.mark.parametrize("dP, field", [(30.0, "maxerr"), (-30.0, "minerr")])
+def test_ggov1_error_limits(dP, field):
+    lim = dict(maxerr=0.002, minerr=-0.002)
+    s = island_system(("GGOV1", dict(GGOV1, Aset=1.0, **lim)))
+    res = simulate(s, 5.0, dt=0.01, events=[LoadStep(2, 0.5, dP=dP)])
+    err = res["G.gov.ERR"]
+    assert np.max(err) <= lim["maxerr"] + 1e-15 and np.min(err) >= lim["minerr"] - 1e-15
+    assert np.sum(np.abs(err - lim[field]) < 1e-15) > 50
+
+
+def test_ggov1_acceleration_limiter():
+    """Load rejection: the speed rises faster than Aset, the acceleration limiter takes the low
+    value and the fuel demand falls at exactly Ka*(Aset - accel)."""
+    params = dict(GGOV1, Aset=0.001, Ka=5.0, Rclose=-5.0, Ropen=5.0, Tact=0.05)
+    s = island_system(("GGOV1", params), M=4.0)
+    res = simulate(s, 3.0, dt=0.005, events=[LoadStep(2, 0.5, dP=-30.0)], tol=1e-11)
+    t, fsr, fsra, acc = res.t, res["G.gov.FSR"], res["G.gov.FSRA"], res["G.gov.ACC"]
+    sel = (np.abs(fsr - fsra) < 1e-12) & (res["G.gov.FSRN"] > fsr + 1e-6)
+    assert np.sum(sel) > 20                                    # the limiter was in control
+    ok = sel[:-1] & sel[1:] & (np.diff(t) > 0)
+    dfsr = np.diff(fsr)[ok] / np.diff(t)[ok]
+    target = params["Ka"] * (params["Aset"] - 0.5 * (acc[:-1] + acc[1:])[ok])
+    assert np.max(np.abs(dfsr - target)) < 1e-6
+
+
+def test_ggov1_engine_delay():
+    """Tc = Tb = 0: PMECH is Kturb*(wf - Wfnl) Teng seconds earlier, minus Dm*(1 + dw)."""
+    Teng = 0.25
+    params = dict(GGOV1, Teng=Teng, Tb=0.0, Dm=0.02)
+    s = island_system(("GGOV1", params))
+    res = simulate(s, 6.0, dt=0.01, events=[LoadStep(2, 0.5, dP=10.0)])
+    t, val, w, pm = res.t, res["G.gov.VAL"], res["G.omega"], res["G.gov.PMECH"]
+    ut = params["Kturb"] * (val * w - params["Wfnl"])
+    late = t > Teng
+    expect = np.interp(t[late] - Teng, t, ut) - params["Dm"] * w[late]
+    assert np.ptp(val) > 0.02
+    assert np.max(np.abs(pm[late] - expect)) < 1e-10
+
+
+@pytest.mark.parametrize("params, field", [
+    (dict(GGOV1, Rselect=2), "Rselect"),
+    (dict(GGOV1, Dm=-0.1), "Dm"),
+    (dict(GGOV1, Vmax=0.1), "Vmax"),
+    (dict(GGOV1, maxerr=-0.1), "maxerr"),
+    (dict(GGOV1, Tc=0.1, Tb=0.0), "Tc"),
+    (dict(GGOV1, Kdgov=1.0, Tdgov=0.0), "Kdgov"),
+    (dict(GGOV1, Tact=0.0), "Tact"),
+    (dict(GGOV1, Ldref=0.5), "Ldref"),          # fsr0 = 0.6 above TLIM = 0.533: load limiter in control
+    (dict(GGOV1, Vmax=0.55, Vmin=0.15), "Vmax"),   # fsr0 = 0.6 beyond Vmax, at setup
+    (dict(GGOV1, Flag=0.5), "Flag"),
+])
+def test_ggov1_bad_data(params, field):
+    with pytest.raises(DataError) as e:
+        island_system(("GGOV1", params))
+    assert e.value.field == field

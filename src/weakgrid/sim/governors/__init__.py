@@ -11,9 +11,11 @@ from .degov1 import DEGOV1
 from .degov import DEGOV
 from .pidgov import PIDGOV
 from .wpidhy import WPIDHY
+from .ggov1 import GGOV1
 
 __all__ = ["TGOV1", "TGOV1N", "HYGOV", "IEEEG1", "IEESGO", "TG2"]
 __all__ += ["GAST"]
 __all__ += ["DEGOV1", "DEGOV"]
 __all__ += ["PIDGOV"]
 __all__ += ["WPIDHY"]
+__all__ += ["GGOV1"]
