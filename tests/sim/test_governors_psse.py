@@ -121,6 +121,51 @@ def test_degov_initial_point_is_an_equilibrium(gov):
     assert worst < 1e-9 and dw < 1e-10
 
 
+#: GENROU of PSID's ThreeBus_DEGOV1_*.dyr (H = 6.175, D = 0.05, S(1.0) = 0.1, S(1.2) = 0.8)
+GENROU_DEGOV1 = dict(GENROU, S10=0.1, S12=0.8)
+#: small-signal eigenvalues of PSID's test_case63 (ThreeBus_DEGOV1_nodelay_flag0/1.dyr: GENROU +
+#: DEGOV1 at bus 102, no exciter) as PowerSimulationsDynamics.jl computes them
+#: (test/results/results_eigenvalues.jl, BSD-3-Clause, (c) Alliance for Sustainable Energy)
+PSID_DEGOV1_EIGS = {
+    0: [-39.22517856531171 - 0.23706643304840616j, -39.22517856531171 + 0.23706643304840616j,
+        -13.403547886572664, -8.122746726423252, -5.391500486820183 - 2.241842433737118j,
+        -5.391500486820183 + 2.241842433737118j, -0.6466138560537371 - 8.624155441599354j,
+        -0.6466138560537371 + 8.624155441599354j, -0.20824914641735212, -0.05243031034640425],
+    1: [-39.224926800052884 - 0.23735163098908485j, -39.224926800052884 + 0.23735163098908485j,
+        -19.85028250949885, -13.323569303234533, -7.521736802553002,
+        -5.905690613400367 - 2.3710175079240416j, -5.905690613400367 + 2.3710175079240416j,
+        -0.5479840603712405 - 8.276315089713018j, -0.5479840603712405 + 8.276315089713018j,
+        -0.2082414387220071, -0.05252688447358956],
+}
+
+
+def state_matrix_eigs(s, h=1e-7):
+    """Eigenvalues of the reduced state matrix at the initial point (finite differences of the
+    DAE residual; the structurally zero ones of unused states dropped)."""
+    z0, nx = s.z0.copy(), s.nx
+    F0, _ = s.residual(0.0, z0)
+    J = np.zeros((len(z0), len(z0)))
+    for j in range(len(z0)):
+        z = z0.copy()
+        z[j] += h
+        J[:, j] = (s.residual(0.0, z)[0] - F0) / h
+    A = J[:nx, :nx] - J[:nx, nx:] @ np.linalg.solve(J[nx:, nx:], J[nx:, :nx])
+    ev = np.linalg.eigvals(A)
+    return np.sort_complex(ev[np.abs(ev) > 1e-6])
+
+
+@pytest.mark.parametrize("M", [0, 1])
+def test_degov1_eigenvalues_as_psid(M, monkeypatch):
+    """PSID case 63 (GENROU + DEGOV1, throttle or electrical-power droop): the small-signal
+    eigenvalues of the initial point equal PSID's (within PSID's own test tolerance, 1e-3 on
+    the norm; measured 4-5e-4) -- the governor's structure and its TE lag on Pe included."""
+    monkeypatch.setitem(globals(), "GENROU", GENROU_DEGOV1)
+    s = threebus_system(("DEGOV1", dict(DEGOV1, M=M)), sexs=False).setup()
+    ev = state_matrix_eigs(s)
+    ref = np.sort_complex(np.array(PSID_DEGOV1_EIGS[M], dtype=complex))
+    assert len(ev) == len(ref)
+    assert np.linalg.norm(ev - ref) < 1e-3
+
 @pytest.mark.parametrize("M", [0, 1])
 def test_degov1_droop(M):
     """Throttle (M = 0) or electrical-power (M = 1) droop: omega_ss - 1 = -DROOP * dP (machine base)."""
