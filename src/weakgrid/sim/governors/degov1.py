@@ -33,6 +33,9 @@ Initialized at rest at the machine's initial torque ``tm0``: ``THR = THRD = tm0`
 base), the filters at their steady inputs, ``pref = DROOP*fb0`` (``fb0 = tm0`` with M = 0,
 ``Pe0`` with M = 1). A ``tm0`` beyond ``TMAX`` / ``TMIN`` is refused at setup naming the limit.
 
+Small-signal check: on PSID's case 63 (GENROU + DEGOV1, M = 0 and 1) the eigenvalues of the
+initial point equal PowerSimulationsDynamics.jl's within 5.1e-4 (norm 7.3e-4).
+
 PSS/E record: ICON ``M``; CONs ``T1 T2 T3 K T4 T5 T6 TD TMAX TMIN DROOP TE``.
 """
 
