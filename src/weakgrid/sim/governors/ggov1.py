@@ -232,7 +232,8 @@ class GGOV1(MachineControl):
         fsr = np.clip(np.minimum(fsrn, other), p["Vmin"], p["Vmax"])
         if self._any_loop:
             F = fsr
-            slope = 1.0 + (p["Kpgov"] + np.where(p["Tdgov"] > 0, p["Kdgov"] / np.where(p["Tdgov"] > 0, p["Tdgov"], 1.0), 0.0)) * p["R"]
+            kd = np.where(p["Tdgov"] > 0, p["Kdgov"], 0.0) / np.where(p["Tdgov"] > 0, p["Tdgov"], 1.0)
+            slope = 1.0 + (p["Kpgov"] + kd) * p["R"]          # dh/dF with the governor in control
             for _ in range(30):
                 fbF = np.where(self._loop, F, fb)
                 e, fsrn = self._fsrn(fbF, pmw, gi, gd, dw)
