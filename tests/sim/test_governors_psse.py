@@ -222,6 +222,18 @@ def test_degov_delay_is_exact():
     assert np.max(np.abs(res["G.tm"] - thrd * SN / 100.0)) < 1e-12
 
 
+
+def test_degov_delay_shorter_than_the_step():
+    """TD < dt: the delayed point lies inside the step, interpolated between the last accepted
+    point and the current state (which the Jacobian then sees); still THR(t - TD) exactly."""
+    TD, dt = 0.004, 0.01
+    s = island_system(("DEGOV1", dict(DEGOV1, K=5.0, TD=TD)), M=20.0)
+    res = simulate(s, 4.0, dt=dt, events=[LoadStep(2, 0.5, dP=10.0)])
+    t, thr, thrd = res.t, res["G.gov.THR"], res["G.gov.THRD"]
+    late = t > TD
+    assert np.max(np.abs(thrd[late] - np.interp(t[late] - TD, t, thr))) < 1e-12
+    assert np.max(np.abs(thrd - thr)) > 1e-5                     # it is delayed
+
 @pytest.mark.parametrize("model, params, field", [
     ("DEGOV1", dict(DEGOV1, TMAX=0.5, TMIN=0.6), "TMAX"),
     ("DEGOV1", dict(DEGOV1, T1=0.0, T2=0.0, T3=0.1), "T3"),
