@@ -662,3 +662,29 @@ def test_ggov1_record_layout():
     assert len(cls.psse_record) == 35 and cls.psse_record[:2] == ("Rselect", "Flag")
     assert cls.psse_record[-2:] == ("Rup", "Rdown") and cls.psse_record[29] == "Trate"
     assert set(cls.psse_record) == {p.name for p in cls.params} - {"Ttrack"}
+
+
+#: a GGOV1 record of ACTIVSg2000_dynamics.dyr (bus 1050; Texas A&M synthetic grid ACTIVSg2000,
+#: CC BY 4.0, as shipped in NREL-Sienna/PowerSystemsTestData psse_dyr/): a 107.28-MW turbine
+ACTIVSG2000_GGOV1 = ("1  1  0.04  1  0.05  -0.05  21.071  0.0553  0  1  1  0.15  0.2767  1.5  0.2  0.5  "
+                     "0  0  3  2  1  1  0  1  -1  0  0.01  10  0.1  107.28  0  4  5  99  -99  /")
+
+
+def test_ggov1_activsg2000_record():
+    """One of ACTIVSg2000's 367 GGOV1 records (all Rselect = 1, Flag = 1, Dm = 0, with a turbine
+    rating Trate) read through psse_record: at rest on the turbine base, then the line trip of
+    PSID's benchmark; the speed settles on the infinite bus."""
+    from weakgrid.sim.governors import GGOV1 as cls
+
+    fields = [float(v) for v in ACTIVSG2000_GGOV1.split("/")[0].split()]
+    params = cls.psse_params(dict(zip(cls.psse_record, fields)), None)
+    assert params["Trate"] == 107.28 and params["Kpgov"] == 21.071
+    s = threebus_system(("GGOV1", params)).setup()
+    worst, dw = at_rest(s)
+    assert worst < 1e-9 and dw < 1e-10
+    gov = s.components["GGOV1"]
+    fsr0 = (100.0 / 107.28) / 1.5 + 0.2                     # PMECH0 = 100 MW on the 107.28-MW base
+    assert s.z0[gov.idx("VAL")][0] == pytest.approx(fsr0, rel=1e-9)
+    res = simulate(s, 20.0, dt=1 / 120, events=[LineTrip(0, 1.0)])
+    assert res.ok and abs(res["G.omega"][-1] - 1) < 1e-5
+    assert np.max(res["G.gov.VAL"]) <= 1.0 + 1e-12
