@@ -41,25 +41,27 @@ GENROU = dict(Sn=100, M=12.35, D=0.05, ra=0.0, xd=1.8, xq=1.7, xd1=0.3, xq1=0.55
               xl=0.2, Td10=8.0, Td20=0.03, Tq10=0.4, Tq20=0.05, S10=0.0, S12=1.0)
 
 
-def threebus():
+def threebus(p102=100.0, load=250.0):
     """PSID's PSS/E benchmark network ThreeBusMulti.raw (v33) in MATPOWER form: infinite bus 101,
-    the studied unit at 102 (100 MW), 250 + j30 MVA of load at 103, three equal lines."""
+    the studied unit at 102, a load at 103, three equal lines. The DEGOV/DEGOV1 cases: 100 MW at
+    102, 250 + j30 MVA of load; the PIDGOV/WPIDHY cases: 70 MW, 200 + j30 MVA."""
     bus = np.array([
         [101, 3, 0, 0, 0, 0, 1, 1.05, 0, 138, 1, 1.1, 0.9],
         [102, 2, 0, 0, 0, 0, 1, 1.02, -0.944, 138, 1, 1.1, 0.9],
-        [103, 1, 250, 30, 0, 0, 1, 0.99341, -8.7697, 138, 1, 1.1, 0.9]], float)
+        [103, 1, load, 30, 0, 0, 1, 0.99341, -8.7697, 138, 1, 1.1, 0.9]], float)
     gen = np.array([
-        [101, 153.335, 73.271, 100, -100, 1.05, 100, 1, 318, 0] + [0] * 11,
-        [102, 100.0, -3.247, 100, -100, 1.02, 100, 1, 318, 0] + [0] * 11], float)
+        [101, load - p102 + 3.335, 73.271, 100, -100, 1.05, 100, 1, 318, 0] + [0] * 11,
+        [102, p102, -3.247, 100, -100, 1.02, 100, 1, 318, 0] + [0] * 11], float)
     br = np.array([[101, 102, 0.01, 0.12, 0, 250, 250, 250, 0, 0, 1, -360, 360],
                    [101, 103, 0.01, 0.12, 0, 250, 250, 250, 0, 0, 1, -360, 360],
                    [102, 103, 0.01, 0.12, 0, 250, 250, 250, 0, 0, 1, -360, 360]], float)
     return {"baseMVA": 100.0, "bus": bus, "gen": gen, "branch": br}
 
 
-def threebus_system(governor, machine="GENROU", sexs=True):
-    """The three-bus case with ``governor = (model, params)`` on the unit at bus 102."""
-    s = System(threebus())
+def threebus_system(governor, machine="GENROU", sexs=True, hydro=False):
+    """The three-bus case with ``governor = (model, params)`` on the unit at bus 102 (``hydro``:
+    the 70-MW dispatch of PSID's PIDGOV/WPIDHY cases)."""
+    s = System(threebus(70.0, 200.0) if hydro else threebus())
     if machine == "GENROU":
         s.add_machine("GENROU", "G", gen=1, **GENROU)
         if sexs:   # SEXS of the PIDGOV/WPIDHY cases
@@ -288,23 +290,23 @@ PIDGOV = dict(PIDGOV_PSID, P3=1.1)
 PIDGOV_ISLAND = dict(PIDGOV, Dturb=0.0, Kp=1.0, Ki=0.3, Kd=0.2, Ta=0.1, Tb=0.2, Velmax=0.2, Velmin=-0.2)
 
 
-def test_pidgov_psid_case_cannot_start():
-    """ThreeBus_PIDGOV_*.dyr: 100 MW on 100 MVA needs gate 1.025 (P3 = 0.9 at full gate) > Gmax."""
+@pytest.mark.parametrize("flag", [0, 1])
+def test_pidgov_initial_point_is_an_equilibrium(flag):
+    """PSID's ThreeBus_PIDGOV_PowerFlag / _GateFlag cases (70 MW): at rest at PSID's initial gate
+    0.95 (the inverse of the gate table at 0.7 pu), then the line trip of PSID's case 58."""
+    s = threebus_system(("PIDGOV", dict(PIDGOV_PSID, Flag=flag)), hydro=True).setup()
+    worst, dw = at_rest(s)
+    assert worst < 1e-9 and dw < 1e-10
+    assert s.z0[s.components["PIDGOV"].idx("GATE")][0] == pytest.approx(0.95, rel=1e-12)
+    res = simulate(s, 10.0, dt=1 / 120, events=[LineTrip(0, 1.0)])
+    assert res.ok and abs(res["G.omega"][-1] - 1) < 2e-5
+
+
+def test_pidgov_beyond_full_gate_refused():
+    """100 MW with PSID's table (P3 = 0.9 at full gate) needs gate 1.025 > Gmax = 1: refused."""
     with pytest.raises(DataError) as e:
         threebus_system(("PIDGOV", PIDGOV_PSID)).setup()
     assert e.value.field == "Gmax" and "1.025" in str(e.value)
-
-
-@pytest.mark.parametrize("flag", [0, 1])
-def test_pidgov_initial_point_is_an_equilibrium(flag):
-    s = threebus_system(("PIDGOV", dict(PIDGOV, Flag=flag))).setup()
-    worst, dw = at_rest(s)
-    assert worst < 1e-9 and dw < 1e-10
-    gov = s.components["PIDGOV"]
-    g = s.z0[gov.idx("GATE")][0]
-    assert g == pytest.approx(0.9 + (1.0 - 0.5) / (1.1 - 0.5) * 0.1, rel=1e-9)   # inverse of the table
-    res = simulate(s, 10.0, dt=1 / 120, events=[LineTrip(0, 1.0)])          # PSID case 58's event
-    assert res.ok and abs(res["G.omega"][-1] - 1) < 2e-5
 
 
 def test_pidgov_droop_on_power():
@@ -378,23 +380,34 @@ def test_pidgov_bad_data(params, field):
 WPIDHY = dict(TREG=0.01, REG=-0.05, KP=3.0, KI=0.5, KD=3.0, TA=0.02, TB=0.01, VELMX=0.025, VELMN=-0.025,
               GATMX=1.0, GATMN=0.2, TW=3.25, PMAX=52001., PMIN=0.0, D=0.0, G0=0.12, G1=0.545, P1=0.4,
               G2=0.827, P2=0.83, P3=1.0)
-#: gains that settle alone in the island (PSID's are for a unit on a stiff grid)
-WPIDHY_ISLAND = dict(WPIDHY, KP=2.0, KI=0.4, KD=0.5, TA=0.05, TB=0.2, TW=1.0, VELMX=0.2, VELMN=-0.2)
+#: gains that settle alone in the island (KD is the speed-to-gate gain, see the model)
+WPIDHY_ISLAND = dict(WPIDHY, KD=2.0, KP=0.5, KI=0.05, TW=1.0, VELMX=0.2, VELMN=-0.2)
 
 
 def test_wpidhy_initial_point_is_an_equilibrium():
+    """PSID's ThreeBus_WPIDHY case (70 MW): at rest at PSID's initial gate 0.7417, then the line
+    trip of PSID's case 60."""
+    s = threebus_system(("WPIDHY", WPIDHY), hydro=True).setup()
+    worst, dw = at_rest(s)
+    assert worst < 1e-9 and dw < 1e-10
+    assert s.z0[s.components["WPIDHY"].idx("GATE")][0] == pytest.approx(0.7417441860465115, rel=1e-12)
+    res = simulate(s, 10.0, dt=1 / 120, events=[LineTrip(0, 1.0)])
+    assert res.ok and abs(res["G.omega"][-1] - 1) < 1e-4
+
+
+def test_wpidhy_at_full_gate():
+    """100 MW needs the full gate (GATMX = 1): at rest on the limit, held there after the trip."""
     s = threebus_system(("WPIDHY", WPIDHY)).setup()
     worst, dw = at_rest(s)
     assert worst < 1e-9 and dw < 1e-10
-    assert s.z0[s.components["WPIDHY"].idx("GATE")][0] == pytest.approx(1.0, abs=1e-12)
-    res = simulate(s, 10.0, dt=1 / 120, events=[LineTrip(0, 1.0)])          # PSID case 60's event
+    res = simulate(s, 10.0, dt=1 / 120, events=[LineTrip(0, 1.0)])
     assert res.ok and np.max(res["G.gov.GATE"]) <= 1.0 + 1e-9
 
 
 def test_wpidhy_droop():
     """omega_ss - 1 = REG*(Pe_ss - Pe0) on the machine base (REG < 0)."""
     s = island_system(("WPIDHY", WPIDHY_ISLAND))
-    res = simulate(s, 60.0, dt=0.02, events=[LoadStep(2, 0.5, dP=10.0)], tol=1e-11)
+    res = simulate(s, 250.0, dt=0.1, events=[LoadStep(2, 0.5, dP=10.0)], tol=1e-11)
     expected = WPIDHY["REG"] * (island_pe(s, 10.0) - P0 / 100) * 100.0 / SN
     assert abs(expected) > 3e-3
     assert res["G.omega"][-1] - 1 == pytest.approx(expected, rel=1e-5)
@@ -688,3 +701,41 @@ def test_ggov1_activsg2000_record():
     res = simulate(s, 20.0, dt=1 / 120, events=[LineTrip(0, 1.0)])
     assert res.ok and abs(res["G.omega"][-1] - 1) < 1e-5
     assert np.max(res["G.gov.VAL"]) <= 1.0 + 1e-12
+
+
+
+#: small-signal eigenvalues of PSID's test cases 58 (GENROU + SEXS + PIDGOV, Flag 0 / 1) and 60
+#: (GENROU + SEXS + WPIDHY), 70 MW at bus 102 (test/results/results_eigenvalues.jl, BSD-3-Clause,
+#: (c) Alliance for Sustainable Energy)
+PSID_HYDRO_EIGS = {
+    ("PIDGOV", 0): [-99.99999037034084, -41.17481961789709, -38.789855128930164, -5.647427439841257,
+                    -3.8982943228132214 - 1.5754284098308229j, -3.8982943228132214 + 1.5754284098308229j,
+                    -2.000000000000001, -0.9492553729947647, -0.8686675700247483 - 8.496111510550772j,
+                    -0.8686675700247483 + 8.496111510550772j, -0.28282148961179976 - 1.1097759323927108j,
+                    -0.28282148961179976 + 1.1097759323927108j, -0.1975067616652887 - 0.17956822187766j,
+                    -0.1975067616652887 + 0.17956822187766j, -0.11697960134622151],
+    ("PIDGOV", 1): [-100.00010646060846, -41.17482850153586, -38.789870976223455, -5.718238174509167,
+                    -3.7935658880265133, -2.0454156913133885, -1.9999999999999976,
+                    -1.2228555790477964 - 0.7200047656459937j, -1.2228555790477964 + 0.7200047656459937j,
+                    -0.9655206559688869, -0.9001334037955144 - 8.447836359367825j,
+                    -0.9001334037955144 + 8.447836359367825j, -0.19849913626541832 - 0.17939599481963514j,
+                    -0.19849913626541832 + 0.17939599481963514j, -0.04238523317744444],
+    ("WPIDHY", None): [-106.13231871102334, -91.13024819676329, -63.8688081304463, -40.03565106938418,
+                       -38.75323547447537 - 8.125818822049656j, -38.75323547447537 + 8.125818822049656j,
+                       -6.104826779980879, -1.395127240875047 - 5.966607970662552j,
+                       -1.395127240875047 + 5.966607970662552j, -0.9449531063097173, -0.48179149983179287,
+                       -0.1941504953444676 - 0.18213498194497163j, -0.1941504953444676 + 0.18213498194497163j,
+                       -0.03057660237077197 - 0.30118043163774183j, -0.03057660237077197 + 0.30118043163774183j],
+}
+
+
+@pytest.mark.parametrize("model, flag", list(PSID_HYDRO_EIGS), ids=["PIDGOV-power", "PIDGOV-gate", "WPIDHY"])
+def test_hydro_pid_eigenvalues_as_psid(model, flag):
+    """The small-signal eigenvalues of PSID's PIDGOV / WPIDHY cases (with their SEXS and GENROU)
+    equal PSID's (PSID's own test tolerance 1e-3 on the norm)."""
+    params = dict(PIDGOV_PSID, Flag=flag) if model == "PIDGOV" else WPIDHY
+    s = threebus_system((model, params), hydro=True).setup()
+    ev = state_matrix_eigs(s)
+    ref = np.sort_complex(np.array(PSID_HYDRO_EIGS[(model, flag)], dtype=complex))
+    assert len(ev) == len(ref)
+    assert np.linalg.norm(ev - ref) < 1e-3

@@ -6,28 +6,31 @@ Block diagram (pu on the machine base ``Sn`` = PSS/E MBASE; times in s)::
     (Pe - pref) --[ REG/(1+sTREG) ]--> XREG          (droop on electrical power; REG < 0 in
                                                       PSS/E data: the droop is -REG)
     u = XREG - dw
-    u --[ (KP + KI/s + KD s) / (1+sTA)^2 ]--> XA                      (PID, states PI, XD, XA)
+    u --[ (KD s^2 + KP s + KI) / (s (1+sTA)^2) ]--> XA                (PID, states PI, XD, XA)
         realized as (KP' + KI/s + KD' s/(1+sTA)) / (1+sTA),
         KP' = KP - TA*KI,  KD' = KD - TA*KP + TA^2*KI
-    dGATE/dt = clip((XA - GATE)/TB, VELMN, VELMX)                    (gate servo 1/(1+sTB) with
-    GATE non-windup in GATMN..GATMX                                   velocity and position limits)
+    XA --[ 1/(1+sTB) ]--> XB
+    v = clip(XB, VELMN, VELMX)                                         (gate velocity limits)
+    v --[ 1/s, non-windup GATMN..GATMX ]--> GATE
     Pg = gate characteristic (G0, 0), (G1, P1), (G2, P2), (1, P3) at GATE
     Pg --[ (1 - sTW)/(1 + sTW/2) ]--> XW-output --clip(PMIN, PMAX)--> PT   (water column)
     PMECH = PT - D*dw,   tm = PMECH/omega
 
-The PID output is the gate position demand; the gate servo follows it with the time constant
-TB (as OpenIPSL's WPIDHY, marked verified against PSS/E: a derivative-lag ``s/(1+sTB)`` rate-limited and
-integrated; here as the rate-limited lag it equals, with the position limits non-windup on the
-gate). PowerSimulationsDynamics.jl's WPIDHY instead integrates the lagged PID output (a second
-integrator, no gate feedback); it initializes PSID's own ThreeBus_WPIDHY case at 0.7 pu of
-power for a 1.0-pu unit and has no PSS/E result to check it. ``tm`` is the torque
+The PID output is the gate velocity demand: the gate integrates it, so from speed to gate
+``KD`` acts as the proportional gain, ``KP`` as the integral gain and ``KI`` integrates twice.
+This is PowerSimulationsDynamics.jl's reading of the PSS/E diagram. OpenIPSL's WPIDHY reads it
+as a gate *position* demand (a derivative-lag ``s/(1+sTB)`` before the velocity limits and
+the integrator); with the data of PSID's PSS/E benchmark case (KD = 3, KP = 3, KI = 0.5,
+TW = 3.25 s; 70 MW, gate 0.742) that reading has two unstable eigenvalues (+2.7 and +15.8 1/s)
+at the initial point, while this one is stable and its eigenvalues equal PSID's (test case 60)
+within 5e-4. ``tm`` is the torque
 (PSS/E's machine models divide PMECH by the speed; system base ``*Sn/Sb``).
 
 Initialized at rest at the machine's initial torque ``tm0``: ``GATE`` = the gate at which the
-characteristic gives ``tm0`` (machine base), ``PI = XA = GATE``, ``XREG = XD = 0``, the water
-column at ``tm0``, ``pref = Pe0``. In the steady state the PID input is zero, so the speed
-settles at ``dw = REG*(Pe - pref)``. An initial gate beyond ``GATMX``/``GATMN`` or a ``tm0``
-beyond ``PMAX``/``PMIN`` is refused at setup naming the limit.
+characteristic gives ``tm0`` (machine base), every controller state 0 except the water column
+(``tm0``), ``pref = Pe0``. In the steady state the PID input is zero, so the speed settles at
+``dw = REG*(Pe - pref)``. An initial gate beyond ``GATMX``/``GATMN`` or a ``tm0`` beyond
+``PMAX``/``PMIN`` is refused at setup naming the limit.
 
 PSS/E record (CONs only): ``TREG REG KP KI KD TA TB VELMX VELMN GATMX GATMN TW PMAX PMIN D G0 G1
 P1 G2 P2 P3``.
@@ -57,7 +60,7 @@ class WPIDHY(MachineControl):
         Param("KI", 1.0, "1/s", "integral gain", "pos"),
         Param("KD", 0.0, "s", "derivative gain", ""),
         Param("TA", 0.02, "s", "controller time constant", "nonneg"),
-        Param("TB", 0.01, "s", "gate servo time constant", "pos"),
+        Param("TB", 0.01, "s", "gate servo time constant", "nonneg"),
         Param("VELMX", 0.1, "pu/s", "maximum gate opening velocity", ""),
         Param("VELMN", -0.1, "pu/s", "maximum gate closing velocity (< 0)", ""),
         Param("GATMX", 1.0, "pu", "maximum gate opening", ""),
@@ -73,7 +76,7 @@ class WPIDHY(MachineControl):
         Param("P2", 0.8, "pu (machine base)", "power at G2", ""),
         Param("P3", 1.0, "pu (machine base)", "power at full gate (1 pu)", ""),
     )
-    states = ("XREG", "PI", "XD", "XA", "GATE", "XW")
+    states = ("XREG", "PI", "XD", "XA", "XB", "GATE", "XW")
     outputs = ("Pg", "PMECH")
 
     #: PSS/E .dyr record after ``IBUS 'WPIDHY' ID`` (CONs only)
@@ -103,6 +106,7 @@ class WPIDHY(MachineControl):
         self.REGL = Lag(p["REG"], p["TREG"])
         self.D = Washout(p["KD"] - TA * p["KP"] + TA * TA * p["KI"], TA)
         self.LA = Lag(1.0, TA)
+        self.LB = Lag(1.0, p["TB"])
         self.GATE = IntegratorNonWindup(1.0, p["GATMN"], p["GATMX"])
         self.WATER = LeadLag(-p["TW"], p["TW"] / 2.0)
         self.k = self.Sn / system.Sb
@@ -116,7 +120,7 @@ class WPIDHY(MachineControl):
         self.pref0 = sig["Pe0"][self.mach] / self.k
         g0 = power_gate(self, tm0)
         z = np.zeros(self.n)
-        for k, v in enumerate((z, g0, z, g0, g0, self.WATER.init(tm0))):
+        for k, v in enumerate((z, z, z, z, z, g0, self.WATER.init(tm0))):
             x[self.sl(k)] = v
         self.initial_bounds = [("the turbine power (tm0, machine base)", tm0, p["PMIN"], p["PMAX"],
                                 "PMIN", "PMAX")]
@@ -124,14 +128,15 @@ class WPIDHY(MachineControl):
     def compute(self, ctx):
         p = self.p
         m = self._mi
-        xreg, xpi, xd, xa, gate, xw = (ctx.x[..., s] for s in self._sls)
+        xreg, xpi, xd, xa, xb, gate, xw = (ctx.x[..., s] for s in self._sls)
         omega = ctx.sig["omega"][..., m]
         dw = omega - 1.0
         ein = ctx.sig["Pe"][..., m] / self.k - self.pref0
         u = self.REGL.output(xreg, ein) - dw
         ypid = self.kp * u + xpi + self.D.output(xd, u)
         ya = self.LA.output(xa, ypid)
-        v = np.clip((ya - gate) / p["TB"], p["VELMN"], p["VELMX"])
+        yb = self.LB.output(xb, ya)
+        v = np.clip(yb, p["VELMN"], p["VELMX"])
         pg = gate_power(self, gate)
         pt = np.clip(self.WATER.output(xw, pg), p["PMIN"], p["PMAX"])
         pm = pt - p["D"] * dw
@@ -140,7 +145,8 @@ class WPIDHY(MachineControl):
         f[..., self._sls[1]] = p["KI"] * u
         f[..., self._sls[2]] = self.D.deriv(xd, u)
         f[..., self._sls[3]] = self.LA.deriv(xa, ypid)
-        f[..., self._sls[4]] = v
-        f[..., self._sls[5]] = self.WATER.deriv(xw, pg)
+        f[..., self._sls[4]] = self.LB.deriv(xb, ya)
+        f[..., self._sls[5]] = v
+        f[..., self._sls[6]] = self.WATER.deriv(xw, pg)
         ctx.sig["tm"][..., m] = pm / omega * self.k
         ctx.out["WPIDHY.Pg"], ctx.out["WPIDHY.PMECH"] = pg, pm
