@@ -462,3 +462,143 @@ class PITrackAW:
 def deadband(u, lower, upper):
     """Dead band without offset: 0 inside ``[lower, upper]``, ``u - upper`` above, ``u - lower`` below."""
     return np.where(u > upper, u - upper, np.where(u < lower, u - lower, 0.0))
+
+
+class LeadLag2:
+    r"""Second-order lead-lag :math:`(1 + sA)/(1 + sB + s^2 C)` (unit gain).
+
+    Realized in controllable canonical form, states ``x1`` (the lagged input) and
+    ``x2 = dx1/dt``::
+
+        C > 0:          dx1/dt = x2,  C dx2/dt = u - x1 - B x2,  y = x1 + A x2
+        C = 0, B > 0:   B dx1/dt = u - x1 (x2 unused),  y = (A/B)(u - x1) + x1
+        C = 0, B = 0:   y = u (states unused)
+
+    The steady state for a constant input ``u0`` is ``x1 = u0``, ``x2 = 0``. A lead ``A > 0``
+    without a lag (``B = C = 0``) is improper; models refuse it (:meth:`improper`).
+
+    Parameters
+    ----------
+    A : array_like
+        Lead time constant [s].
+    B : array_like
+        First-order denominator coefficient [s] (e.g. ``T1`` or ``T5 + T6``).
+    C : array_like
+        Second-order denominator coefficient [s^2] (e.g. ``T1*T2`` or ``T5*T6``).
+    """
+
+    nx = 2
+
+    def __init__(self, A, B, C):
+        self.A = np.asarray(A, dtype=float)
+        self.B = np.asarray(B, dtype=float)
+        self.C = np.asarray(C, dtype=float)
+        self._two = self.C > 0
+        self._one = ~self._two & (self.B > 0)
+        self._Cs = np.where(self._two, self.C, 1.0)
+        self._Bs = np.where(self._one, self.B, 1.0)
+        self._r = self.A / self._Bs
+
+    def improper(self):
+        """Boolean array: a lead without any lag (``A != 0`` with ``B = C = 0``)."""
+        return (self.A != 0) & ~self._two & ~self._one
+
+    def init(self, u0):
+        u0 = np.asarray(u0, dtype=float)
+        return u0 * 1.0, np.zeros_like(u0)
+
+    def output(self, x1, x2, u):
+        return np.where(self._two, x1 + self.A * x2,
+                        np.where(self._one, self._r * (u - x1) + x1, u))
+
+    def deriv(self, x1, x2, u):
+        d1 = np.where(self._two, x2, np.where(self._one, (u - x1) / self._Bs, 0.0))
+        d2 = np.where(self._two, (u - x1 - self.B * x2) / self._Cs, 0.0)
+        return d1, d2
+
+
+class TransportDelay:
+    r"""Pure transport delay :math:`e^{-sT_D}` from a stored history of the delayed signal.
+
+    The phasor simulator integrates with a fixed-step implicit method; a delay is represented
+    exactly (no Padé approximation) by the history of its input at the accepted points:
+    ``record(t, u)`` is called at every accepted point, and ``output(t, u)`` returns
+    ``u(t - TD)`` interpolated linearly between the stored points (second order, as the
+    trapezoidal rule). Before the first stored time the input is its initial (steady) value.
+    When ``t - TD`` falls after the last stored point (a delay shorter than the step) the value
+    is interpolated between that point and the current input ``u`` (so it depends on the
+    current state, and the Jacobian sees it). ``TD = 0`` passes the input through.
+
+    Parameters
+    ----------
+    TD : array_like
+        Delay [s] (>= 0), one per device.
+    """
+
+    def __init__(self, TD):
+        self.TD = np.asarray(TD, dtype=float)
+        self._on = self.TD > 0
+        self.any = bool(np.any(self._on))
+        self._t = np.zeros(0)
+        self._v = np.zeros((0, self.TD.size))
+        self._k = 0
+
+    def reset(self, t0, u0):
+        """Start the history at time ``t0`` with the steady input ``u0`` (also valid before ``t0``)."""
+        cap = 1024
+        self._t = np.zeros(cap)
+        self._v = np.zeros((cap, self.TD.size))
+        self._t[0] = t0
+        self._v[0] = u0
+        self._k = 1
+
+    def record(self, t, u):
+        """Store the input ``u`` at an accepted time ``t`` (a repeated time overwrites; an earlier
+        time, a new run from the start, drops the history after it)."""
+        if not self.any:
+            return
+        k = self._k
+        if k and t < self._t[k - 1] - 1e-12:
+            k = int(np.searchsorted(self._t[:k], t - 1e-12))
+            if k == 0:
+                self.reset(t, u)
+                return
+        if k and abs(t - self._t[k - 1]) <= 1e-12:
+            self._v[k - 1] = u
+            self._k = k
+            return
+        if k == len(self._t):
+            # drop what no delay reaches back to, else grow
+            keep = int(np.searchsorted(self._t[:k], self._t[k - 1] - self.TD.max() - 1e-9)) - 1
+            if keep > k // 2:
+                self._t[:k - keep] = self._t[keep:k]
+                self._v[:k - keep] = self._v[keep:k]
+                k -= keep
+            else:
+                self._t = np.concatenate([self._t, np.zeros(len(self._t))])
+                self._v = np.concatenate([self._v, np.zeros_like(self._v)])
+        self._t[k] = t
+        self._v[k] = u
+        self._k = k + 1
+
+    def output(self, t, u):
+        """``u(t - TD)``: the stored history, or the current input ``u`` where ``TD = 0``."""
+        if not self.any:
+            return u
+        k = self._k
+        ts, vs = self._t[:k], self._v[:k]
+        td = t - self.TD
+        j = np.clip(np.searchsorted(ts, td, side="right"), 1, max(k - 1, 1))   # ts[j-1] <= td < ts[j]
+        cols = np.arange(self.TD.size)
+        if k > 1:
+            t0, t1 = ts[j - 1], ts[j]
+            w = np.clip((td - t0) / np.where(t1 > t0, t1 - t0, 1.0), 0.0, 1.0)
+            hist = vs[j - 1, cols] + w * (vs[j, cols] - vs[j - 1, cols])
+        else:
+            hist = vs[0]
+        hist = np.where(td <= ts[0], vs[0], hist)
+        tl, vl = ts[k - 1], vs[k - 1]
+        inside = td > tl                                  # delay shorter than the step
+        w = np.where(inside, (td - tl) / max(t - tl, 1e-300), 0.0)
+        recent = vl + w * (u - vl)
+        return np.where(self._on, np.where(inside, recent, hist), u)

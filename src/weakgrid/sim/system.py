@@ -93,6 +93,7 @@ def _registry():
     from .exciters import (AC8B, ESAC1A, ESDC1A, ESDC2A, ESST1A, ESST3A, ESST4B, EXAC1, EXAC4, EXST1,
                            IEEET1, IEEET3, IEEEVC, IEEEX1)
     from .governors import GAST, IEEEG1, IEESGO, TG2, TGOV1N
+    from .governors import DEGOV, DEGOV1, GGOV1, PIDGOV, WPIDHY
     from .pss import ST2CUT
     from .renewables import WTARA1, WTDTA1, WTPTA1, WTTQA1
     from .exciters import ESAC6A, EXAC2, EXPIC1, SCRX, ST6B, ST8C
@@ -101,6 +102,7 @@ def _registry():
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
                                     ESST1A, ESAC1A, ESDC1A, IEEET3, ESST4B, EXAC4, AC8B, IEEEVC,
                                     IEEEG1, IEESGO, TG2, TGOV1N, GAST, ST2CUT)
+            + (DEGOV1, DEGOV, PIDGOV, WPIDHY, GGOV1)
             + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ESD1, ZIP)
             + (WTDTA1, WTARA1, WTPTA1, WTTQA1)    # after REECA1: the ANDES importer links in this order
             + (InfiniteBus, PVSource)
