@@ -63,11 +63,12 @@ def threebus_system(governor, machine="GENROU", sexs=True, hydro=False):
     the 70-MW dispatch of PSID's PIDGOV/WPIDHY cases)."""
     s = System(threebus(70.0, 200.0) if hydro else threebus())
     if machine == "GENROU":
-        s.add_machine("GENROU", "G", gen=1, **GENROU)
+        s.add_machine("GENROU", "G", gen=1, psse_shaft=1.0, **GENROU)
         if sexs:   # SEXS of the PIDGOV/WPIDHY cases
             s.add_exciter("SEXS", "G.avr", "G", TATB=0.4, TB=5.0, K=20.0, TE=1.0, EMIN=-50.0, EMAX=50.0)
     else:
-        s.add_machine("GENCLS", "G", gen=1, Sn=100, M=16.0, D=0.03, ra=0.0, xd1=0.25)
+        s.add_machine("GENCLS", "G", gen=1, Sn=100, M=16.0, D=0.03, ra=0.0, xd1=0.25,
+                      psse_shaft=1.0)
     s.add_governor(governor[0], "G.gov", "G", **governor[1])
     ib = InfiniteBus()
     ib.add_source("IB", 0)
@@ -89,7 +90,7 @@ def island_case():
 
 def island_system(governor, M=10.0):
     s = System(island_case())
-    s.add_machine("GENCLS", "G", gen=0, Sn=SN, M=M, D=0.0, ra=0.0, xd1=XD1)
+    s.add_machine("GENCLS", "G", gen=0, Sn=SN, M=M, D=0.0, ra=0.0, xd1=XD1, psse_shaft=1.0)
     s.add_governor(governor[0], "G.gov", "G", **governor[1])
     return s.setup()
 
@@ -206,7 +207,8 @@ def test_degov_throttle_limits(model, base, dP, field):
     L = lim[field]
     assert np.max(thr) <= lim["TMAX"] + 1e-9 and np.min(thr) >= lim["TMIN"] - 1e-9
     assert thr[-1] == pytest.approx(L, abs=1e-9)
-    assert res["G.tm"][-1] == pytest.approx(L * SN / 100.0, abs=1e-9)
+    # tm is PSS/E's PMECH = THRD*omega (the PSS/E shaft divides it by the speed)
+    assert res["G.tm"][-1] == pytest.approx(L * res["G.omega"][-1] * SN / 100.0, abs=1e-9)
     w = res["G.omega"]
     assert (w[-1] - w[-50]) * np.sign(dP) < 0                   # still decelerating / accelerating
 
@@ -221,7 +223,7 @@ def test_degov_delay_is_exact():
     assert np.ptp(thr) > 0.05
     assert np.max(np.abs(thrd[late] - np.interp(t[late] - TD, t, thr))) < 1e-12
     assert np.max(np.abs(thrd[~late] - thr[0])) < 1e-12
-    assert np.max(np.abs(res["G.tm"] - thrd * SN / 100.0)) < 1e-12
+    assert np.max(np.abs(res["G.tm"] - thrd * res["G.omega"] * SN / 100.0)) < 1e-12
 
 
 
@@ -449,7 +451,7 @@ def test_wpidhy_power_limits(dP, field):
     pm = res["G.gov.PMECH"]
     assert np.max(pm) <= lim["PMAX"] + 1e-12 and np.min(pm) >= lim["PMIN"] - 1e-12
     assert pm[-1] == pytest.approx(lim[field], abs=1e-12)
-    assert res["G.tm"][-1] == pytest.approx(lim[field] / res["G.omega"][-1] * SN / 100, rel=1e-12)
+    assert res["G.tm"][-1] == pytest.approx(lim[field] * SN / 100, rel=1e-12)   # PMECH
 
 
 @pytest.mark.parametrize("params, field", [

@@ -6,7 +6,7 @@ DEGOV1 (:mod:`weakgrid.sim.governors.degov1`) without its droop loop: an isochro
     dw = omega - 1
     -dw --[ (1+sT3)/(1+sT1+s^2 T1 T2) ]--> y1                      (electric control box)
     y1 --[ (1+sT4)/((1+sT5)(1+sT6)) ]--> y2 --[ K/s, non-windup TMIN..TMAX ]--> THR   (actuator)
-    THR --[ e^{-sTD} ]--> THRD,   PMECH = THRD*(1 + dw),   tm = PMECH/omega = THRD
+    THR --[ e^{-sTD} ]--> THRD,   PMECH = THRD*(1 + dw),   tm = PMECH (the PSS/E shaft divides by omega)
 
 Machine base, engine dead time by stored history (exact, no Padé approximation), output torque
 and initialization as DEGOV1 (see there). The state ``PEF`` of DEGOV1 is present and stays 0.

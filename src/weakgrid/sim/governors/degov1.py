@@ -10,7 +10,7 @@ Block diagram (pu on the machine base ``Sn`` = PSS/E MBASE; times in s)::
     y1 --[ (1+sT4)/((1+sT5)(1+sT6)) ]--> y2                        (actuator dynamics ACT1, ACT2)
     y2 --[ K/s, non-windup TMIN..TMAX ]--> THR                     (actuator position = throttle)
     THR --[ e^{-sTD} ]--> THRD                                     (engine dead time)
-    PMECH = THRD*(1 + dw),  tm = PMECH/omega = THRD                (torque to the shaft)
+    PMECH = THRD*(1 + dw),  tm = PMECH                 (the PSS/E shaft divides it by omega)
 
 ``TE`` filters the electrical power only; the throttle feedback (M = 0) is direct, as in
 PowerSimulationsDynamics.jl's DEGOV1 (whose eigenvalues this reproduces, below).
@@ -21,8 +21,8 @@ on the actuator output itself (the transfer function is the same).
 
 Output: PSS/E's diesel model multiplies the delayed throttle by the speed to give the
 mechanical *power* PMECH, and the PSS/E machine models divide PMECH by the speed to get the
-mechanical torque; weakgrid's shaft takes the torque, so ``tm = THRD`` (on the system base:
-``THRD*Sn/Sb``).
+mechanical torque: ``tm = PMECH`` (system base: ``*Sn/Sb``), and the machine's PSS/E shaft
+(``psse_shaft = 1``, set for every machine read from a PSS/E file) divides it by the speed.
 
 Engine dead time: represented exactly by a stored history of ``THR`` at the integrator's
 accepted points, linearly interpolated at ``t - TD`` (:class:`~weakgrid.sim.blocks.TransportDelay`),
@@ -146,6 +146,6 @@ class DEGOV1(MachineControl):
         f[..., self._sls[4]] = self.THR.deriv(thr, y2)
         f[..., self._sls[5]] = np.where(self.kpe > 0, self.PEF.deriv(pef, pe), 0.0)
         thrd = self.DELAY.output(ctx.t, thr)
-        ctx.sig["tm"][..., m] = thrd * self.k
+        ctx.sig["tm"][..., m] = thrd * omega * self.k   # PMECH: the PSS/E shaft divides by omega
         o = ctx.out
         o[f"{self.type_name}.THRD"], o[f"{self.type_name}.PMECH"] = thrd, thrd * omega

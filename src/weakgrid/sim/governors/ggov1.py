@@ -16,7 +16,7 @@ Block diagram (pu on the turbine base ``Trate`` MW, or the machine base ``Sn`` w
     dVAL/dt = clip((FSR - VAL)/Tact, Rclose, Ropen), VAL non-windup Vmin..Vmax   (actuator)
     wf    = VAL*(1+dw) (Flag = 1) | VAL (Flag = 0)              (fuel flow)
     Kturb*(wf - Wfnl) --[ e^{-sTeng} ]--[ (1+sTc)/(1+sTb) ]--> S4   (engine dead time, turbine; LL)
-    PMECH = S4 - Dm*(1+dw),   tm = PMECH/omega                  (Dm >= 0)
+    PMECH = S4 - Dm*(1+dw),   tm = PMECH                        (Dm >= 0)
 
 Low-value gate in continuous time. PSS/E evaluates the gate with the previous step's output:
 its acceleration limiter is ``FSRA = FSR(t-DELT) + Ka*DELT*(Aset - accel)``, and the integrators
@@ -35,8 +35,8 @@ represented (as in OpenIPSL's GGOV1); tighter than +-10 pu/s they raise a warnin
 Rselect = -1 closes an algebraic loop (the gate output enters the governor error): it is solved
 in each evaluation (Newton on the piecewise-linear loop, slope ``1 + (Kpgov + Kdgov/Tdgov)*R``).
 
-Output: ``tm`` is the torque, PSS/E's PMECH divided by the speed (PSS/E's machine models do
-that), converted from the turbine base to the system base.
+Output: ``tm`` is PSS/E's PMECH converted from the turbine base to the system base; as PSS/E's
+machine models, the machine's PSS/E shaft (``psse_shaft = 1``, set for every machine read from a PSS/E file) divides it by the speed.
 
 Initialized at rest at the machine's initial torque ``tm0``: ``PMECH0 = tm0`` (turbine base),
 ``VAL = FSR = FSRN = GI = fsr0 = (PMECH0 + Dm)/Kturb + Wfnl``, ``Pmwset = PELF = Pe0``,
@@ -264,7 +264,7 @@ class GGOV1(MachineControl):
             f[..., self._sls[k]] = d[st]
         s4 = self.LL.output(ll, utd)
         pm = s4 - p["Dm"] * (1.0 + dw)
-        ctx.sig["tm"][..., m] = pm / omega * self.kT
+        ctx.sig["tm"][..., m] = pm * self.kT   # PMECH: the PSS/E shaft divides by omega
         o = ctx.out
         o["GGOV1.ERR"], o["GGOV1.ACC"] = e, accel
         o["GGOV1.FSRN"], o["GGOV1.FSRT"], o["GGOV1.FSRA"] = fsrn, fsrt, fsra

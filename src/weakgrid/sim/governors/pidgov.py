@@ -14,10 +14,10 @@ Block diagram (pu on the machine base ``Sn`` = PSS/E MBASE; times in s)::
     v --[ 1/s, non-windup Gmin..Gmax ]--> GATE
     Pg = gate characteristic (G0, 0), (G1, P1), (G2, P2), (1, P3) at GATE
     Pg --[ (1 - sTz)/(1 + sTz/2) ]--> PT,   Tz = Atw*Tw            (water column, state XW)
-    PMECH = PT - Dturb*dw,   tm = PMECH/omega
+    PMECH = PT - Dturb*dw,   tm = PMECH
 
-``tm`` is the torque: PSS/E's governors give the mechanical power PMECH and PSS/E's machine
-models divide it by the speed; weakgrid's shaft takes the torque (system base: ``*Sn/Sb``).
+``tm`` is PSS/E's mechanical power PMECH (system base: ``*Sn/Sb``); as PSS/E's machine models,
+the machine's PSS/E shaft (``psse_shaft = 1``, set for every machine read from a PSS/E file) divides it by the speed.
 
 Initialized at rest at the machine's initial torque ``tm0``: ``GATE`` = the gate at which the
 characteristic gives ``tm0`` (machine base), ``XA = XB = PI = GATE``, ``XREG = XD = 0`` and
@@ -145,5 +145,5 @@ class PIDGOV(MachineControl):
         f[..., self._sls[4]] = self.LA.deriv(xb, yb_in)
         f[..., self._sls[5]] = v
         f[..., self._sls[6]] = self.WATER.deriv(xw, pg)
-        ctx.sig["tm"][..., m] = pm / omega * self.k
+        ctx.sig["tm"][..., m] = pm * self.k   # PMECH: the PSS/E shaft divides by omega
         ctx.out["PIDGOV.Pg"], ctx.out["PIDGOV.PMECH"] = pg, pm

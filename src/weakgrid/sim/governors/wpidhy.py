@@ -14,7 +14,7 @@ Block diagram (pu on the machine base ``Sn`` = PSS/E MBASE; times in s)::
     v --[ 1/s, non-windup GATMN..GATMX ]--> GATE
     Pg = gate characteristic (G0, 0), (G1, P1), (G2, P2), (1, P3) at GATE
     Pg --[ (1 - sTW)/(1 + sTW/2) ]--> XW-output --clip(PMIN, PMAX)--> PT   (water column)
-    PMECH = PT - D*dw,   tm = PMECH/omega
+    PMECH = PT - D*dw,   tm = PMECH
 
 The PID output is the gate velocity demand: the gate integrates it, so from speed to gate
 ``KD`` acts as the proportional gain, ``KP`` as the integral gain and ``KI`` integrates twice.
@@ -23,8 +23,8 @@ as a gate *position* demand (a derivative-lag ``s/(1+sTB)`` before the velocity 
 the integrator); with the data of PSID's PSS/E benchmark case (KD = 3, KP = 3, KI = 0.5,
 TW = 3.25 s; 70 MW, gate 0.742) that reading has two unstable eigenvalues (+2.7 and +15.8 1/s)
 at the initial point, while this one is stable and its eigenvalues equal PSID's (test case 60)
-within 5e-4. ``tm`` is the torque
-(PSS/E's machine models divide PMECH by the speed; system base ``*Sn/Sb``).
+within 5e-4. ``tm`` is PSS/E's PMECH (system base ``*Sn/Sb``); as PSS/E's machine models,
+the machine's PSS/E shaft (``psse_shaft = 1``, set for every machine read from a PSS/E file) divides it by the speed.
 
 Initialized at rest at the machine's initial torque ``tm0``: ``GATE`` = the gate at which the
 characteristic gives ``tm0`` (machine base), every controller state 0 except the water column
@@ -148,5 +148,5 @@ class WPIDHY(MachineControl):
         f[..., self._sls[4]] = self.LB.deriv(xb, ya)
         f[..., self._sls[5]] = v
         f[..., self._sls[6]] = self.WATER.deriv(xw, pg)
-        ctx.sig["tm"][..., m] = pm / omega * self.k
+        ctx.sig["tm"][..., m] = pm * self.k   # PMECH: the PSS/E shaft divides by omega
         ctx.out["WPIDHY.Pg"], ctx.out["WPIDHY.PMECH"] = pg, pm
