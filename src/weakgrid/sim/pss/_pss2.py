@@ -151,7 +151,7 @@ class DualInputPSS(MachineControl):
     #: (lead, lag) parameter pairs of the phase-compensation lead-lags, in series
     LEAD_LAGS = (("T1", "T2"), ("T3", "T4"))
     _HEAD = ("W1", "W2", "L6", "W3", "W4", "L7") + tuple(f"RTF{k + 1}" for k in range(N_RTF))
-    outputs = ("sig", "sig2", "vss")
+    outputs = ("sig", "sig2", "vss", "vs")
 
     @classmethod
     def psse_params(cls, values, ctx):
@@ -233,7 +233,8 @@ class DualInputPSS(MachineControl):
             k = self._k0 + j
             f[..., sl[k]] = LL.deriv(X[k], y)
             y = LL.output(X[k], y)
-        s["vs"][..., m] = hard_limit(y, p["VSTMIN"], p["VSTMAX"])
+        vs = hard_limit(y, p["VSTMIN"], p["VSTMAX"])
+        s["vs"][..., m] = vs
         name = self.type_name
         o = ctx.out
-        o[f"{name}.sig"], o[f"{name}.sig2"], o[f"{name}.vss"] = r1, r2, y
+        o[f"{name}.sig"], o[f"{name}.sig2"], o[f"{name}.vss"], o[f"{name}.vs"] = r1, r2, y, vs

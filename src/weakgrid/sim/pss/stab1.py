@@ -39,7 +39,7 @@ class STAB1(MachineControl):
         Param("HLIM", 0.1, "pu", "output limit (symmetric, +-HLIM)", "nonneg"),
     )
     states = ("WO", "LL1", "LL2")
-    outputs = ("sig", "vss")
+    outputs = ("sig", "vss", "vs")
 
     #: PSS/E .dyr record after ``IBUS 'STAB1' ID``: CONs K/T, T, T1/T3, T3, T2/T4, T4, HLIM.
     psse_record = ("KT", "T", "T1T3", "T3", "T2T4", "T4", "HLIM")
@@ -77,4 +77,4 @@ class STAB1(MachineControl):
         f[..., sl[2]] = self.LL2.deriv(x2, y1)
         vs = hard_limit(y2, -p["HLIM"], p["HLIM"])
         ctx.sig["vs"][..., m] = vs
-        ctx.out["STAB1.sig"], ctx.out["STAB1.vss"] = u, y2
+        ctx.out["STAB1.sig"], ctx.out["STAB1.vss"], ctx.out["STAB1.vs"] = u, y2, vs
