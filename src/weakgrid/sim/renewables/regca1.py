@@ -52,7 +52,19 @@ from ..params import Param
 
 class REGCA1(Component):
     """Renewable generator/converter model A (WECC) on a static generator row (or its share of it:
-    ``gammap``, ``gammaq``)."""
+    ``gammap``, ``gammaq``).
+
+    PSS/E reader interface (REGCA1, REECA1, REECB1, REPCA1 alike): ``psse_record`` (ICONs first;
+    names starting with ``_`` are ICONs consumed by ``psse_params``/``psse_link``),
+    ``psse_params(values, ctx)`` -> parameters and ``psse_link(values, ctx)`` -> the link dict of
+    :meth:`Component.add`, with ``values`` the record's fields by ``psse_record`` name (numbers;
+    REPCA1's circuit id ``_CKT`` a string) and ``ctx`` the contract's context (``bus``, ``id``,
+    ``mbase``, ``sbase``, ``where``) plus ``gen_row`` (0-based gen-table row of the generator
+    (IBUS, ID)), ``names`` (model -> weakgrid name of the records already built at that generator,
+    e.g. ``{"REGCA1": "REGCA1_103_1"}``: the reader builds REGCA1 before REECA1/REECB1 and those
+    before REPCA1) and, for REPCA1 with a monitored branch, ``branch_row(from_bus, to_bus, ckt)`` ->
+    0-based branch row (PSS/E bus numbers, stripped circuit id).
+    """
 
     kind = "device"
     gen_shared = True        # with machines or other converters, by the shares gammap, gammaq
