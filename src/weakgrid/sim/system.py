@@ -93,14 +93,14 @@ def _registry():
     from .exciters import (AC8B, ESAC1A, ESDC1A, ESDC2A, ESST1A, ESST3A, ESST4B, EXAC1, EXAC4, EXST1,
                            IEEET1, IEEET3, IEEEVC, IEEEX1)
     from .governors import GAST, IEEEG1, IEESGO, TG2, TGOV1N
-    from .pss import PSS2A, PSS2B, ST2CUT, STAB1
+    from .pss import PSS2A, PSS2B, PSS2C, ST2CUT, STAB1
     from .renewables import WTARA1, WTDTA1, WTPTA1, WTTQA1
 
     return {c.__name__: c for c in (GENCLS, GENROU, EXDC2, SEXS, TGOV1, HYGOV, IEEEST,
                                     ESST3A, EXST1, IEEEX1, IEEET1, EXAC1, ESDC2A,
                                     ESST1A, ESAC1A, ESDC1A, IEEET3, ESST4B, EXAC4, AC8B, IEEEVC,
                                     IEEEG1, IEESGO, TG2, TGOV1N, GAST, ST2CUT)
-            + (STAB1, PSS2A, PSS2B)
+            + (STAB1, PSS2A, PSS2B, PSS2C)
             + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ESD1, ZIP)
             + (WTDTA1, WTARA1, WTPTA1, WTTQA1)    # after REECA1: the ANDES importer links in this order
             + (InfiniteBus, PVSource)}

@@ -45,11 +45,11 @@ from ..params import Param
 #: PSS/E input signal codes of the dual-input stabilizers.
 INPUT_CODES = {1: "rotor speed deviation", 2: "bus frequency deviation",
                3: "generator electrical power on MBASE", 4: "generator accelerating power",
-               5: "bus voltage", 6: "derivative of bus voltage"}
+               5: "bus voltage", 6: "derivative of bus voltage", 7: "compensated frequency (PSS2C)"}
 SUPPORTED_CODES = (1, 3, 5)
 _CODE_FIX = ("weakgrid provides input codes 1 (rotor speed deviation), 3 (electrical power on "
-             "MBASE) and 5 (bus voltage); 2 (bus frequency), 4 (accelerating power) and 6 (dV/dt) "
-             "are not available to stabilizers")
+             "MBASE) and 5 (bus voltage); 2 (bus frequency), 4 (accelerating power), 6 (dV/dt) and 7 "
+             "(compensated frequency) are not available to stabilizers")
 N_RTF = 8   # states of the ramp-tracking filter (M*N <= 8)
 
 
