@@ -158,6 +158,42 @@ def test_same_values_as_andes_psse_parser(dyr):
             assert m.line.v[0] is None and cls.psse_link(vals, _ctx(names=names))["terminal"]
 
 
+def _synthetic(model, icons):
+    """A record with distinct CONs (0.011, 0.022, ...): a field read at the wrong place shows."""
+    n = len(MODELS[model].psse_record) - len(icons)
+    return icons + [round(0.011 * (k + 1), 6) for k in range(n)]
+
+
+@andes_needed
+@pytest.mark.parametrize("ec", ["REECA1", "REECB1"])
+def test_same_field_order_as_andes_on_distinct_values(ec, tmp_path):
+    """Records whose CONs are all different, read by ``psse_record`` and by ANDES's parser: each
+    name gets the same number (REECA1's CON ``Vref1`` is ANDES's ``Vbias`` -> ``Vref1``)."""
+    andes = pytest.importorskip("andes")
+    if not (RENA / "ThreeBusRenewable.raw").exists():
+        pytest.skip("PSID's RENA files not vendored (tests/data/psid, branch psse-peer)")
+    icons = {"REGCA1": [1], "REECA1": [0, 1, 0, 1, 0, 1], "REECB1": [0, 1, 0, 1, 1],
+             "REPCA1": [0, 0, 0, "'1'", 1, 0, 1]}
+    recs = {m: _synthetic(m, icons[m]) for m in ("REGCA1", ec, "REPCA1")}
+    dyr = tmp_path / "synthetic.dyr"
+    dyr.write_text("102 'GENCLS' 1 0.0 0.0 /\n" + "".join(
+        f"103 '{m}' 1 " + " ".join(str(x) for x in f) + " /\n" for m, f in recs.items()))
+    andes.config_logger(stream_level=40)
+    ss = andes.load(str(RENA / "ThreeBusRenewable.raw"), addfile=str(dyr), setup=False, no_output=True,
+                    default_config=True)
+    names = {}
+    for bus, model, gid, fields in dyr_records(dyr.read_text()):
+        if model not in MODELS:
+            continue
+        cls = MODELS[model]
+        ours = cls.psse_params(_values(model, fields), _ctx(names=names))
+        names[model] = f"{model}_{bus}_{gid}"
+        m = ss.models[model]
+        for f in cls.psse_record:
+            if not f.startswith("_"):
+                assert ours[f] == float(getattr(m, f).v[0]), (model, f)
+
+
 @andes_needed
 def test_andes_route_accepts_busr_zero_as_local():
     """Regression: ANDES's PSS/E parser copies REECB1's ICON BUSR = 0 (PSS/E: local); the ANDES
