@@ -9,7 +9,8 @@ Library gives PSS/E's meaning:
 
 * REGCA1 ``Rrpwr`` is the "LVPL ramp rate limit (pu/s)", ``Iqrmax``/``Iqrmin`` the "upper/lower
   limit on rate of change for reactive current (pu/s)": limits on dIp/dt, dIq/dt. ANDES 2.0
-  applies them to ``Tg dI/dt`` (``rates_per_s = 0``), 1/Tg = 50 times faster with Tg = 0.02 s.
+  applies them to ``Tg dI/dt`` (``rates_per_s = 0``), 1/Tg = 50 times faster with Tg = 0.02 s
+  (PSID as well; its RENA cases never reach these limits, so PSS/E's results cannot decide).
 * REECA1/REECB1 ICON BUSR and REPCA1 ICON IREG: "0 for local"; ANDES's parser copies the 0.
 * REECB1: PSS/E's (and PSID's, which matches PSS/E's results) voltage PI regulates
   ``Vsel - Vt_filt`` and the current orders are divided by ``Vt_filt``; ANDES 2.0 feeds ``Vsel``

@@ -22,8 +22,11 @@ Rate limits: ANDES 2.0 applies ``Rrpwr``, ``Iqrmax``, ``Iqrmin`` to ``Tg dx/dt``
 the system base), so that with PSS/E's data (``Tg`` = 0.02 s) its current ramps 1/Tg = 50 times
 faster than PSS/E's, whose limits bound ``dIp/dt`` and ``dIq/dt`` in pu/s on MBASE (PSS/E Model
 Library, REGCA1: "Rrpwr: LVPL ramp rate limit (pu/s)", "Iqrmax/Iqrmin: upper/lower limit on rate
-of change for reactive current (pu/s)"). ``rates_per_s = 1`` gives PSS/E's meaning (set by the
-PSS/E reader, :meth:`psse_params`); the default 0 keeps ANDES's, as imported from ANDES.
+of change for reactive current (pu/s)"; WECC's REGC_A specification alike, typical Rrpwr = 10 pu/s:
+a 0.1-s recovery of the active current). ``rates_per_s = 1`` gives PSS/E's meaning (set by the
+PSS/E reader, :meth:`psse_params`); the default 0 keeps ANDES's, as imported from ANDES. (PSID
+clamps ``Ipcmd - Ip`` before dividing by ``Tg`` too; its PSS/E benchmark cases, with Rrpwr = 10
+and Iqrmax = 100, never reach the limits, so they do not tell the two readings apart.)
 
 Limits follow ANDES: the rate limits bound ``T dx/dt``; the upper limit LVPL of ``S0`` is
 an anti-windup limit that moves with ``S2``: a state that crosses it is *reset* to it and held
