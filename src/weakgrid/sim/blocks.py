@@ -163,6 +163,28 @@ class Washout:
         return np.where(self._on, (u - x) / self._Ts, 0.0)
 
 
+class WashoutBypass(Washout):
+    r"""Washout :math:`sT/(1+sT)` that is bypassed (output = input) when ``T = 0``.
+
+    The convention of the second washouts ``TW2``/``TW4`` of the IEEE 421.5 / PSS/E dual-input
+    stabilizers (PSS2A, PSS2B): a zero time constant removes the block. State ``x`` obeys
+    :math:`T\dot x = u - x` (derivative 0 when bypassed), output :math:`y = u - x`.
+
+    Parameters
+    ----------
+    T : array_like
+        Time constant [s] (>= 0; 0 bypasses the block).
+    """
+
+    def __init__(self, T):
+        super().__init__(T, T)
+
+    def output(self, x, u):
+        if self._all:
+            return u - x
+        return np.where(self._on, u - x, u)
+
+
 class Integrator:
     r"""Integrator :math:`K/s`, output = state.
 

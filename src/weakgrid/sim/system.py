@@ -94,7 +94,7 @@ def _registry():
                            IEEET1, IEEET3, IEEEVC, IEEEX1)
     from .governors import GAST, IEEEG1, IEESGO, TG2, TGOV1N
     from .governors import DEGOV, DEGOV1, GGOV1, PIDGOV, WPIDHY
-    from .pss import ST2CUT
+    from .pss import PSS2A, PSS2B, PSS2C, ST2CUT, STAB1
     from .renewables import WTARA1, WTDTA1, WTPTA1, WTTQA1
     from .exciters import ESAC6A, EXAC2, EXPIC1, SCRX, ST6B, ST8C
 
@@ -103,6 +103,7 @@ def _registry():
                                     ESST1A, ESAC1A, ESDC1A, IEEET3, ESST4B, EXAC4, AC8B, IEEEVC,
                                     IEEEG1, IEESGO, TG2, TGOV1N, GAST, ST2CUT)
             + (DEGOV1, DEGOV, PIDGOV, WPIDHY, GGOV1)
+            + (STAB1, PSS2A, PSS2B, PSS2C)
             + (REGCA1, REECA1, REECB1, REPCA1, PVD1, ESD1, ZIP)
             + (WTDTA1, WTARA1, WTPTA1, WTTQA1)    # after REECA1: the ANDES importer links in this order
             + (InfiniteBus, PVSource)

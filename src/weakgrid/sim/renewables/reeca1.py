@@ -142,22 +142,66 @@ class REECA1(Component):
         Param("kvs", 2.0, "pu/pu", "tracking gain of the V PI (ANDES config)", "nonneg"),
         Param("vdl_np", 1.0, "-", "VDL table also limits the non-priority current (1: WECC, 0: ANDES 2.0)",
               "nonneg"),
+        Param("rates_per_s", 0.0, "-", "1: dPmax, dPmin bound dPref/dt [pu/s on Sn] (PSS/E, WECC); "
+              "0: they bound tpfilt*dPref/dt (ANDES 2.0)", "flag"),
     )
+
+    #: PSS/E .dyr record after ``IBUS 'REECA1' ID`` (PSS/E Model Library, REECA1): ICONs BUSR (bus
+    #: of the voltage measurement, 0 = local), PFFLAG, VFLAG, QFLAG, PFLAG, PQFLAG; 45 CONs.
+    psse_record = ("_BUSR", "PFFLAG", "VFLAG", "QFLAG", "PFLAG", "PQFLAG",
+                   "Vdip", "Vup", "Trv", "dbd1", "dbd2", "Kqv", "Iqh1", "Iql1", "Vref0", "Iqfrz", "Thld",
+                   "Thld2", "Tp", "QMax", "QMin", "VMAX", "VMIN", "Kqp", "Kqi", "Kvp", "Kvi", "Vref1", "Tiq",
+                   "dPmax", "dPmin", "PMAX", "PMIN", "Imax", "Tpord",
+                   "Vq1", "Iq1", "Vq2", "Iq2", "Vq3", "Iq3", "Vq4", "Iq4",
+                   "Vp1", "Ip1", "Vp2", "Ip2", "Vp3", "Ip3", "Vp4", "Ip4")
+
+    @classmethod
+    def psse_params(cls, values, ctx):
+        """PSS/E record -> parameters. ``BUSR = 0`` (or the converter's own bus) is PSS/E's local
+        voltage measurement; another bus is refused (remote sensing is not implemented). The ramp
+        limits ``dPmax``, ``dPmin`` keep their PSS/E meaning (pu/s on MBASE:
+        ``rates_per_s = 1``); the current limiter is WECC's (``vdl_np = 1``, the default)."""
+        v = dict(values)
+        busr = v.pop("_BUSR")
+        if busr not in (0, ctx.bus):
+            raise DataError(ctx.where, "BUSR", busr,
+                            "remote voltage measurement (ICON 1) is not implemented; give 0 (local: the "
+                            "converter's terminal bus)")
+        v["rates_per_s"] = 1.0
+        return v
+
+    @classmethod
+    def psse_link(cls, values, ctx):
+        """Link of a PSS/E record: the REGCA1 of the same generator (IBUS, ID), by its weakgrid
+        name ``ctx.names["REGCA1"]`` (the records already built at that generator)."""
+        name = getattr(ctx, "names", {}).get(cls.controlled)
+        if name is None:
+            raise DataError(ctx.where, "ID", ctx.id,
+                            f"a {cls.__name__} drives the {cls.controlled} of its generator: give a "
+                            f"{cls.controlled} record for bus {ctx.bus} id '{ctx.id}'")
+        return {"reg": name}
     states = ("s0", "S1", "PIQ", "s4", "pfilt", "s5", "PIV")
     outputs = ("Ipcmd", "Iqcmd", "Ipmax", "Iqmax", "Iqinj", "Pord", "Volt_dip", "Qsel", "PIQ_y", "PIV_y",
                "fThld2", "s4_y", "Pref")
 
     # ------------------------------------------------------------------ import
     @classmethod
-    def andes_link(cls, m, k, dev_name, **_):
-        """Link of ANDES device ``k``: the weakgrid name of its converter (``reg``)."""
+    def andes_link(cls, m, k, dev_name, ss=None, **_):
+        """Link of ANDES device ``k``: the weakgrid name of its converter (``reg``).
+
+        ``busr`` empty is local sensing; so is ``busr = 0`` when the case has no bus 0: ANDES's
+        PSS/E parser copies the ICON BUSR, whose 0 is PSS/E's "local" (before, such a record was
+        refused as remote sensing)."""
         name = dev_name.get((cls.controlled, m.reg.v[k]))
         if name is None:
             if m.reg.v[k] in list(getattr(m.system, cls.controlled).idx.v):
                 return None      # its converter is out of service
             raise DataError(f"ANDES {cls.__name__} {m.idx.v[k]}", "reg", m.reg.v[k],
                             f"no {cls.controlled} with this idx; only {cls.controlled} converters are supported")
-        if getattr(m, "busr", None) is not None and m.busr.v[k] not in (None, ""):
+        busr = m.busr.v[k] if getattr(m, "busr", None) is not None else None
+        if busr == 0 and ss is not None and 0 not in list(ss.Bus.idx.v):
+            busr = None                              # PSS/E's BUSR = 0: local
+        if busr not in (None, ""):
             raise DataError(f"ANDES {cls.__name__} {m.idx.v[k]}", "busr", m.busr.v[k],
                             "remote voltage sensing is not supported; leave it empty")
         return {"reg": name}
@@ -211,7 +255,9 @@ class REECA1(Component):
         self.s0b = Lag(1.0, p["Trv"])
         self.S1b = Lag(1.0, p["Tp"])
         self.s4b = Lag(1.0, p["Tiq"])
-        self.pfb = LagRate(1.0, p["tpfilt"], p["dPmin"], p["dPmax"])
+        per_s = p["rates_per_s"] > 0      # PSS/E's dP/dt limits on the LagRate's tpfilt*dP/dt
+        self.pfb = LagRate(1.0, p["tpfilt"], np.where(per_s, p["dPmin"] * p["tpfilt"], p["dPmin"]),
+                           np.where(per_s, p["dPmax"] * p["tpfilt"], p["dPmax"]))
         self.s5b = Lag(1.0, p["Tpord"])
         self.PIQb = PITrackAW(p["Kqp"], p["Kqi"], p["kqs"])
         self.PIVb = PITrackAW(p["Kvp"], p["Kvi"], p["kvs"])
@@ -242,6 +288,17 @@ class REECA1(Component):
         return iq1, ip1
 
     # ------------------------------------------------- variant hooks (REECB1)
+    def _vdiv(self, v, s0y):
+        """Voltage dividing the power orders into currents: ``max(v, 0.01)``, the terminal
+        voltage (ANDES 2.0)."""
+        return np.where(v <= 0.01, 0.01, v)
+
+    def _piq0(self, v):
+        """Initial state of the Q PI (``Qerr = 0`` there): 0 (ANDES), or the nearest value within
+        its output limits ``[VMIN, VMAX]`` when 0 is outside them (a state outside its limits
+        is driven by the tracking anti-windup: no steady start)."""
+        return np.clip(0.0, self.p["VMIN"], self.p["VMAX"])
+
     def _qref0(self, v, vp):
         """Initial Q reference (ANDES: ``q0`` with QFLAG = 0, ``Vref1 - v0`` with QFLAG = 1)."""
         p = self.p
@@ -288,7 +345,7 @@ class REECA1(Component):
                             "voltage dip; widen the band")
         x[self.sl(0)] = v
         x[self.sl(1)] = self.p0
-        x[self.sl(2)] = 0.0
+        x[self.sl(2)] = self._piq0(v)
         qcpf = np.where(self.zp, self.q0, self.p0 * np.tan(self.pfaref0))
         pfsel = np.where(p["PFFLAG"] > 0, qcpf, self.Qref0)
         x[self.sl(3)] = pfsel / vp
@@ -314,7 +371,7 @@ class REECA1(Component):
         self._dip_prev = np.zeros(self.n, bool)
         self._t_thld = np.full(self.n, -np.inf)
         self._t_thld2 = np.full(self.n, -np.inf)
-        self._piq_hold = np.zeros(self.n)
+        self._piq_hold = x[self.sl(2)].copy()
         self._piv_hold = x[self.sl(6)].copy()
         self._ipmax_hold = ipmax.copy()
         self._s4_hold = pfsel / vp
@@ -337,8 +394,8 @@ class REECA1(Component):
         t = ctx.t
         dip = (v < p["Vdip"]) | (v > p["Vup"])
         run = ~dip
-        vp = np.where(v <= 0.01, 0.01, v)
         s0y = self.s0b.output(s0, v)
+        vp = self._vdiv(v, s0y)
         S1y = self.S1b.output(S1, Pe)
         # reactive power
         qref = self.Qref0 + qext

@@ -11,6 +11,16 @@ REECA1 without its voltage-dependent current limits (VDL1, VDL2), its post-dip s
 * ``Vsel = clip(PIQ, VMIN, VMAX)`` with VFLAG = 1, 0 with VFLAG = 0; the voltage PI's input is
   ``Vsel`` (QFLAG = 1); the initial Q reference is ``q0``.
 
+PSS/E's REECB1 (``wecc = 1``, set by the PSS/E reader): the current commands are the orders
+divided by the *filtered* voltage ``s0`` (``Ipcmd = Pord/s0``, ``Iqcmd = Q/s0`` with QFLAG = 0),
+not by the terminal voltage ``v`` as in ANDES 2.0; the voltage PI regulates the terminal
+voltage, its input is ``Vsel - s0`` (QFLAG = 1), with ``Vsel`` the Q PI's output (VFLAG = 1;
+limited to ``[VMIN, VMAX]``: a voltage reference, e.g. 0.9..1.05 pu in PSID's RENA and the WECC
+240-bus data; the Q PI starts at ``v0``) or the Q reference itself (VFLAG = 0: REPCA1 then sends
+a voltage reference; it starts at ``v0``). This is the structure PSID implements and matches to
+PSS/E's own results on its RENA cases. ANDES 2.0's ``Vsel`` without ``- s0`` cannot start in
+steady state with such ``VMIN > 0`` data (the V PI integrates ``Vsel >= VMIN``).
+
 The voltage-dip freeze of ``s4``, ``s5`` and the PI controllers is REECA1's: in a dip the PI
 outputs are held at their value at the last accepted point before it. ANDES 2.0 holds them at
 their value in the Newton iterate at which its dip flag switched, which after a network event
@@ -26,6 +36,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..component import Component
+from ..params import Param
 from .reeca1 import REECA1
 
 _ONLY_A = {"PFLAG", "Vref1", "Iqfrz", "Thld", "Thld2", "vdl_np"} | {
@@ -35,7 +46,18 @@ _ONLY_A = {"PFLAG", "Vref1", "Iqfrz", "Thld", "Thld2", "vdl_np"} | {
 class REECB1(REECA1):
     """Renewable energy electrical control model B (WECC); drives one REGCA1."""
 
-    params = tuple(p for p in REECA1.params if p.name not in _ONLY_A)
+    params = tuple(p for p in REECA1.params if p.name not in _ONLY_A) + (
+        Param("wecc", 0.0, "-", "1 PSS/E's REECB1 (the V PI regulates Vsel - s0; Vsel = PIQ, or the Q "
+              "reference with VFLAG = 0; currents = orders / s0), 0 ANDES 2.0 (V PI input Vsel = clip(PIQ "
+              "or 0); currents = orders / v)", "flag"),)
+
+    #: PSS/E .dyr record after ``IBUS 'REECB1' ID`` (PSS/E Model Library, REECB1; PSID's RENA and
+    #: the WECC 240-bus files): ICONs BUSR (0 = local), PFFLAG, VFLAG, QFLAG, PQFLAG — no PFLAG —
+    #: and 25 CONs. :meth:`REECA1.psse_params` / :meth:`REECA1.psse_link` apply.
+    psse_record = ("_BUSR", "PFFLAG", "VFLAG", "QFLAG", "PQFLAG",
+                   "Vdip", "Vup", "Trv", "dbd1", "dbd2", "Kqv", "Iqh1", "Iql1", "Vref0", "Tp", "QMax",
+                   "QMin", "VMAX", "VMIN", "Kqp", "Kqi", "Kvp", "Kvi", "Tiq", "dPmax", "dPmin", "PMAX",
+                   "PMIN", "Imax", "Tpord")
 
     def setup(self, system):
         Component.setup(self, system)
@@ -48,15 +70,37 @@ class REECB1(REECA1):
         shape = np.shape(s0)
         return np.broadcast_to(self.Imaxr, shape), np.broadcast_to(self.Imaxr, shape)
 
+    @classmethod
+    def psse_params(cls, values, ctx):
+        """As :meth:`REECA1.psse_params`, with PSS/E's reactive path (``wecc = 1``)."""
+        v = super().psse_params(values, ctx)
+        v["wecc"] = 1.0
+        return v
+
+    def _std(self):
+        return self.p["wecc"] > 0
+
+    def _vdiv(self, v, s0y):
+        # PSS/E: Ipcmd = Pord / Vt_filt, Iqcmd = Q / Vt_filt (the Trv-filtered voltage s0)
+        return np.where(self._std(), np.maximum(s0y, 0.01), super()._vdiv(v, s0y))
+
+    def _piq0(self, v):
+        p = self.p
+        # PSS/E: the Q PI's output is the voltage reference of the V PI: it starts at v0
+        return np.where(self._std(), np.clip(v, p["VMIN"], p["VMAX"]), super()._piq0(v))
+
     def _qref0(self, v, vp):
-        return self.q0.copy()
+        p = self.p
+        # PSS/E with VFLAG = 0, QFLAG = 1: the reference (plus REPCA1's Qext) is a voltage
+        return np.where(self._std() & (p["VFLAG"] <= 0) & (p["QFLAG"] > 0), v, self.q0)
 
     def _vsel(self, piq, pfsel):
         p = self.p
-        return np.clip(np.where(p["VFLAG"] > 0, piq, 0.0), p["VMIN"], p["VMAX"])
+        ands = np.clip(np.where(p["VFLAG"] > 0, piq, 0.0), p["VMIN"], p["VMAX"])
+        return np.where(self._std(), np.where(p["VFLAG"] > 0, piq, pfsel), ands)
 
     def _piv_input(self, vsel, s0y):
-        return np.where(self.p["QFLAG"] > 0, vsel, 0.0)
+        return np.where(self.p["QFLAG"] > 0, vsel - np.where(self._std(), s0y, 0.0), 0.0)
 
     def _iqinj(self, iqv, dip, t):
         return np.clip(iqv, self.p["Iql1"], self.p["Iqh1"])

@@ -18,6 +18,16 @@ Without an electrical control (REECA1) the commands are held at their initial va
 conventions are ANDES's: ``Iolim``, ``Iqrmax``, ``Iqrmin`` are currents on the device
 base ``Sn`` (converted by ``Sn/Sb``).
 
+Rate limits: ANDES 2.0 applies ``Rrpwr``, ``Iqrmax``, ``Iqrmin`` to ``Tg dx/dt`` (``Rrpwr`` on
+the system base), so that with PSS/E's data (``Tg`` = 0.02 s) its current ramps 1/Tg = 50 times
+faster than PSS/E's, whose limits bound ``dIp/dt`` and ``dIq/dt`` in pu/s on MBASE (PSS/E Model
+Library, REGCA1: "Rrpwr: LVPL ramp rate limit (pu/s)", "Iqrmax/Iqrmin: upper/lower limit on rate
+of change for reactive current (pu/s)"; WECC's REGC_A specification alike, typical Rrpwr = 10 pu/s:
+a 0.1-s recovery of the active current). ``rates_per_s = 1`` gives PSS/E's meaning (set by the
+PSS/E reader, :meth:`psse_params`); the default 0 keeps ANDES's, as imported from ANDES. (PSID
+clamps ``Ipcmd - Ip`` before dividing by ``Tg`` too; its PSS/E benchmark cases, with Rrpwr = 10
+and Iqrmax = 100, never reach the limits, so they do not tell the two readings apart.)
+
 Limits follow ANDES: the rate limits bound ``T dx/dt``; the upper limit LVPL of ``S0`` is
 an anti-windup limit that moves with ``S2``: a state that crosses it is *reset* to it and held
 there while its input pushes up (the integrator's non-windup limits, refreshed at every Newton
@@ -45,7 +55,19 @@ from ..params import Param
 
 class REGCA1(Component):
     """Renewable generator/converter model A (WECC) on a static generator row (or its share of it:
-    ``gammap``, ``gammaq``)."""
+    ``gammap``, ``gammaq``).
+
+    PSS/E reader interface (REGCA1, REECA1, REECB1, REPCA1 alike): ``psse_record`` (ICONs first;
+    names starting with ``_`` are ICONs consumed by ``psse_params``/``psse_link``),
+    ``psse_params(values, ctx)`` -> parameters and ``psse_link(values, ctx)`` -> the link dict of
+    :meth:`Component.add`, with ``values`` the record's fields by ``psse_record`` name (numbers;
+    REPCA1's circuit id ``_CKT`` a string) and ``ctx`` the contract's context (``bus``, ``id``,
+    ``mbase``, ``sbase``, ``where``) plus ``gen_row`` (0-based gen-table row of the generator
+    (IBUS, ID)), ``names`` (model -> weakgrid name of the records already built at that generator,
+    e.g. ``{"REGCA1": "REGCA1_103_1"}``: the reader builds REGCA1 before REECA1/REECB1 and those
+    before REPCA1) and, for REPCA1 with a monitored branch, ``branch_row(from_bus, to_bus, ckt)`` ->
+    0-based branch row (PSS/E bus numbers, stripped circuit id).
+    """
 
     kind = "device"
     gen_shared = True        # with machines or other converters, by the shares gammap, gammaq
@@ -71,7 +93,30 @@ class REGCA1(Component):
         Param("gammaq", 1.0, "-", "share of the static generator's Q", "pos"),
         Param("LVPL_strict", 1.0, "-", "1: S0 never exceeds LVPL (reset whenever it crosses it); "
               "0: reset only while dS0/dt >= 0 (ANDES 2.0)", "flag"),
+        Param("rates_per_s", 0.0, "-", "1: Rrpwr, Iqrmax, Iqrmin bound dIp/dt, dIq/dt [pu/s on Sn] (PSS/E, "
+              "WECC); 0: they bound Tg*dIp/dt, Tg*dIq/dt, Rrpwr on the system base (ANDES 2.0)", "flag"),
     )
+
+    #: PSS/E .dyr record after ``IBUS 'REGCA1' ID``: ICON Lvplsw, then the 14 CONs (PSS/E Model
+    #: Library, REGCA1; the layout of PSID's RENA and the WECC 240-bus files).
+    psse_record = ("Lvplsw", "Tg", "Rrpwr", "Brkpt", "Zerox", "Lvpl1", "Volim", "Lvpnt1", "Lvpnt0",
+                   "Iolim", "Tfltr", "Khv", "Iqrmax", "Iqrmin", "Accel")
+
+    @classmethod
+    def psse_params(cls, values, ctx):
+        """PSS/E record -> parameters: ``Sn`` = the generator's MBASE; the rate limits ``Rrpwr``,
+        ``Iqrmax``, ``Iqrmin`` keep their PSS/E meaning (pu/s on MBASE: ``rates_per_s = 1``);
+        the record's CONs are otherwise the parameters (``Accel``, the network-interface
+        acceleration factor, has no effect on the model)."""
+        v = dict(values)
+        v["Sn"] = float(ctx.mbase)
+        v["rates_per_s"] = 1.0
+        return v
+
+    @classmethod
+    def psse_link(cls, values, ctx):
+        """Link of a PSS/E record: the gen-table row ``ctx.gen_row`` of its generator (IBUS, ID)."""
+        return {"gen": int(ctx.gen_row)}
     states = ("S0", "S1", "S2")
     outputs = ("Ipout", "Iqout", "Pe", "Qe", "LVG", "LVPL", "Ipcmd", "Iqcmd")
     units = {"Pe": "power", "Qe": "power"}
@@ -161,9 +206,15 @@ class REGCA1(Component):
             raise DataError(self.element(i), "Brkpt", p["Brkpt"][i],
                             f"the initial active current {self.Ipcmd0[i]:.4g} pu exceeds the LVPL limit "
                             f"{lvpl[i]:.4g} pu at {v[i]:.4g} pu; lower Brkpt or raise Lvpl1")
-        self.S0 = LagRate(1.0, p["Tg"], -np.inf, p["Rrpwr"])
-        self.S1 = LagRate(-1.0, p["Tg"], np.where(self.q0 < 0, p["Iqrmin"], -np.inf),
-                          np.where(self.q0 > 0, p["Iqrmax"], np.inf))
+        # rate limits on Tg*dx/dt (the LagRate convention): PSS/E's dx/dt limits times Tg, and
+        # PSS/E's Rrpwr (pu/s on Sn) on the system base of S0
+        per_s = p["rates_per_s"] > 0
+        rrpwr = np.where(per_s, p["Rrpwr"] * p["Tg"] * p["Sn"] / system.Sb, p["Rrpwr"])
+        iqrmax = np.where(per_s, p["Iqrmax"] * p["Tg"], p["Iqrmax"])
+        iqrmin = np.where(per_s, p["Iqrmin"] * p["Tg"], p["Iqrmin"])
+        self.S0 = LagRate(1.0, p["Tg"], -np.inf, rrpwr)
+        self.S1 = LagRate(-1.0, p["Tg"], np.where(self.q0 < 0, iqrmin, -np.inf),
+                          np.where(self.q0 > 0, iqrmax, np.inf))
         self.S2 = Lag(1.0, p["Tfltr"])
         x[self.sl(0)] = self.Ipcmd0
         x[self.sl(1)] = self.S1.init(self.Iqcmd0)

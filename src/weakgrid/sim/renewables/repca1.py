@@ -17,6 +17,12 @@ s; ``V`` is the voltage of the converter's bus, the line is the monitored branch
     fe --[PI Kpg, Kig (tracking anti-windup), Pmin..Pmax]--> s5 --[Lag 1/(1+sTg)]--> s6
     Pext = Fflag * s6
 
+Without a monitored line, ANDES 2.0 (and an ANDES import) takes ``Pline = Qline = 0``: the
+plant's Q/V and P loops then see no power at all. PSS/E's REPCA1 without a monitored branch
+(branch ICONs 0) regulates the generator's own output: the link ``terminal=True`` (set by the
+PSS/E reader, :meth:`psse_link`) takes ``Pline + jQline`` = the converter's ``Pe + jQe`` and
+``Iline`` = its current (as PSID does on its PSS/E benchmark cases, which it matches).
+
 The frequency ``f`` [pu] is measured at the converter's bus as ANDES's ``BusFreq`` does
 (angle lag ``Tf``, washout ``Tw``; the constants of the BusFreq named in ``busf`` or found at
 the bus, ANDES's defaults 0.02 s and 0.1 s otherwise). ``Rc``, ``Xc`` default to the monitored
@@ -84,6 +90,51 @@ class REPCA1(Component):
         Param("kqs", 2.0, "pu/pu", "Q PI tracking gain (ANDES config)", "nonneg"),
         Param("ksg", 2.0, "pu/pu", "P PI tracking gain (ANDES config)", "nonneg"),
     )
+    #: PSS/E .dyr record after ``IBUS 'REPCA1' ID`` (PSS/E Model Library, REPCA1; PSID's RENA and
+    #: the WECC 240-bus files): ICONs IREG (regulated bus, 0 = local), monitored branch FROM bus, TO
+    #: bus and circuit id (a quoted string), VCFlag, RefFlag, Fflag; 27 CONs (PSS/E's ``Tlag`` is
+    #: ``Tg``).
+    psse_record = ("_IREG", "_BUS1", "_BUS2", "_CKT", "VCFlag", "RefFlag", "Fflag",
+                   "Tfltr", "Kp", "Ki", "Tft", "Tfv", "Vfrz", "Rc", "Xc", "Kc", "emax", "emin", "dbd1",
+                   "dbd2", "Qmax", "Qmin", "Kpg", "Kig", "Tp", "fdbd1", "fdbd2", "femax", "femin", "Pmax",
+                   "Pmin", "Tg", "Ddn", "Dup")
+
+    @classmethod
+    def psse_params(cls, values, ctx):
+        """PSS/E record -> parameters: the ICONs of the link are dropped (see :meth:`psse_link`),
+        ``IREG`` must be 0 or the converter's bus (a remote regulated bus is not implemented);
+        ``PLflag = 1`` (PSS/E's REPCA1 always closes the plant power loop; it acts with
+        ``Fflag = 1``)."""
+        v = dict(values)
+        ireg = v.pop("_IREG")
+        if ireg not in (0, ctx.bus):
+            raise DataError(ctx.where, "IREG", ireg, "a remote regulated bus (ICON 1) is not implemented; "
+                            "give 0 (the converter's terminal bus)")
+        for f in ("_BUS1", "_BUS2", "_CKT"):
+            v.pop(f)
+        v["PLflag"] = 1.0
+        return v
+
+    @classmethod
+    def psse_link(cls, values, ctx):
+        """Link of a PSS/E record: the REECA1 or REECB1 of the same generator
+        (``ctx.names[...]``), and the monitored branch: none (``terminal=True``: the
+        converter's own output) when its FROM and TO buses are 0, else the 0-based branch row
+        ``ctx.branch_row(from_bus, to_bus, ckt)`` (the measured end is the converter's bus)."""
+        names = getattr(ctx, "names", {})
+        ree = names.get("REECA1") or names.get("REECB1")
+        if ree is None:
+            raise DataError(ctx.where, "ID", ctx.id, "a REPCA1 drives the REECA1 or REECB1 of its "
+                            f"generator: give one for bus {ctx.bus} id '{ctx.id}'")
+        b1, b2 = values["_BUS1"], values["_BUS2"]
+        if b1 == 0 and b2 == 0:
+            return {"ree": ree, "line": None, "terminal": True}
+        if b1 == 0 or b2 == 0:
+            raise DataError(ctx.where, "BUS1" if b1 == 0 else "BUS2", 0,
+                            "give both buses of the monitored branch (ICONs 2, 3), or 0 for both")
+        return {"ree": ree, "line": int(ctx.branch_row(int(b1), int(b2), str(values["_CKT"]).strip())),
+                "zline": False}
+
     states = ("s0", "s1", "s2", "s3", "s4", "s5", "s6", "L", "WO")
     outputs = ("Pext", "Qext", "f", "Pline", "Qline", "eHld", "fe", "s5_y")
 
@@ -154,6 +205,8 @@ class REPCA1(Component):
         self.b2 = np.zeros(self.n, int)
         self.isign = np.zeros(self.n)
         self.zl = np.ones(self.n, complex)
+        self.term = np.array([bool(lk.get("terminal")) for lk in self.links], bool)
+        self.r = np.zeros(self.n, int)        # REGCA1 of each plant control
         Sn = np.zeros(self.n)
         for i, lk in enumerate(self.links):
             ree = next((c for c in ecs if lk.get("ree") in c.names), None)
@@ -164,12 +217,16 @@ class REPCA1(Component):
             self.ree[i] = j
             self.ree_comps[i] = ree
             r = regc.names.index(ree.links[j]["reg"])
+            self.r[i] = r
             self.bus[i] = regc.bus[r]
             Sn[i] = regc.p["Sn"][r]
             row = lk.get("line")
             if row is None:
                 self.b1[i] = self.b2[i] = self.bus[i]
                 continue
+            if self.term[i]:
+                raise DataError(self.element(i), "terminal", True,
+                                "a plant control measures either a line or its converter's terminal")
             if not (0 <= int(row) < net.branch.shape[0]):
                 raise DataError(self.element(i), "line", row, "give a 0-based row of the branch table")
             br = net.branch[int(row)]
@@ -214,11 +271,15 @@ class REPCA1(Component):
         return out
 
     # ---------------------------------------------------------------- algebra
-    def _line(self, V):
+    def _line(self, V, PQ=None):
+        """Pline, Qline, VCsel, |V|; ``PQ`` = the converters' ``Pe + jQe`` (terminal measurement)."""
         V1, V2 = V[..., self.b1], V[..., self.b2]
         Vb = V[..., self.bus]
         I = self.isign * (V1 - V2) / self.zl
         S = self.isign * V1 * np.conj((V1 - V2) / self.zl)
+        if PQ is not None and self.term.any():
+            S = np.where(self.term, PQ, S)
+            I = np.where(self.term, np.conj(PQ / np.where(np.abs(Vb) > 1e-6, Vb, 1e-6)), I)
         Vc = np.abs(Vb - (self.p["Rc"] + 1j * self.p["Xc"]) * I)
         v = np.abs(Vb)
         vcsel = np.where(self.p["VCFlag"] > 0, Vc, S.imag * self.p["Kc"] + v)
@@ -227,7 +288,7 @@ class REPCA1(Component):
     def init(self, system, x, sig):
         V = system.network.pf.V
         self.V0 = V[self.bus].copy()
-        P, Q, vcsel, v = self._line(V)
+        P, Q, vcsel, v = self._line(V, self.regc.p0[self.r] + 1j * self.regc.q0[self.r])
         self.Pline0, self.Qline0, self.Vref0 = P, Q, vcsel
         for i in np.nonzero(v < self.p["Vfrz"])[0]:
             raise DataError(self.element(i), "Vfrz", self.p["Vfrz"][i],
@@ -244,7 +305,8 @@ class REPCA1(Component):
         x = ctx.x
         sl = self._sls
         s0, s1, s2, s3, s4, s5, s6, L, wo = (x[..., sl[k]] for k in range(9))
-        P, Q, vcsel, v = self._line(ctx.V)
+        r = self.r
+        P, Q, vcsel, v = self._line(ctx.V, ctx.sig["REGCA1.Pe"][..., r] + 1j * ctx.sig["REGCA1.Qe"][..., r])
         # frequency at the bus (ANDES BusFreq): angle lag and washout
         Vb = ctx.V[..., self.bus]
         err = np.angle(Vb * np.conj(self.V0) * np.exp(-1j * L))

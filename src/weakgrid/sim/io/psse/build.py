@@ -6,8 +6,10 @@ through its ``psse_record`` (field order, PSS/E's ICONs then CONs) and ``psse_pa
 model weakgrid lacks (no registry class, or one without ``psse_record``) is never dropped nor
 replaced: all of them are listed, by bus, id and model, in one :class:`DataError`. Controls
 (exciters, compensators, stabilizers, governors) attach to the machine at ``(IBUS, ID)`` by their
-class's ``kind``; a ``device`` model (a converter) declares ``psse_link(values, ctx, gen_row=,
-devices=, system=, maps=)`` returning its link (e.g. ``{"gen": row}``).
+class's ``kind``; a ``device`` model (a converter) declares ``psse_link(values, ctx)`` returning
+its link (e.g. ``{"gen": ctx.gen_row}``), with ``ctx`` (:class:`PsseContext`) carrying the
+generator's row, the names of the records already built at it and a branch look-up; devices
+are built in the registry's order (REGCA1, then REECA1/REECB1, then REPCA1).
 
 PSS/E conventions kept:
 
@@ -215,7 +217,10 @@ def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = 
     for kind in _CONTROL_KINDS:
         for r in by_kind.get(kind, []):
             b.control(r, reg[r.model], kind)
-    for r in by_kind.get("device", []):
+    # devices in the registry's order: a converter (REGCA1) before its electrical control
+    # (REECA1, REECB1), before the plant controller (REPCA1), whatever the file's order
+    order = {name: k for k, name in enumerate(reg)}
+    for r in sorted(by_kind.get("device", []), key=lambda r: order[r.model]):
         b.device(r, reg[r.model])
     b.static_generators(static_gens)
     b.finish(dyr)
@@ -312,14 +317,29 @@ class _Builder:
         if link_fn is None:
             raise DataError(r.where, "MODEL", r.model, f"{r.model} cannot be linked from a .dyr "
                             "record (its class has no psse_link)")
-        link = link_fn(_values(r, cls), ctx, gen_row=self.maps.gen_row, devices=self.devices,
-                       system=self.system, maps=self.maps)
+        import dataclasses
+
+        names = {m: n for (m, b, i), n in self.devices.items() if (b, i) == key}
+        ctx = dataclasses.replace(ctx, gen_row=self.maps.gen_row[key], names=names,
+                                  branch_row=self._branch_row)
+        link = link_fn(_values(r, cls), ctx)
         params = _params(r, cls, ctx)
         name = f"{r.model}_{r.bus}_{r.id}"
         with _at(r):
             self.system._component(r.model, "device").add(name, link, params)
         self.devices[(r.model, r.bus, r.id)] = name
         self.machines.setdefault(key, name)
+
+    def _branch_row(self, i, j, ckt):
+        """0-based branch row of the PSS/E branch (i, j, ckt), in either direction."""
+        key = str(ckt).strip()
+        for a, b in ((i, j), (j, i)):
+            for (fi, fj, c), row in self.maps.branch_row.items():
+                if (fi, fj) == (a, b) and str(c).strip() == key:
+                    return row
+        raise DataError("PSS/E case", "branch", f"{i}-{j}-{ckt}",
+                        "no such branch in the .raw (give FROM, TO and the circuit id of a "
+                        "non-transformer branch)")
 
     def static_generators(self, static_gens):
         """In-service generators without a machine or converter: as ANDES simulates them."""

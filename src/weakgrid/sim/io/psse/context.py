@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Callable
 
 
 @dataclass(frozen=True)
@@ -27,6 +28,13 @@ class PsseContext:
         Nominal frequency ``BASFRQ`` [Hz].
     where : str
         ``"file.dyr line 12, GENROU at bus 102 id '1'"``, for error messages.
+    gen_row : int or None
+        0-based gen-table row of the generator (IBUS, ID) (for a device's ``psse_link``).
+    names : dict
+        ``{model: weakgrid name}`` of the records already built at that generator (a converter's
+        controls link to its REGCA1, a plant controller to its electrical control).
+    branch_row : callable or None
+        ``branch_row(from_bus, to_bus, ckt) -> 0-based branch row`` (a monitored branch).
     """
 
     bus: int
@@ -37,3 +45,6 @@ class PsseContext:
     kv: float
     fn: float
     where: str
+    gen_row: int | None = None
+    names: dict = field(default_factory=dict)
+    branch_row: Callable | None = None
