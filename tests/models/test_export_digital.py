@@ -1,0 +1,132 @@
+"""The exported digital controller (C step function, FMU) equals the Python controller along a
+closed-loop run of a shipped study.
+
+The run: case 2 (SG behind a UPQC, islanded LV microgrid), scenario c2-high-f200 (0.2-s fault
+at the UPQC bus, the controller bypassed during it), the HJI controller, the shipped rating
+0.1 pu. The Python DigitalController's samples are recorded (measured signals, demanded and
+applied u); the same measured signals are fed to the C step function and to the FMU. Along
+this run the rating clip acts on ~1/3 of the post-fault samples and 200 samples are bypassed.
+"""
+
+import ctypes
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+from weakgrid.models.export_digital import generate_digital_c, spec_from_setup
+from weakgrid.sim.upqc import rating_clip
+from weakgrid.study.build import build_setup
+from weakgrid.study.controllers import train_hji
+from weakgrid.study.runner import Run, run_scenario
+from weakgrid.study.studyfile import load_study
+
+CC = shutil.which("gcc")
+needs_gcc = pytest.mark.skipif(CC is None, reason="gcc is not installed: the C controller and "
+                                                  "the FMU cannot be compiled")
+DP = ctypes.POINTER(ctypes.c_double)
+T_END = 3.5
+TOL = 1e-9
+
+
+@pytest.fixture(scope="module")
+def closed_loop():
+    """The recorded closed-loop run, the trained controller and its digital spec."""
+    study = load_study("case2-lv-microgrid")
+    sc = next(s for s in study.scenarios() if s["id"] == "c2-high-f200")
+    run = Run.of(study, dict(sc, t_end=T_END), "hji")
+    setup = build_setup(study, run.load, run.upqc)
+    _, ctl = train_hji(study, setup.design)
+    rec = run_scenario(study, run, trained={(run.load, run.upqc): ctl})
+    assert not rec.metrics["failed"]
+    spec = spec_from_setup(setup, bypass=run.bypass)
+    return rec, ctl, spec
+
+
+def compile_digital(ctl, spec, tmp_path, name="c2"):
+    files = generate_digital_c(ctl, spec, name, "test")
+    for f, text in files.items():
+        (tmp_path / f).write_text(text)
+    lib = tmp_path / f"lib{name}.so"
+    r = subprocess.run([CC, "-std=c99", "-O2", "-Wall", "-Wextra", "-pedantic", "-Werror",
+                        "-fPIC", "-shared", "-o", str(lib), str(tmp_path / f"{name}.c"),
+                        str(tmp_path / f"{name}_law.c"), "-lm"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    return ctypes.CDLL(str(lib))
+
+
+class CController:
+    """ctypes driver of NAME_init/NAME_step (the state struct in an opaque buffer)."""
+
+    def __init__(self, lib, name):
+        self.init, self.step_fn = getattr(lib, f"{name}_init"), getattr(lib, f"{name}_step")
+        self.s = ctypes.create_string_buffer(4096)
+        assert self.init(self.s, None) == 0
+
+    def step(self, meas):
+        m = np.ascontiguousarray(meas, float)
+        u = np.zeros(2)
+        rc = self.step_fn(self.s, m.ctypes.data_as(DP), u.ctypes.data_as(DP))
+        return rc, u
+
+
+def recorded(rec, n_signals):
+    """Per sample: measured signals (arbitrary while bypassed: the controller ignores them),
+    enable = 1, Python's active flag, demanded and applied u."""
+    s = rec.series
+    y = s["y_measured"]
+    active = np.all(np.isfinite(y), axis=1)
+    y = np.where(np.isfinite(y), y, 0.0)
+    meas = np.hstack([y, np.ones((len(y), 1))])
+    assert meas.shape[1] == n_signals + 1
+    return s["tk"], meas, active, s["u_demanded"], s["u_applied"]
+
+
+def test_the_run_exercises_the_clip_and_the_bypass(closed_loop):
+    rec, ctl, spec = closed_loop
+    tk, _, active, ud, ua = recorded(rec, 3)
+    assert (~active).sum() >= 150                       # 0.2 s bypassed at T = 1 ms
+    clipped = np.hypot(ud[:, 0], ud[:, 1]) > spec.Vmax * (1 + 1e-6)
+    assert clipped.sum() >= 50 and np.abs(ua - ud)[clipped].max() > 1e-2
+    np.testing.assert_array_equal(ua, rating_clip(ud, spec.Vmax))
+    assert spec.Vmax == 0.1 and spec.bypass == [(3.0, 3.2)]
+
+
+@needs_gcc
+def test_c_step_equals_the_python_controller_in_closed_loop(closed_loop, tmp_path):
+    rec, ctl, spec = closed_loop
+    tk, meas, active, ud, ua = recorded(rec, 3)
+    c = CController(compile_digital(ctl, spec, tmp_path), "c2")
+    U = np.zeros_like(ua)
+    rc = np.zeros(len(tk), int)
+    for k in range(len(tk)):
+        rc[k], U[k] = c.step(meas[k])
+    np.testing.assert_array_equal(rc == 0, active)      # same samples bypassed
+    err = np.abs(U - ua).max()
+    print(f"C vs Python, {len(tk)} samples: max |u_C - u_Python| = {err:.3g} pu")
+    assert err <= TOL
+    # without the clip the C law equals the demanded u (clip off: Vmax <= 0)
+    spec0 = type(spec)(spec.state_map, None, spec.bypass)
+    c0 = CController(compile_digital(ctl, spec0, tmp_path, "c2n"), "c2n")
+    U0 = np.array([c0.step(m)[1] for m in meas])
+    assert np.abs(U0[active] - ud[active]).max() <= TOL
+
+
+@needs_gcc
+def test_c_step_enable_input_and_fail_safe(closed_loop, tmp_path):
+    rec, ctl, spec = closed_loop
+    tk, meas, active, ud, ua = recorded(rec, 3)
+    c = CController(compile_digital(ctl, spec, tmp_path), "c2")
+    k = int(np.nonzero(active & (np.hypot(ud[:, 0], ud[:, 1]) > 0.05))[0][0])
+    for j in range(k):
+        c.step(meas[j])
+    off = meas[k].copy()
+    off[-1] = 0.0                                      # external disable: bypass output
+    assert c.step(off) == (1, pytest.approx([0.0, 0.0]))
+    bad = meas[k + 1].copy()
+    bad[0] = np.nan                                    # a lost measurement: fail-safe
+    rc, u = c.step(bad)
+    assert rc == -1 and np.all(u == 0.0)
+    rc, u = c.step(meas[k + 2])                        # the clock kept counting
+    assert rc == 0 and np.abs(u - ua[k + 2]).max() <= TOL
