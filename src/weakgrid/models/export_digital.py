@@ -373,8 +373,9 @@ def fmu_block(controller, spec: DigitalSpec, name: str) -> dict:
             "defaults": f"{name}_default_params(&c->par);",
             "init": f"{name}_init(&c->st, &c->par)",
             "sample": f"{name}_step(&c->st, c->meas, c->out)",
-            "t0": "c->par.t0",
+            "next_time": f"c->st.p.t0 + (double)c->st.k * {name.upper()}_T",
             "after_sample": "c->active_out = c->st.active ? 1.0 : 0.0;",
+            "extra_fields": "double active_out;", "extra_reset": "c->active_out = 0.0;",
             "variables": vars_,
             "description": f"weakgrid digital UPQC controller {name} "
                            f"({spec.state_map.machine}, T = {controller.system.T:g} s)"}
