@@ -221,3 +221,44 @@ def test_fmu_simulated_by_fmpy_with_input_signals(closed_loop, fmu_file):
                        start_values={"Vmax": 0.05})
     got = np.column_stack([res["Vup"], res["Vuq"]])
     assert np.abs(got[1:] - rating_clip(ud[:-1], 0.05)).max() <= TOL
+
+
+@needs_gcc
+def test_cli_writes_the_validated_controller(closed_loop, tmp_path, capsys):
+    """`weakgrid export --study --scenario` writes the C checked above, and its FMU."""
+    from weakgrid.cli.main import main
+
+    rec, ctl, spec = closed_loop
+    f = tmp_path / "c2hji.controller.json"
+    ctl.save(f)
+    args = ["export", str(f), "--study", "case2-lv-microgrid", "--scenario", "c2-high-f200"]
+    assert main(args + ["--format", "c"]) == 0
+    from weakgrid import __version__
+
+    prov = f"From {f.name} (weakgrid {__version__}; model kind upqc-design)."
+    for k, text in generate_digital_c(ctl, spec, "c2hji", prov).items():
+        assert (tmp_path / k).read_text() == text, k
+    out = capsys.readouterr().out
+    assert "angle0" in out and "|u| <= 0.1 pu" in out and "(3.0, 3.2)" in out
+    pytest.importorskip("fmpy", reason="FMPy is the optional extra 'fmu'")
+    from fmpy.validation import validate_fmu
+
+    assert main(args + ["--format", "fmu", "-d", str(tmp_path / "fmu")]) == 0
+    assert validate_fmu(str(tmp_path / "fmu" / "c2hji.fmu")) == []
+
+
+def test_cli_refuses_incomplete_constants(trained_presets, tmp_path, capsys):
+    from weakgrid.cli.main import main
+
+    _, ctl = trained_presets["case2-paper"]
+    f = tmp_path / "p.controller.json"
+    ctl.save(f)
+    assert main(["export", str(f)]) == 2
+    assert "ws" in capsys.readouterr().err
+    assert main(["export", str(f), "--param", "ws=314.1592653589793", "--rating", "0.1",
+                 "--bypass", "3.0:3.1"]) == 0
+    h = (tmp_path / "p.h").read_text()
+    assert "p_step" in h and "meas[2]  omega" in h
+    assert "p->bypass[0][1] = 3.1;" in (tmp_path / "p.c").read_text()
+    assert main(["export", str(f), "--param", "ws=1", "--bypass", "3.1"]) == 2
+    assert main(["export", str(f), "--param", "tau=1", "--param", "ws=1"]) == 2

@@ -130,12 +130,12 @@ def spec_from_design(model, values=None, bypass=(), rating=None) -> DigitalSpec:
         cls = SGStateMap
     unknown = set(values) - set(defaults)
     if unknown:
-        raise ParameterError("param", sorted(unknown)[0],
+        raise ParameterError("--param", sorted(unknown)[0],
                              f"the {model.machine} measurement mapping has {sorted(defaults)}")
     for k, (v, why) in defaults.items():
         if k not in values:
             if v is None:
-                raise ParameterError("param", k, f"the controller file does not record {k}: "
+                raise ParameterError("--param", k, f"the controller file does not record {k}: "
                                      f"give --param {k}=VALUE or --study STUDY")
             values[k] = float(v)
             origin[k] = why
