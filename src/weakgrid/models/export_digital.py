@@ -101,7 +101,8 @@ def spec_from_setup(setup, bypass=(), rating=None) -> DigitalSpec:
         r_from = f"{where}: upqc.rating"
     else:
         r_from = "given" if rating is not None else "none"
-    origin = {k: f"{where}: operating point of {setup.source}" for k in setup.state_map.values()}
+    origin = {k: f"{where}: {setup.machine.upper()} {setup.source} at its operating point"
+              for k in setup.state_map.values()}
     origin.update(Vmax=r_from, bypass="given" if bypass else "none")
     return DigitalSpec(setup.state_map, rating, list(bypass), origin=origin)
 
