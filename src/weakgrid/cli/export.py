@@ -49,8 +49,9 @@ def add_parser(sub):
     g.add_argument("--scenario", default=None,
                    help="scenario of --study whose bypass windows the controller keeps")
     g.add_argument("--rating", type=positive_float, default=None,
-                   help="UPQC series-voltage rating |Vu|max [pu] (default: --study's "
-                        "upqc.rating, else the controller's input bound, else no clip)")
+                   help="UPQC rating: the largest series-voltage magnitude [pu] (default: "
+                        "--study's upqc.rating, else the controller's input bound, else no "
+                        "clip)")
     g.add_argument("--bypass", action="append", default=None, metavar="START:END",
                    help="a bypass window [START, END) in s (repeatable)")
     g.add_argument("--param", action="append", default=None, metavar="NAME=VALUE",
