@@ -276,3 +276,23 @@ def test_cli_refuses_incomplete_constants(trained_presets, tmp_path, capsys):
     assert "p->bypass[0][1] = 3.1;" in (tmp_path / "p.c").read_text()
     assert main(["export", str(f), "--param", "ws=1", "--bypass", "3.1"]) == 2
     assert main(["export", str(f), "--param", "tau=1", "--param", "ws=1"]) == 2
+    assert main(["export", str(f), "--param", "ws=1", "--load", "high"]) == 2   # needs --study
+    capsys.readouterr()
+
+
+def test_cli_refuses_a_model_without_a_digital_upqc_controller(tmp_path, capsys):
+    from weakgrid.cli.main import main
+    from weakgrid.game import (GameCost, GridMesh, LinearPolicy, LinearSystem, dlqr,
+                               even_monomials, solve_hji)
+
+    A, B, E = np.array([[1.0, 0.01], [-0.1, 0.99]]), np.eye(2), 0.1 * np.ones((2, 1))
+    s = LinearSystem(A, B, E)
+    K, _, _ = dlqr(A, B, np.eye(2), np.eye(2))
+    ctl = solve_hji(s, even_monomials(2, 2), GameCost.for_system(s, np.eye(2), np.eye(2),
+                                                                 np.eye(1), 5.0),
+                    GridMesh([-1] * 2, [1] * 2, [0.5] * 2), LinearPolicy(K))
+    f = tmp_path / "lin.controller.json"
+    ctl.save(f)
+    assert main(["export", str(f), "--format", "c"]) == 2
+    assert "c-law" in capsys.readouterr().err
+    assert main(["export", str(f), "--format", "c-law"]) == 0

@@ -96,8 +96,9 @@ def _params(items):
 def digital_spec(ctl, args):
     """The digital controller's constants from the command line (see the help)."""
     from ..game.errors import ParameterError
-    from ..models.export_digital import spec_from_design, spec_from_setup
+    from ..models.export_digital import check_exportable, spec_from_design, spec_from_setup
 
+    check_exportable(ctl)
     bypass = [_window(b) for b in args.bypass or ()]
     rating = args.rating
     if rating is None and args.study is None:

@@ -25,7 +25,7 @@ from ..game.export_c import c_literal, generate_c, valid_c_name
 from ..sim.design_states import GTIStateMap, SGStateMap
 
 __all__ = ["DigitalSpec", "MAX_BYPASS", "generate_digital_c", "fmu_block",
-           "spec_from_setup", "spec_from_design"]
+           "spec_from_setup", "spec_from_design", "check_exportable"]
 
 #: Capacity of the bypass-window table in the parameter struct.
 MAX_BYPASS = 8
@@ -146,14 +146,16 @@ def spec_from_design(model, values=None, bypass=(), rating=None) -> DigitalSpec:
                        origin=origin)
 
 
-def _check(controller, spec):
+def check_exportable(controller, spec=None):
+    """Refuse controllers that are not of the design model (10), or of another machine than
+    ``spec``'s mapping."""
     system = controller.system
     if getattr(system, "kind", None) != "upqc-design":
         raise ParameterError("model.kind", getattr(system, "kind", None),
                              "the digital UPQC controller needs a controller of the design "
                              "model (10) ('upqc-design'); export the law alone with --format "
                              "c-law")
-    if spec.state_map.machine != system.machine:
+    if spec is not None and spec.state_map.machine != system.machine:
         raise ParameterError("machine", spec.state_map.machine,
                              f"the controller is designed for a {system.machine}")
 
@@ -161,8 +163,8 @@ def _check(controller, spec):
 def _signals(spec):
     m = spec.state_map
     return list(m.signals) + [("enable", "-", "1: controller enabled, 0: bypass (e.g. a "
-                                                "protection's fault-detect); any other value "
-                                                "counts as 1")]
+                                                "protection's fault-detect); other finite "
+                                                "values count as 1, non-finite as 0")]
 
 
 def generate_digital_c(controller, spec: DigitalSpec, name: str,
@@ -174,7 +176,7 @@ def generate_digital_c(controller, spec: DigitalSpec, name: str,
     ``NAME_value``).
     """
     name = valid_c_name(name)
-    _check(controller, spec)
+    check_exportable(controller, spec)
     law = f"{name}_law"
     law_c, law_h = generate_c(controller, name, provenance, file=law)
     T = controller.system.T
@@ -296,7 +298,7 @@ int {name}_step({name}_state *s, const double meas[{up}_N_MEAS], double u_out[{u
 {{
     const {name}_params *p = &s->p;
     const double t = p->t0 + (double)s->k * {up}_T;   /* this sample's time */
-    int active = meas[{n_meas - 1}] != 0.0;
+    int active = isfinite(meas[{n_meas - 1}]) && meas[{n_meas - 1}] != 0.0;
     for (int i = 0; i < p->n_bypass; ++i)
         if (p->bypass[i][0] <= t && t < p->bypass[i][1]) active = 0;
     s->t = t;
@@ -340,7 +342,7 @@ def fmu_block(controller, spec: DigitalSpec, name: str) -> dict:
     """The digital controller described for :func:`weakgrid.fmu.build_fmu`."""
     from ..fmu import FmuVar
 
-    _check(controller, spec)
+    check_exportable(controller, spec)
     sig = _signals(spec)
     vars_ = []
     for i, (n, u, d) in enumerate(sig):
