@@ -27,6 +27,8 @@ from weakgrid.study.controllers import train_hji
 from weakgrid.study.runner import Run, run_scenario
 from weakgrid.study.studyfile import load_study
 
+# FMPy is in the extras 'fmu' and 'test': these tests need it; they are skipped only where gcc
+# is missing (the C controller and the FMU are then not compiled)
 CC = shutil.which("gcc")
 needs_gcc = pytest.mark.skipif(CC is None, reason="gcc is not installed: the C controller and "
                                                   "the FMU cannot be compiled")
@@ -146,7 +148,6 @@ def test_c_step_enable_input_and_fail_safe(closed_loop, tmp_path):
 
 @pytest.fixture(scope="module")
 def fmu_file(closed_loop, tmp_path_factory):
-    pytest.importorskip("fmpy", reason="FMPy is the optional extra 'fmu'")
     if CC is None:
         pytest.skip("gcc is not installed: the FMU cannot be compiled")
     from weakgrid.fmu import build_fmu
@@ -254,7 +255,6 @@ def test_cli_writes_the_validated_controller(closed_loop, tmp_path, capsys):
     out = capsys.readouterr().out
     assert f"|u| <= {spec.Vmax:g} pu" in out and str(spec.bypass[0]) in out
     assert all(k in out for k in spec.state_map.values())
-    pytest.importorskip("fmpy", reason="FMPy is the optional extra 'fmu'")
     from fmpy.validation import validate_fmu
 
     assert main(args + ["--format", "fmu", "-d", str(tmp_path / "fmu")]) == 0
