@@ -102,7 +102,7 @@ def main():
     what = "digital controller step" if args.digital else "C saddle point"
     print(f"exported {what} of {label}: median {statistics.median(ns):.1f} ns per "
           f"evaluation (min {min(ns):.1f}, max {max(ns):.1f}; {args.repeats} repeats of "
-          f"{args.calls} calls; gcc -O2; goal ≤ 100 ns)")
+          f"{args.calls} calls; gcc -O2{'' if args.digital else '; goal ≤ 100 ns'})")
 
 
 DIGITAL = HARNESS.replace("double u[NAME_UP_N_CONTROLS], w[NAME_UP_N_DISTURBANCES], sink = 0.0;",
