@@ -7,7 +7,9 @@ The runs, HJI controller, shipped ratings, the controller bypassed during the fa
   UPQC bus, 3.0-3.2 s), to 3.5 s: the rating clip (0.1 pu) acts on ~1/3 of the post-fault
   samples, 200 samples are bypassed;
 * case 1 (GTI with dc link behind a UPQC, weak grid), scenario c1-high-conv (fault 0.2-0.25 s),
-  to 0.5 s: the GTI mapping (ϕs, Vc), clipped at 0.15 pu after the fault.
+  to 0.5 s: the GTI mapping (ϕs, Vc), clipped at 0.15 pu after the fault; and the same with
+  the rating-aware HJI controller (the rating as its input bound: the bounded law's Newton
+  iteration in C, inside the rating so the clip does not act).
 
 The Python DigitalController's samples are recorded (measured signals, demanded and applied u);
 the same measured signals are fed to the C step function and to the FMU.
@@ -23,7 +25,7 @@ import pytest
 from weakgrid.models.export_digital import generate_digital_c, spec_from_setup
 from weakgrid.sim.upqc import rating_clip
 from weakgrid.study.build import build_setup
-from weakgrid.study.controllers import train_hji
+from weakgrid.study.controllers import design_problem, train_hji
 from weakgrid.study.runner import Run, run_scenario
 from weakgrid.study.studyfile import load_study
 
@@ -34,19 +36,24 @@ needs_gcc = pytest.mark.skipif(CC is None, reason="gcc is not installed: the C c
                                                   "the FMU cannot be compiled")
 DP = ctypes.POINTER(ctypes.c_double)
 TOL = 1e-9
-CASES = {"c2": ("case2-lv-microgrid", "c2-high-f200", 3.5),
-         "c1": ("case1-weak-grid", "c1-high-conv", 0.5)}
+# (study, scenario, t_end, HJI trained with the rating as its input bound)
+CASES = {"c2": ("case2-lv-microgrid", "c2-high-f200", 3.5, False),
+         "c1": ("case1-weak-grid", "c1-high-conv", 0.5, False),
+         "c1-bounded": ("case1-weak-grid", "c1-high-conv", 0.5, True)}
 
 
 @pytest.fixture(scope="module", params=sorted(CASES))
 def closed_loop(request):
     """The recorded closed-loop run, the trained controller and its digital spec."""
-    name, scenario, t_end = CASES[request.param]
+    name, scenario, t_end, bounded = CASES[request.param]
     study = load_study(name)
     sc = next(s for s in study.scenarios() if s["id"] == scenario)
     run = Run.of(study, dict(sc, t_end=t_end), "hji")
     setup = build_setup(study, run.load, run.upqc)
-    _, ctl = train_hji(study, setup.design)
+    if bounded:     # the rating-aware controller (kind hji-bounded) in the hji slot
+        ctl = design_problem(study, setup.design).with_rating(study.get("upqc.rating")).train()
+    else:
+        _, ctl = train_hji(study, setup.design)
     rec = run_scenario(study, run, trained={(run.load, run.upqc): ctl})
     assert not rec.metrics["failed"]
     spec = spec_from_setup(setup, bypass=run.bypass)
@@ -101,8 +108,12 @@ def test_the_run_exercises_the_clip_and_the_bypass(closed_loop):
     tk, _, active, ud, ua = recorded(rec, spec)
     (a, b), = spec.bypass
     assert abs((~active).sum() - (b - a) / ctl.system.T) <= 1     # the fault bypassed
-    clipped = np.hypot(ud[:, 0], ud[:, 1]) > spec.Vmax * (1 + 1e-6)
-    assert clipped.sum() >= 20 and np.abs(ua - ud)[clipped].max() > 1e-2
+    mag = np.hypot(ud[:, 0], ud[:, 1])
+    clipped = mag > spec.Vmax * (1 + 1e-6)
+    if getattr(ctl.cost, "bound", None) is None:
+        assert clipped.sum() >= 20 and np.abs(ua - ud)[clipped].max() > 1e-2
+    else:           # the rating-aware law stays inside its bound: the clip has nothing to do
+        assert mag.max() < spec.Vmax and mag.max() > 0.9 * spec.Vmax
     np.testing.assert_array_equal(ua, rating_clip(ud, spec.Vmax))
 
 
