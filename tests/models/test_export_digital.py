@@ -214,7 +214,8 @@ def test_fmu_equals_the_python_controller_in_closed_loop(closed_loop, fmu_file):
     shutil.rmtree(d, ignore_errors=True)
     np.testing.assert_array_equal(got[:, 4] == 1.0, active)
     err = np.abs(got[:, :2] - ua).max()
-    print(f"FMU vs Python, {rec.scenario.id}, {len(tk)} samples: max |u_FMU - u_Python| = {err:.3g} pu")
+    print(f"FMU vs Python, {rec.scenario.id}, {len(tk)} samples: "
+          f"max |u_FMU - u_Python| = {err:.3g} pu")
     assert err <= TOL
     assert np.abs(got[active, 2:4] - ud[active]).max() <= TOL
 
