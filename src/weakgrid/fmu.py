@@ -18,8 +18,10 @@ start of ``fmi2DoStep``. Use a communication step equal to the period T.
 from __future__ import annotations
 
 import hashlib
+import platform
 import shutil
 import subprocess
+import sys
 import uuid
 import zipfile
 from dataclasses import dataclass
@@ -392,6 +394,10 @@ def build_fmu(block, files: dict, path, tool: str = "weakgrid", cc: str | None =
     Returns the path of ``NAME.fmu``. Needs gcc (or ``cc``) and the FMI headers of FMPy.
     """
     name = block["name"]
+    if platform.system() != "Linux" or sys.maxsize <= 2**32:
+        raise OSError(f"building an FMU needs 64-bit Linux (binaries/linux64); this is "
+                      f"{platform.system()} {platform.machine()}: compile sources/ of an FMU "
+                      "built there, or use --format c")
     cc = cc or shutil.which("gcc")
     if cc is None:
         raise FileNotFoundError("building an FMU needs gcc on the PATH (the FMU's binary "
