@@ -141,7 +141,7 @@ def _write_digital(ctl, args, name, prov):
           f"measurement mapping")
     for k, v, u, d in spec.parameters():
         print(f"  {k:<12} = {v!r:<22} [{u}]  {spec.origin.get(k, 'default')}")
-    print(f"  bypass windows: {spec.bypass or 'none'} s; "
+    print(f"  bypass windows: {str(spec.bypass) + ' s' if spec.bypass else 'none'}; "
           f"rating clip: {'|u| <= %g pu' % spec.Vmax if spec.Vmax else 'off'}")
     return spec, files
 
@@ -175,8 +175,11 @@ def run(args) -> int:
         from ..models.export_digital import fmu_block
 
         spec, files = _write_digital(ctl, args, name, prov)
-        target = build_fmu(fmu_block(ctl, spec, name), files, out / f"{name}.fmu",
-                           tool=f"weakgrid {__version__}")
+        try:
+            target = build_fmu(fmu_block(ctl, spec, name), files, out / f"{name}.fmu",
+                               tool=f"weakgrid {__version__}")
+        except ImportError as exc:     # the optional extra is not installed
+            raise ParameterError("--format", "fmu", str(exc)) from None
         print(f"weakgrid export: wrote {target} (FMI 2.0 co-simulation, binaries/linux64, "
               "sources/); communication step = T")
         return 0
