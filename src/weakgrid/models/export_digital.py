@@ -209,8 +209,9 @@ def generate_digital_c(controller, spec: DigitalSpec, name: str,
  * Default parameters ({name}_default_params) from:
 {origin}
  *
- * C99, no allocation, no globals, only <math.h> (link with -lm). Do not edit: regenerate
- * with `weakgrid export FILE --format c`. */
+ * C99, no allocation, no globals, only <math.h> (link with -lm); IEEE-754 64-bit double
+ * (where double is 32-bit, e.g. TI C28x COFF, use a 64-bit-double ABI such as EABI). Do not
+ * edit: regenerate with `weakgrid export FILE --format c`. */
 #ifndef {up}_H
 #define {up}_H
 
@@ -232,7 +233,7 @@ typedef struct {{
 
 typedef struct {{
     {name}_params p;
-    long k;               /* samples taken */
+    long long k;          /* samples taken (64-bit: no wrap in practice) */
     double t;             /* [s] time of the last sample, t0 + (k-1)*T */
     double x[2];          /* design state of the last sample [rad, rad/s] */
     double u_demand[2];   /* [pu] law output before the rating clip (last active sample) */
@@ -313,7 +314,7 @@ int {name}_step({name}_state *s, const double meas[{up}_N_MEAS], double u_out[{u
         return 1;
     }}
     double u[2];
-    if ({name}_saddle(s->x, u, s->w) != 0 || !isfinite(s->x[0]) || !isfinite(s->x[1]) ||
+    if (!isfinite(s->x[0]) || !isfinite(s->x[1]) || {name}_saddle(s->x, u, s->w) != 0 ||
         !isfinite(u[0]) || !isfinite(u[1])) {{
         s->active = 0;
         u_out[0] = p->u_bypass[0];
