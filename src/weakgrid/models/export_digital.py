@@ -48,7 +48,7 @@ class DigitalSpec:
     state_map : GTIStateMap or SGStateMap
         Measured signals -> design state, with the operating point's constants.
     Vmax : float or None
-        UPQC series-voltage rating |Vu|max [pu]; None: no clip (``Vmax <= 0`` in C).
+        UPQC series-voltage rating, the largest ``|Vu|`` [pu]; None: no clip (``Vmax <= 0`` in C).
     bypass : list of (float, float)
         Windows ``[t_start, t_end)`` [s] of the sample clock ``t0 + k·T`` in which the output
         is ``u_bypass`` (the study's fault windows).
