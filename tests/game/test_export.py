@@ -186,7 +186,7 @@ def test_export_cli_writes_files(trained_presets, tmp_path, capsys):
     _, ctl = trained_presets["case2-paper"]
     f = tmp_path / "case2-paper.controller.json"
     ctl.save(f)
-    assert main(["export", str(f), "--format", "c"]) == 0
+    assert main(["export", str(f), "--format", "c-law"]) == 0
     assert (tmp_path / "case2_paper.c").exists() and (tmp_path / "case2_paper.h").exists()
     assert "case2_paper_saddle" in (tmp_path / "case2_paper.h").read_text()
     assert main(["export", str(f), "--format", "json", "-d", str(tmp_path / "o")]) == 0

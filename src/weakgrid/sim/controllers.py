@@ -11,7 +11,12 @@ Measurements of the paper's design states from the simulated grid
 * GTI: ``phi_hat`` = inverter angle w.r.t. the UPQC shunt bus minus ``phi_s0``;
   ``upsilon = tau*(Vc^2 - Vc0^2)/2`` from the dc-link energy;
 * SG (classical-model analogue): ``phi_hat`` = rotor angle w.r.t. the UPQC
-  shunt bus minus its initial value; ``upsilon`` = speed error ``omega - 1`` [pu].
+  shunt bus minus its initial value; ``upsilon`` = speed error ``omega - 1`` [pu]
+  (times ``ws`` if given).
+
+Each is a measurement of signals (:func:`gti_signals`, :func:`sg_signals`) composed with a
+measurement mapping of :mod:`weakgrid.sim.design_states` (:func:`gti_state_map`,
+:func:`sg_state_map`): the part a device runs, exported to C with the controller.
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ import math
 
 import numpy as np
 
+from .design_states import GTIStateMap, SGStateMap
 from .errors import DataError, SimulationError
 
 
@@ -45,31 +51,73 @@ class UPQCTarget:
         self.upqc.u_p[self.i], self.upqc.u_q[self.i] = float(u[0]), float(u[1])
 
 
-def gti_design_states(gti_name):
-    """Measurement function returning ``[phi_hat, upsilon]`` of GTI ``gti_name`` (see module docstring)."""
+def gti_signals(gti_name):
+    """Measurement function returning the measured signals ``[phi_s, Vc]`` of GTI ``gti_name``
+    (:attr:`GTIStateMap.signals <weakgrid.sim.design_states.GTIStateMap.signals>`)."""
 
     def measure(sim, t, z, ctx):
         g = sim.sys.components["GTI"]
         i = g.names.index(gti_name)
-        phi = ctx.out["GTI.phi_s"][i] - g.phi0[i]
-        return np.array([phi, ctx.out["GTI.upsilon"][i]])
+        return np.array([ctx.out["GTI.phi_s"][i], ctx.x[g.idx("Vc")[i]]])
 
     return measure
 
 
-def sg_design_states(machine_name, upqc_bus):
-    """Measurement ``[delta - theta_r - (delta0 - theta_r0), omega - 1]`` of a machine vs. the UPQC shunt bus."""
+def gti_state_map(system, gti_name) -> GTIStateMap:
+    """The :class:`~weakgrid.sim.design_states.GTIStateMap` of GTI ``gti_name`` of a set-up
+    ``system`` (its operating point ``phi0`` and its ``tau``, ``Vc0``)."""
+    g = system.components["GTI"]
+    i = g.names.index(gti_name)
+    return GTIStateMap(float(g.phi0[i]), float(g.p["tau"][i]), float(g.p["Vc0"][i]))
+
+
+def sg_signals(machine_name, upqc_bus):
+    """Measurement function returning ``[delta, theta_r, omega]`` of machine ``machine_name``
+    and the UPQC shunt bus ``upqc_bus`` (external number)."""
 
     def measure(sim, t, z, ctx):
         s = sim.sys
         m = s.machine_number(machine_name)
         b = s.network.index_of(upqc_bus)
-        th = float(np.angle(ctx.V[b]))
-        th0 = float(np.angle(s.network.pf.V[b]))
-        d = ctx.sig["delta"][m] - th - (s.sig_defaults["delta0"][m] - th0)
-        return np.array([d, ctx.sig["omega"][m] - 1.0])
+        return np.array([ctx.sig["delta"][m], float(np.angle(ctx.V[b])), ctx.sig["omega"][m]])
 
     return measure
+
+
+def sg_state_map(system, machine_name, upqc_bus, ws=1.0) -> SGStateMap:
+    """The :class:`~weakgrid.sim.design_states.SGStateMap` of a machine of a set-up ``system``
+    w.r.t. the UPQC shunt bus ``upqc_bus`` (``ws``: υ per pu of speed error, 1 = pu)."""
+    m = system.machine_number(machine_name)
+    b = system.network.index_of(upqc_bus)
+    th0 = float(np.angle(system.network.pf.V[b]))
+    return SGStateMap(float(system.sig_defaults["delta0"][m]) - th0, float(ws))
+
+
+def mapped(signals, state_map):
+    """Measurement function ``state_map(signals(...))``; ``state_map(system)`` builds the map
+    when the first sample is taken if it is a callable of the system, else it is the map."""
+    cache = {}
+
+    def measure(sim, t, z, ctx):
+        mp = cache.get(id(sim.sys))
+        if mp is None:
+            mp = cache[id(sim.sys)] = state_map(sim.sys) if not hasattr(state_map, "signals") \
+                else state_map
+        return mp(signals(sim, t, z, ctx))
+
+    return measure
+
+
+def gti_design_states(gti_name):
+    """Measurement function returning ``[phi_hat, upsilon]`` of GTI ``gti_name`` (see module docstring)."""
+    return mapped(gti_signals(gti_name), lambda s: gti_state_map(s, gti_name))
+
+
+def sg_design_states(machine_name, upqc_bus, ws=1.0):
+    """Measurement ``[delta - theta_r - (delta0 - theta_r0), (omega - 1)*ws]`` of a machine vs.
+    the UPQC shunt bus (``ws = 1``: speed error in pu)."""
+    return mapped(sg_signals(machine_name, upqc_bus),
+                  lambda s: sg_state_map(s, machine_name, upqc_bus, ws))
 
 
 class DigitalController:

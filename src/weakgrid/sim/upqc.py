@@ -31,6 +31,18 @@ from .network import BR_B, BR_R, BR_X, F_BUS, SHIFT, T_BUS, TAP
 from .params import Param
 
 
+def rating_clip(u, Vmax):
+    """``u = [Vup, Vuq]`` [pu] (or rows of them) scaled down to ``|u| <= Vmax`` as the UPQC
+    applies it: ``u·min(1, Vmax/|u|)`` with ``|u| = hypot(Vup, Vuq)`` (``Vmax = inf``: u).
+
+    This is the rating clip of the exported digital controller
+    (:mod:`weakgrid.models.export_digital`, same operations).
+    """
+    u = np.asarray(u, float)
+    mag = np.hypot(u[..., 0], u[..., 1])
+    return u * np.minimum(1.0, Vmax / np.where(mag > 0, mag, 1.0))[..., None]
+
+
 class UPQC(Component):
     """Vectorized UPQC series branches; add instances with :meth:`add_upqc`."""
 

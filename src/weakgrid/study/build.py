@@ -44,7 +44,7 @@ from ..design.upqc_insert import insert_upqc_matpower, insert_upqc_pandapower
 from ..game.errors import ParameterError
 from ..logs import quiet_loggers
 from ..sim.errors import DataError
-from ..sim.controllers import gti_design_states, sg_design_states
+from ..sim.controllers import gti_signals, gti_state_map, mapped, sg_signals, sg_state_map
 from ..sim.gti import GTI
 from ..sim.network import BR_R, BR_X, F_BUS, GEN_BUS, T_BUS, Network
 from ..sim.system import System
@@ -62,7 +62,9 @@ class Setup:
     """A study's grid, set up for simulation at one operating point.
 
     ``machine`` is "gti" or "sg"; ``source`` the controlled machine; ``measure`` returns the
-    design states ``[ϕ̂ (rad), υ (rad/s)]``; ``design`` the derived model (10) and
+    design states ``[ϕ̂ (rad), υ (rad/s)]``: ``state_map(measure_signals(...))``, the
+    measured signals of the machine mapped by a :mod:`weakgrid.sim.design_states` map (what a
+    device computes, exported with the controller); ``design`` the derived model (10) and
     ``derivation`` how it was derived; ``signals`` maps figure keys to result variables.
     """
 
@@ -84,6 +86,8 @@ class Setup:
     Sb_mva: float = 100.0
     bus_id: dict = field(default_factory=dict)
     branch_names: dict = field(default_factory=dict)
+    measure_signals: object = None
+    state_map: object = None
 
     def bus(self, ref, where="bus") -> int:
         """External bus number of a bus reference (number, or name)."""
@@ -469,14 +473,12 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
     I = yu * (net.pf.V[r] - net.pf.V[b1])
     p_line = abs(float((net.pf.V[r] * np.conj(I)).real)) * net.Sb
     if der.machine == "gti":
-        measure = gti_design_states(ctl_name)
-    else:
-        meas = sg_design_states(ctl_name, r_id)
-        ws = 2 * math.pi * float(net.f_hz)
-
-        def measure(sim, t, z, ctx):
-            m = meas(sim, t, z, ctx)
-            return np.array([m[0], m[1] * ws])              # speed error pu -> rad/s
+        measure_signals = gti_signals(ctl_name)
+        state_map = gti_state_map(s, ctl_name)
+    else:   # upsilon in rad/s: speed error pu times ws
+        measure_signals = sg_signals(ctl_name, r_id)
+        state_map = sg_state_map(s, ctl_name, r_id, ws=2 * math.pi * float(net.f_hz))
+    measure = mapped(measure_signals, state_map)
     speed_of = d["report"].get("speed_of")
     speed_of = speed_of if speed_of is not None else (ctl_name if der.machine == "sg" else
                                                (dyn["generator"][0]["name"]
@@ -495,4 +497,4 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
                  machine=der.machine, source=ctl_name, upqc_name=upqc_name, shunt_bus=r_id,
                  upqc_branch=k_up, measure=measure, design=der.model, derivation=der,
                  line_power_mw=p_line, signals=signals, Sb_mva=float(net.Sb), bus_id=bus_id,
-                 branch_names=br_names)
+                 branch_names=br_names, measure_signals=measure_signals, state_map=state_map)

@@ -12,6 +12,7 @@ from ..sim.controllers import DigitalController, UPQCTarget
 from ..sim.events import Fault, LineTrip, LoadStep
 from ..sim.integrate import simulate
 from ..sim.network import F_BUS, T_BUS
+from ..sim.upqc import rating_clip
 from .build import build_setup
 from .controllers import controller_variant, make_controller
 from .failure import failure_text
@@ -184,17 +185,20 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     if not choice.pss:
         _disable_pss(setup.system)
     T = setup.design.T
-    xs = []
+    xs, ys = [], []
     policy = choice.policy
+    state_map = setup.state_map
 
-    def K(m):
-        m = np.asarray(m, float)
+    def K(y):   # the digital controller: measured signals -> design state -> law
+        y = np.asarray(y, float)
+        m = state_map(y)
         u = np.zeros(2) if policy is None else np.asarray(policy(m), float).reshape(2)
+        ys.append(y.copy())
         xs.append(m.copy())
         return u
 
     target = UPQCTarget(setup.upqc_name) if setup.upqc_name else _MeasureOnly()
-    dc = DigitalController(K, T=T, measure=setup.measure, target=target,
+    dc = DigitalController(K, T=T, measure=setup.measure_signals, target=target,
                            enable=enable_windows(run.bypass, run.t_end), name=run.controller)
     events = make_events(setup, run)
     t0 = time.perf_counter()
@@ -210,6 +214,9 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     # measurements were logged only when active; align them by the active mask
     active = np.array([dc.active(t) for t in tk])
     xk[active] = np.asarray(xs).reshape(-1, 2)[: active.sum()]
+    ny = len(setup.state_map.signals)
+    yk = np.full((len(tk), ny), np.nan)
+    yk[active] = np.asarray(ys).reshape(-1, ny)[: active.sum()]
     t = res.t
     series = {"t": t}
     for key_, name in setup.signals.items():
@@ -247,14 +254,15 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     up = setup.system.components.get("UPQC")
     vmax = float(up.p["Vmax"][up.names.index(setup.upqc_name)]) if up is not None and \
         setup.upqc_name in up.names else float("inf")
-    mag = np.hypot(uk[:, 0], uk[:, 1]) if uk.size else np.zeros(0)
-    ua = uk * np.minimum(1.0, vmax / np.where(mag > 0, mag, 1.0))[:, None] if uk.size else uk
+    ua = rating_clip(uk, vmax) if uk.size else uk
     metrics["control_cost"] = control_cost(ua, R_DESIGN, T)
     metrics["control_cost_demanded"] = control_cost(uk, R_DESIGN, T)
     rc = running_cost(xa, ua, Q_DESIGN, R_DESIGN)
     metrics["running_cost_18"] = float(rc[-1]) if rc.size else 0.0
     series["tk"], series["running_cost"] = tk, rc
     series["x_design"] = xk
+    # per sample: the measured signals (NaN while bypassed), demanded and applied u
+    series["y_measured"], series["u_demanded"], series["u_applied"] = yk, uk, ua
     if "vup" in series and "vuq" in series:
         vu = np.hypot(series["vup"], series["vuq"])
         series["vu"] = vu
