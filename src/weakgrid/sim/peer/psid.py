@@ -228,27 +228,30 @@ def weakgrid_events(case, system, names):
 
 # ------------------------------------------------------------------------------ loads
 def convert_loads(system, kind):
-    """Convert every bus load as PSID's ``transform_load_to_constant_*`` does.
+    """Convert every load as PSID's ``transform_load_to_constant_*`` does (before setup).
 
-    weakgrid's bus loads are constant impedances in the time domain; ``"constant power"`` and
-    ``"constant current"`` add a :class:`~weakgrid.sim.loads.ZIP` replacing each bus load."""
-    zips = [c for c in system.components.values() if c.type_name == "ZIP" and c.links]
-    if kind == "constant impedance":
-        if zips:
-            raise Unsupported("the system already has ZIP loads; converting them to constant impedance "
-                              "is not implemented in the harness")
-        return
-    shares = {"constant power": dict(kpp=100.0, kpi=0.0, kpz=0.0, kqp=100.0, kqi=0.0, kqz=0.0),
+    weakgrid's bus loads (``PD + jQD`` of the network) are constant impedances in the time domain;
+    a :class:`~weakgrid.sim.loads.ZIP` replaces a share ``P0 + jQ0`` of its bus load with a
+    polynomial. ``kind`` = ``"constant impedance"``, ``"constant power"`` or ``"constant
+    current"``: ZIPs the reader made get those shares, and the rest of each bus load gets a ZIP
+    with them too (none needed for constant impedance)."""
+    shares = {"constant impedance": dict(kpp=0.0, kpi=0.0, kpz=100.0, kqp=0.0, kqi=0.0, kqz=100.0),
+              "constant power": dict(kpp=100.0, kpi=0.0, kpz=0.0, kqp=100.0, kqi=0.0, kqz=0.0),
               "constant current": dict(kpp=0.0, kpi=100.0, kpz=0.0, kqp=0.0, kqi=100.0, kqz=0.0)}[kind]
-    if zips:
-        raise Unsupported("the system already has ZIP loads; the harness does not re-convert them")
     net = system.network
     Sb = net.Sb
+    rest = {b: complex(net.bus[b, PD], net.bus[b, QD]) / Sb for b in range(net.nb)}
+    zip_ = system.components.get("ZIP")
+    if zip_ is not None:
+        for i, lk in enumerate(zip_.links):
+            zip_._values[i].update(shares)
+            rest[int(lk["bus"])] -= complex(lk["P0"], lk["Q0"])
+    if kind == "constant impedance":
+        return
     zip_ = system._component("ZIP", "device")
-    for b in range(net.nb):
-        P, Q = float(net.bus[b, PD]), float(net.bus[b, QD])
-        if P or Q:
-            zip_.add_zip(f"ZIP_{net.bus_ids[b]}", b, P / Sb, Q / Sb, **shares)
+    for b, s in rest.items():
+        if abs(s) > 1e-12:
+            zip_.add_zip(f"ZIP_psid_{net.bus_ids[b]}", b, s.real, s.imag, **shares)
 
 
 # ------------------------------------------------------------------------------ weakgrid
