@@ -128,7 +128,10 @@ class Names:
     def machine(self, bus, gid) -> str:
         gid = _strip_id(gid)
         names = list(self.sys.machine_names)
-        if self.ss is None:
+        table = getattr(self.sys, "psse_machine", None)   # the reader's {(bus, id): name}
+        if self.ss is None and table:
+            hits = [n for (b, i), n in table.items() if int(b) == int(bus) and _strip_id(i) == gid]
+        elif self.ss is None:
             pat = re.compile(rf"^[A-Za-z0-9]+_{int(bus)}_{re.escape(gid)}$")
             hits = [n for n in names if pat.match(n)]
         else:   # ANDES route: ANDES's names carry no PSS/E id; match by bus
@@ -161,6 +164,14 @@ class Names:
         rows = [k for k in range(net.nl)
                 if {int(net.branch[k, F_BUS]), int(net.branch[k, T_BUS])} == {fb, tb}]
         ckt = _strip_id(ckt)
+        table = getattr(self.sys, "psse_branch_row", None)   # the reader's {(i, j, ckt): row}
+        if self.ss is None and table:
+            hit = [int(r) for (i, j, c), r in table.items()
+                   if {int(i), int(j)} == {int(f), int(t)} and _strip_id(c) == ckt]
+            if len(hit) == 1:
+                return hit
+            raise DataError(f"branch {f}-{t} '{ckt}'", "ckt", ckt,
+                            f"no such branch in the .raw; branches: {sorted(table)}")
         ids = _branch_ckts(self.sys)
         if ids is not None:
             hit = [k for k in rows if _strip_id(ids[k]) == ckt]
