@@ -459,6 +459,11 @@ def run_andes(case, root=None, h=None, tol=1e-8):
                 if q == "bus angle difference":
                     kr = list(ss.Bus.idx.v).index(cmp["ref_bus"])
                     y = y - np.asarray(ts.y[:, ss.Bus.a.a[kr]])
+        elif q == "mechanical torque":   # ANDES: system base; PSS/E PMECH: machine base
+            mdl, k = _andes_machine(ss, cmp["bus"], cmp["id"])
+            y = np.asarray(ts.y[:, mdl.tm.a[k]]) * ss.config.mva / float(mdl.Sn.v[k])
+        elif q in ("branch P", "branch Q"):
+            y = _andes_branch_flow(ss, ts, cmp, ev)
         else:
             raise Unsupported(f"quantity '{q}' not read from ANDES in this harness")
         return dedupe(t, y)
@@ -484,6 +489,37 @@ def andes_data_changes(ss):
         if dest and dest != m:
             out.append(f"{m} read as {dest}")
     return out
+
+
+def _andes_branch_flow(ss, ts, cmp, ev):
+    """P or Q [pu, system base] at one end of an in-service ANDES ``Line`` (its pi model: series
+    ``1/(r + jx)``, shunts ``g/2 + g1 + j(b/2 + b1)`` and ``g/2 + g2 + j(b/2 + b2)``, tap and phase
+    shift at the from end), from ANDES's bus voltages."""
+    if ev["kind"] == "branch trip" and {ev["from_bus"], ev["to_bus"]} == {cmp["from_bus"], cmp["to_bus"]}:
+        raise Unsupported("the flow of the tripped branch itself is not computed by the harness")
+    ln = ss.Line
+    lines = _andes_lines(ss, cmp["from_bus"], cmp["to_bus"])
+    if len(lines) != 1:
+        raise Unsupported(f"ANDES: {len(lines)} lines {cmp['from_bus']}-{cmp['to_bus']}")
+    k = list(ln.idx.v).index(lines[0])
+    v = lambda name: float(getattr(ln, name).v[k])  # noqa: E731
+    ys = 1.0 / complex(v("r"), v("x"))
+    yh = complex(v("g") / 2 + v("g1"), v("b") / 2 + v("b1"))
+    yk = complex(v("g") / 2 + v("g2"), v("b") / 2 + v("b2"))
+    m = v("tap") * np.exp(1j * v("phi"))
+    bus = list(ss.Bus.idx.v)
+
+    def V(b):
+        j = bus.index(b)
+        return ts.y[:, ss.Bus.v.a[j]] * np.exp(1j * ts.y[:, ss.Bus.a.a[j]])
+
+    b1, b2 = ln.bus1.v[k], ln.bus2.v[k]
+    V1, V2 = V(b1), V(b2)
+    if (cmp["end"] == "from") == (int(b1) == int(cmp["from_bus"])):
+        S = V1 * np.conj((ys + yh) / abs(m) ** 2 * V1 - ys / np.conj(m) * V2)
+    else:
+        S = V2 * np.conj(-ys / m * V1 + (ys + yk) * V2)
+    return np.asarray(S.real if cmp["quantity"] == "branch P" else S.imag)
 
 
 def _andes_lines(ss, f, t):
