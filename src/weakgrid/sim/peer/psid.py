@@ -541,6 +541,8 @@ def _andes_machine(ss, bus, gid):
         for k in range(mdl.n):
             if int(mdl.bus.v[k]) == int(bus) and mdl.u.v[k] > 0:
                 hits.append((mdl, k))
-    if len(hits) != 1:
-        raise Unsupported(f"ANDES: {len(hits)} machines at bus {bus} (id '{gid}' cannot be told apart)")
+    if not hits:
+        raise Unsupported(f"ANDES has no machine at bus {bus}")
+    if len(hits) > 1:
+        raise Unsupported(f"ANDES: {len(hits)} machines at bus {bus} (its names do not carry PSS/E's id '{gid}')")
     return hits[0]
