@@ -168,11 +168,18 @@ def main(argv=None):
                     help="weakgrid's reader: native (psse) or ANDES's parser (andes)")
     ap.add_argument("--json", default=str(HERE / "psse_benchmarks.json"))
     ap.add_argument("--docs", default="", help="also write the table into this markdown file (between markers)")
+    ap.add_argument("--andes-from", default="", help="reuse the ANDES results of an earlier JSON of this script "
+                    "(ANDES's runs do not depend on weakgrid's code)")
+    ap.add_argument("--label", default="", help="provenance written above the table (e.g. the merged commits)")
     a = ap.parse_args(argv)
     want = {x for x in a.cases.split(",") if x}
     tools = set(a.tools.split(","))
     results = []
     t_all = time.perf_counter()
+    andes_prev = {}
+    if a.andes_from:
+        andes_prev = {e["case"]["id"]: e["andes"] for e in json.loads(Path(a.andes_from).read_text())["cases"]
+                      if "andes" in e}
     for c in psid.load_cases():
         if want and c["id"] not in want:
             continue
@@ -180,7 +187,9 @@ def main(argv=None):
         if c["run"]:
             if "weakgrid" in tools:
                 e["weakgrid"] = _weakgrid(c, a.route)
-            if "andes" in tools and c["csv"]:
+            if c["id"] in andes_prev:
+                e["andes"] = andes_prev[c["id"]]
+            elif "andes" in tools and c["csv"]:
                 e["andes"] = _andes(c)
         results.append(e)
         print(f"{c['id']}: weakgrid {e.get('weakgrid', {}).get('status', '-')}; "
@@ -188,7 +197,8 @@ def main(argv=None):
     md = table(results)
     print()
     print(md)
-    meta = {"route": a.route, "python": platform.python_version(), "wall_s": time.perf_counter() - t_all,
+    meta = {"route": a.route, "label": a.label, "andes_from": a.andes_from,
+            "python": platform.python_version(), "wall_s": time.perf_counter() - t_all,
             "dt_default": psid.DT, "swing_share": psid.SWING_SHARE}
     try:
         import andes
@@ -201,7 +211,8 @@ def main(argv=None):
         p = Path(a.docs)
         s = p.read_text()
         i, j = s.index(BEGIN) + len(BEGIN), s.index(END)
-        p.write_text(s[:i] + "\n" + md + "\n" + s[j:])
+        label = f"\n{a.label}\n" if a.label else ""
+        p.write_text(s[:i] + "\n" + label + "\n" + md + "\n" + s[j:])
     return results
 
 
