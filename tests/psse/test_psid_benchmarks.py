@@ -1,0 +1,92 @@
+"""PSS/E's own results as the peer: every case of PSID's PSS/E benchmark folder.
+
+PowerSimulationsDynamics.jl ships PSS/E ``.raw`` + ``.dyr`` cases with PSS/E's simulation
+results (vendored unedited in ``tests/data/psid``, BSD-3, see its SOURCE.md). Each entry of
+``tests/data/psid/cases.toml`` is one PSID case and ``.dyr`` variant, transcribed from PSID's
+``test/test_case*.jl``: the event, the compared quantities with their CSV column and unit, PSID's
+tolerance and norm, PSID's load conversion.
+
+For each entry this test reads the files exactly as shipped with weakgrid's PSS/E reader
+(``weakgrid.sim.io.psse.from_psse``), converts the loads as PSID does, applies the event,
+simulates to the case's own final time and asserts, for every compared quantity,
+
+* PSID's own assertion ``norm(weakgrid - PSS/E, norm) <= tol``, and
+* the largest difference within 5 % of PSS/E's swing of that quantity (max - min over the run).
+
+A case whose models weakgrid lacks is skipped naming them (the reader refuses it with one
+DataError listing every unsupported record); so is a case whose PSS/E results are not those of
+the files (PSID builds part of its dynamics in Julia: ``run = false``, the entry's note says why).
+An entry without PSS/E results is run to its final time and must complete.
+"""
+
+import numpy as np
+import pytest
+
+from weakgrid.sim.errors import DataError
+from weakgrid.sim.peer import psid
+
+pytestmark = pytest.mark.psse
+
+CASES = psid.load_cases()
+
+
+def _build_or_skip(case):
+    try:
+        import weakgrid.sim.io.psse  # noqa: F401
+    except ImportError:
+        pytest.skip("weakgrid.sim.io.psse (the native PSS/E reader) is not available")
+    try:
+        return psid.run_weakgrid(case)
+    except NotImplementedError as e:
+        pytest.skip(f"the PSS/E reader is not complete: {e}")
+    except psid.Unsupported as e:
+        pytest.skip(str(e))
+    except DataError as e:
+        if e.field in ("models", "model"):
+            pytest.skip(f"models weakgrid lacks: {e.value} ({e})")
+        raise
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c["id"] for c in CASES])
+def test_psid_case(case):
+    if not case["run"]:
+        pytest.skip(f"not a comparison of these files with PSS/E: {case['note']}")
+    run = _build_or_skip(case)
+    res = run["res"]
+    assert res.ok, f"{case['id']}: the run stopped early: {res.failure}"
+    assert res.t[-1] == pytest.approx(case["tend"])
+    if not case["csv"]:
+        return   # no PSS/E results shipped for this case: it must import and run, nothing more
+    try:
+        rows = psid.compare_case(case, run)
+    except psid.Unsupported as e:
+        pytest.skip(str(e))
+    bad = [r for r in rows if not r["ok"]]
+    report = "; ".join(
+        f"{r['quantity']}: {r['norm']}-norm {r['psid_norm']:.3g} {r['unit']} (PSID tol {r['tol']:g}), "
+        f"max {r['max_abs']:.3g} = {100 * r['share_of_swing']:.2f} % of PSS/E's swing {r['swing']:.3g}"
+        for r in rows)
+    assert not bad, f"{case['id']} ({case['psid_test']}) vs PSS/E: {report}"
+
+
+def test_every_psid_psse_case_is_listed():
+    # one entry per PSID test case and .dyr variant; every vendored .dyr is used by an entry
+    ids = [c["id"] for c in CASES]
+    assert len(ids) == len(set(ids))
+    used = {c["dyr"] for c in CASES if c["dyr"]} | {c["raw"] for c in CASES} | {c["csv"] for c in CASES if c["csv"]}
+    vendored = {str(p.relative_to(psid.DATA)) for p in psid.DATA.rglob("*") if p.suffix in (".raw", ".dyr", ".csv")}
+    unused = vendored - used - {"DEGOV/ThreeBus_GAST_simple.dyr"}   # PSID's base file of the DEGOV swap
+    assert not unused, f"vendored files no entry uses: {sorted(unused)}"
+    missing = used - vendored
+    assert not missing, f"entries name files that are not vendored: {sorted(missing)}"
+
+
+def test_psse_samples_keep_the_pre_event_value():
+    # PSS/E repeats the event's time stamp; as PSID, the first (pre-event) sample is kept
+    case = psid.case_by_id("psid20_esac1a")
+    t, M = psid.read_psse_csv(case)
+    raw = np.genfromtxt(psid.data_path(case["csv"]), delimiter=",")
+    assert len(raw) == 4002 and (t[1:] > t[:-1]).all() and len(t) == 4001
+    k = int(np.flatnonzero(np.isclose(t, 1.0))[0])
+    # the terminal voltage (column 3) at t = 1.0 s is still the initial one: the pre-event sample
+    assert M[k, 2] == M[0, 2] and raw[k + 1, 2] != M[0, 2]
