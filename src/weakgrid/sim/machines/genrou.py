@@ -23,8 +23,9 @@ The steady-state initialization follows the OpenIPSL/ANDES procedure.
 Shaft: ANDES's by default; ``psse_shaft = 1`` gives PSS/E's (mechanical input as power,
 divided by the speed; :mod:`~weakgrid.sim.machines.shaft`), as a PSS/E case means it.
 
-Data checks: ``xd2 < xd1 <= xd`` and ``xq2 < xq1 <= xq`` (``xq1 = xq``, no q-axis
-transient effect, occurs in ANDES's wecc data), ``xl < xd1, xq1``; ``xl >= xd2`` (ANDES's
+Data checks: ``xd2 <= xd1 <= xd`` and ``xq2 <= xq1 <= xq`` (``xq1 = xq``, no q-axis
+transient effect, occurs in ANDES's wecc data; ``xd2 = xd1``, no sub-transient effect, in a PSS/E
+case of PowerSimulationsDynamics.jl), ``xl < xd1, xq1``; ``xl >= xd2`` (ANDES's
 ieee39 data) is unusual but well defined and is accepted with a warning, as ANDES does.
 """
 
@@ -97,10 +98,12 @@ class GENROU(SyncMachine):
                 warnings.warn(f"{self.element(i)}: leakage reactance xl = {p['xl'][i]:g} >= xd2 = "
                               f"{p['xd2'][i]:g} (normally xl < xd2); accepted, as in ANDES", UserWarning,
                               stacklevel=2)
-            # xq1 = xq (no q-axis transient effect, ANDES's wecc data) is well defined
-            if not (p["xd2"][i] < p["xd1"][i] <= p["xd"][i]) or not (p["xq2"][i] < p["xq1"][i] <= p["xq"][i]):
+            # xq1 = xq (no q-axis transient effect, ANDES's wecc data) is well defined, and so is
+            # xd2 = xd1 / xq2 = xq1 (no sub-transient effect: gd2 = gq2 = 0, the damper states
+            # drop out of the flux; PSS/E runs such data, e.g. PSID's STAB1 case)
+            if not (p["xd2"][i] <= p["xd1"][i] <= p["xd"][i]) or not (p["xq2"][i] <= p["xq1"][i] <= p["xq"][i]):
                 raise DataError(self.element(i), "xd1", self._values[i]["xd1"],
-                                "need xd2 < xd1 <= xd and xq2 < xq1 <= xq")
+                                "need xd2 <= xd1 <= xd and xq2 <= xq1 <= xq")
         xl = p["xl"]
         self.gd1 = (p["xd2"] - xl) / (p["xd1"] - xl)
         self.gq1 = (p["xq2"] - xl) / (p["xq1"] - xl)
