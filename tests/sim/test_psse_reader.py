@@ -728,3 +728,12 @@ def test_system_wide_data_end_within_the_title_lines(tmp_path):
     q.write_text("\n".join(short) + "\n")
     raw = read_raw(q)
     assert raw.title == ["title 1"] and len(raw.buses) == 3 and len(raw.branches) == 3
+
+
+def test_the_readme_lists_every_model_with_a_psse_record():
+    """The sim README's list of models the .dyr reader reads is the registry's, not a copy."""
+    text = (Path(__file__).resolve().parents[2] / "src" / "weakgrid" / "sim" / "README.md").read_text()
+    part = text[text.index("Models with a PSS/E record"):text.index("Without one")]
+    listed = set(re.findall(r"\b[A-Z][A-Z0-9]{2,}\b", part)) - {"PSS", "PAG"}
+    have = {n for n, c in _registry().items() if getattr(c, "psse_record", None)}
+    assert listed == have
