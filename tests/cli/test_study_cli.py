@@ -18,3 +18,23 @@ def test_design_prints_every_value_and_the_mode_check(capsys):
     for key in ("tau'", "Vs", "B", "a", "Vr_bar", "phi_s0", "Kron reduction", "mismatch"):
         assert key in out
     assert "a = 896.89" in out and "agree" in out
+
+
+def test_modes_writes_the_table_and_the_state_matrix(tmp_path, capsys):
+    """`modes --output/--state-matrix`: the CSV holds every mode and the npz's A has exactly
+    the printed eigenvalues; B and C are the UPQC inputs and the controlled machine's speed."""
+    import numpy as np
+    import pandas as pd
+
+    csv, npz = tmp_path / "modes.csv", tmp_path / "A.npz"
+    assert main(["modes", "case2-lv-microgrid", "--output", str(csv), "--state-matrix",
+                 str(npz)]) == 0
+    table = pd.read_csv(csv)
+    d = np.load(npz)
+    lam = np.linalg.eigvals(d["A"])
+    upper = lam[lam.imag >= 0]
+    assert len(table) == len(upper)
+    np.testing.assert_allclose(np.sort(table["imag"].to_numpy()), np.sort(upper.imag), atol=1e-8)
+    assert d["B"].shape == (d["A"].shape[0], 2) and d["C"].shape == (1, d["A"].shape[0])
+    assert list(d["outputs"])[0].endswith(".omega") and d["C"].sum() == 1.0
+    assert "wrote" in capsys.readouterr().out

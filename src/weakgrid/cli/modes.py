@@ -24,6 +24,11 @@ def add_parser(sub):
                    help="list modes above this frequency (Hz, ≥ 0)")
     p.add_argument("--plot", type=output_file(".png", ".svg", ".pdf"), default=None,
                    help="eigenvalue plot (.png, .svg or .pdf)")
+    p.add_argument("--output", "-o", type=output_file(".csv"), default=None,
+                   help="every mode as a CSV table (eigenvalue, frequency, damping, dominant states)")
+    p.add_argument("--state-matrix", type=output_file(".npz"), default=None,
+                   help="the linearized grid as NumPy arrays: A, B (inputs: the UPQC's Vup, Vuq), "
+                        "C (output: the controlled machine's speed) and the state names")
     p.set_defaults(func=run)
     return p
 
@@ -48,6 +53,29 @@ def run(args) -> int:
         mark = "=>" if r["mode"] == k_m else "  "
         print(f"  {mark}{r['mode']:>5} {r['real']:>10.4g} {r['imag']:>10.4g} {r['f_hz']:>8.4g} "
               f"{r['zeta']:>7.3f}  {r['dominant']}")
+    if args.output:
+        import pandas as pd
+
+        from ..fileio import replace_atomic
+
+        table = pd.DataFrame(m.table(oscillatory_only=False))
+        replace_atomic(args.output, lambda tmp: table.to_csv(tmp, index=False))
+        print(f"  wrote {args.output} ({len(table)} modes)")
+    if args.state_matrix:
+        import io
+
+        from ..design import state_space
+        from ..fileio import write_bytes_atomic
+
+        omega = f"{setup.source}.omega"
+        ss = state_space(setup.system, outputs=[omega], upqc=setup.upqc_name)
+        buf = io.BytesIO()
+        np.savez(buf, A=ss.A, B=ss.B, C=ss.C, D=ss.D, states=np.array(setup.system.state_names()),
+                 inputs=np.array([f"{setup.upqc_name}.Vup", f"{setup.upqc_name}.Vuq"]),
+                 outputs=np.array([omega]))
+        write_bytes_atomic(args.state_matrix, buf.getvalue())
+        print(f"  wrote {args.state_matrix} (A {ss.A.shape}, B {ss.B.shape}, C {ss.C.shape}; "
+              "weakgrid.design.state_space gives it as a python-control StateSpace)")
     # |λ| < 1e-4: the rigid-body (angle reference) modes, numerically zero
     unstable = [lam for lam in m.eigenvalues if lam.real > 1e-6 and abs(lam) > 1e-4]
     if unstable:
