@@ -39,9 +39,6 @@ KNOWN_GAPS = {
         "half the jump",
     "psid29_rena_freq_flag": "as psid29_rena_default_flags (P 25.5 %, Q 27.1 % of the swing; "
         "2-norms within PSID's tolerance)",
-    "psid29_rena_ref_flag": "as psid29_rena_default_flags (REPCA1 reference flag)",
-    "psid29_rena_ref_flag_no_v_flag": "as psid29_rena_default_flags (REPCA1 reference flag, "
-        "VFLAG = 0)",
     "psid41_stab1": "runs since GENROU accepts X''d = X'd (PSS/E does), but V is 1.03e-2 pu off "
         "(22 % of PSS/E's swing) and speed 2.8e-4 pu (31 %); the same STAB1 in a hand-built "
         "copy of the case matches within 0.9 % (tests/sim/test_pss_psse.py): the difference is "

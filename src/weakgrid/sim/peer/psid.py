@@ -360,7 +360,9 @@ def _machine_param(system, name, p):
 def compare_series(cmp, t_ref, y_ref, t, y):
     """Differences of ``(t, y)`` from PSS/E's ``(t_ref, y_ref)`` at PSS/E's samples up to the
     simulated time (PSID's norm, the largest difference, PSS/E's swing, the pass verdict)."""
-    sel = t_ref <= t[-1] + 1e-9
+    # PSS/E's time stamps carry a rounding (5.00007 s for the last sample of a 5-s run): PSID
+    # rounds them to 1 ms, so a sample within 1 ms past the end is the end's
+    sel = t_ref <= t[-1] + 1e-3
     tr, yr = t_ref[sel], y_ref[sel]
     yi = np.interp(tr, t, y)
     err = yi - yr
