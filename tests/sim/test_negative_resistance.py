@@ -45,7 +45,7 @@ def test_negative_resistance_is_accepted_with_a_warning_naming_the_branch():
     with pytest.warns(DataWarning, match=r"1 branch.*negative series resistance.*branch 1 \(3-2\) "
                                          r"BR_R = -0.05.*negative_resistance = \[1\]"):
         net = Network(_split())
-    assert net.negative_resistance == (1,)
+    assert net.negative_resistance == {1}
     assert net.branch[1, BR_R] == -D_R
 
 
@@ -53,7 +53,7 @@ def test_declared_negative_resistance_is_silent():
     with warnings.catch_warnings():
         warnings.simplefilter("error", DataWarning)
         net = Network({**_split(), "negative_resistance": [1]})
-    assert net.negative_resistance == (1,)
+    assert net.negative_resistance == {1}
 
 
 def test_power_flow_loss_of_a_negative_resistance_branch_is_r_i_squared():

@@ -74,7 +74,7 @@ class Network:
         System base power [MVA].
     bus_ids : ndarray of int
         External bus numbers; ``index_of(bus_id)`` maps them to 0-based positions.
-    negative_resistance : tuple of int
+    negative_resistance : set of int
         Branch rows with ``BR_R < 0`` (declared or not).
     """
 
@@ -128,7 +128,7 @@ class Network:
         # negative series resistances are legal in PSS/E and MATPOWER network equivalents
         # (case9241pegase, ACTIVSg10k): taken as given, in the power flow and the time domain
         # alike (one admittance matrix), and said once for all of them, not silently
-        self.negative_resistance = tuple(neg_r)
+        self.negative_resistance = set(neg_r)
         undeclared = [k for k in neg_r if k not in declared_r]
         if undeclared:
             shown = ", ".join(f"branch {k} ({int(branch[k, F_BUS])}-{int(branch[k, T_BUS])}) "
