@@ -37,7 +37,7 @@ Both tools integrate the whole 10 s: their loss-of-synchronism stops are off (we
 the angles themselves > 180°, which case9241pegase has at its power flow). Where a machine's
 speed in weakgrid leaves 1 by more than 0.05 pu, some machines slipped poles (the classical
 template's machines in case_ACTIVSg10k do): a line after the table says so, and the deviation
-column then compares two trajectories past a pole slip.
+column then compares two trajectories past a pole slip (not rerun at h/2, h/4).
 
 Tolerances: ANDES's default TDS tolerance (1e-4); weakgrid's default Newton tolerance (1e-7).
 Where the deviation exceeds 2e-5 pu, both tools run the case again (untimed) at h/2 and h/4,
@@ -264,8 +264,8 @@ def main():
                 if w[0]["ok"] and an[0]["ok"]:
                     d = speed_deviation(w[1], an[1])
                     dev = f"{d:.1e}"
-                    if d > DEV_GOAL:
-                        halved.append((case, d))
+                    if d > DEV_GOAL and w[0].get("omega_excursion", 0.0) <= 0.05:
+                        halved.append((case, d))   # (past a pole slip, halving tells nothing)
                     dev_std = "="
                     if w[0].get("conventions_applied"):   # the standard models differ: untimed run
                         ws = run_child("weakgrid", case, 1, a.solver, a.lu, tmp, conventions="standard")
