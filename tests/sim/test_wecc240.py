@@ -6,6 +6,11 @@ line) for 3 cycles. Oracles: the initial point is an equilibrium (every derivati
 and the grid rides through a cleared fault (no failure, speeds back near nominal). The test
 skips, naming them, while the reader or the PSS/E records of the models the case uses are not
 in the library.
+
+No ANDES result beside it: ANDES 2.0 reads the same two files (109 GENROU, 109 SEXS, 47 GAST,
+37 TGOV1, 25 HYGOV, 10 IEEEST, 37 REGCA1 + REECB1 + REPCA1) and solves the power flow, but its
+initialization fails (checked 2026-12-01): the PI integrator of every REECB1 (``PIQ_xi``)
+starts with a residual of 0.018, its limiter's input at 0 below ``VMIN`` = 0.9.
 """
 
 import hashlib
