@@ -101,7 +101,7 @@ API = [
     ("simulate-fault-reversed", lambda s: _run(s, 0.5, [_fault(0.3, 0.2)]), DataError, ["t_off", "0.2"]),
     ("simulate-dt-negative", lambda s: _sim(s, 1.0, dt=-0.01), DataError, ["dt", "-0.01"]),
     # network data
-    ("branch-negative-R", lambda s: _network(_branch(R=-0.05, X=-0.3)), DataError, ["branch 0", "BR_R", "-0.05"]),
+    ("branch-zero-impedance", lambda s: _network(_branch(R=0.0, X=0.0)), DataError, ["branch 0", "BR_X", "0.0", "non-zero impedance"]),
     ("branch-nan-X", lambda s: _network(_branch(X=math.nan)), DataError, ["branch 0", "BR_X", "nan"]),
     ("branch-inf-B", lambda s: _network(_branch(B=math.inf)), DataError, ["branch 0", "BR_B", "inf"]),
     ("bus-nan-load", lambda s: _network({**two_machine_case(), "bus": np.where(np.arange(13) == 2, math.nan, two_machine_case()["bus"])}), DataError, ["bus 1", "PD", "nan"]),
@@ -143,6 +143,15 @@ def test_undeclared_negative_reactance_is_accepted_with_a_warning():
     with pytest.warns(DataWarning, match=r"branch 0.*BR_X = -0.3.*series_capacitors"):
         n = _network(_branch(R=0.01, X=-0.3))
     assert n.branch[0, 3] == -0.3
+
+
+def test_negative_resistance_is_accepted_with_a_warning():
+    """Network equivalents (case9241pegase, ACTIVSg10k, PSS/E) have R < 0: said, not refused."""
+    from weakgrid.sim.errors import DataWarning
+
+    with pytest.warns(DataWarning, match=r"branch 0 \(1-2\) BR_R = -0.05.*negative_resistance"):
+        n = _network(_branch(R=-0.05, X=0.3))
+    assert n.branch[0, 2] == -0.05
 
 
 def test_declared_series_capacitor_is_accepted():

@@ -49,7 +49,7 @@ class SimulationError(SimError):
     cause : str
         One of ``"newton"`` (Newton iteration failed even at the minimum step),
         ``"divergence"`` (non-finite or runaway state), ``"loss of synchronism"``
-        (rotor-angle spread beyond the limit), ``"voltage collapse"`` (the network's
+        (rotor angles swung apart from the initial point beyond the limit), ``"voltage collapse"`` (the network's
         operating point ends at a fold: after a jump of the controllers' outputs, or as the
         states move on; the attribute ``fold`` then holds the last network solution before
         it) or ``"controller"`` (a digital controller returned invalid output).

@@ -74,7 +74,11 @@ class Simulator:
     max_iter : int
         Newton iterations before the Jacobian is refreshed / the step is halved.
     max_angle_spread : float
-        Loss-of-synchronism threshold on ``max(delta) - min(delta)`` over machines [deg].
+        Loss-of-synchronism threshold [deg] on the spread of the machines' rotor-angle
+        excursions from the operating point the simulation started at,
+        ``max(delta - delta0) - min(delta - delta0)``: the spread of the angles themselves
+        is not a measure of synchronism, large grids operate with more than 180° between
+        their machines (case9241pegase 178°, ACTIVSg10k 236°).
     save_every : int
         Record every n-th step (breakpoints are always recorded).
     linear_solver : {"auto", "dense", "sparse"}
@@ -117,6 +121,7 @@ class Simulator:
         self._alg_key = None
         self.events = []
         self.controllers = []
+        self._delta0 = None   # rotor angles at the start of the first run [rad]
 
     # ----------------------------------------------------------- linear algebra
     def _refresh_jacobian(self, t, z):
@@ -562,12 +567,16 @@ class Simulator:
             raise SimulationError(self.t, "divergence", f"variable {self.sys.var_name(int(bad[0]))} ran away")
         d = self._ctx.sig["delta"]
         if len(d) > 1:
-            spread = d.max() - d.min()
+            e = d - self._delta0 if self._delta0 is not None and len(self._delta0) == len(d) else d
+            spread = e.max() - e.min()
             if spread > self.max_spread:
                 names = self.sys.machine_names
+                i, j = int(e.argmax()), int(e.argmin())
                 raise SimulationError(self.t, "loss of synchronism",
                                       f"rotor angle spread {math.degrees(spread):.1f} deg between "
-                                      f"'{names[int(d.argmax())]}' and '{names[int(d.argmin())]}'")
+                                      f"'{names[i]}' and '{names[j]}' (their swings from the "
+                                      f"initial angles: {math.degrees(e[i]):+.1f} and "
+                                      f"{math.degrees(e[j]):+.1f} deg)")
 
     def run(self, t_end, events=(), controllers=(), on_failure="raise") -> Results:
         """Simulate from the current time to ``t_end`` [s].
@@ -623,6 +632,8 @@ class Simulator:
             self.z = self.solve_algebraic(self.t, self.z)
         F, self._ctx = sys.residual(self.t, self.z)
         self._f = F[:self.nx].copy()
+        if self._delta0 is None:
+            self._delta0 = np.array(self._ctx.sig["delta"], dtype=float, copy=True)
         if sys._accepting:
             sys.accept(self.t, self._ctx)
         rec.add(self.t, self.z, self._ctx)

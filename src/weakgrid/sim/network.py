@@ -59,6 +59,12 @@ class Network:
     ----------
     case : dict
         ``{"baseMVA": float, "bus": (nb, >=13), "gen": (ng, >=10), "branch": (nl, >=11)}``.
+        Optional keys: ``series_capacitors`` (branch rows whose negative ``BR_X`` is meant)
+        and ``negative_resistance`` (branch rows whose negative ``BR_R`` is meant); other
+        negative values are accepted with a :class:`~weakgrid.sim.errors.DataWarning`.
+        A negative series resistance (legal in PSS/E and MATPOWER network equivalents,
+        e.g. case9241pegase, ACTIVSg10k) enters the admittance matrix as given, so the power
+        flow and the time domain see the same branch.
     f_hz : float
         Nominal frequency [Hz].
 
@@ -68,6 +74,8 @@ class Network:
         System base power [MVA].
     bus_ids : ndarray of int
         External bus numbers; ``index_of(bus_id)`` maps them to 0-based positions.
+    negative_resistance : set of int
+        Branch rows with ``BR_R < 0`` (declared or not).
     """
 
     def __init__(self, case: dict, f_hz: float = 60.0):
@@ -77,9 +85,6 @@ class Network:
         self.case = copy.deepcopy({k: case[k] for k in ("baseMVA", "bus", "gen", "branch")})
         # branches with a negative series reactance on purpose (series capacitors)
         self.series_capacitors = {int(k) for k in case.get("series_capacitors", ())}
-        # branches with a negative series resistance on purpose (network equivalents, e.g. PSS/E
-        # and MATPOWER reductions): accepted when declared, the importer notes them
-        self.negative_resistance = {int(k) for k in case.get("negative_resistance", ())}
         self.Sb = float(self.case["baseMVA"])
         if not self.Sb > 0:
             raise DataError("case", "baseMVA", self.Sb, "must be > 0 MVA")
@@ -99,6 +104,8 @@ class Network:
         if len(set(self.bus_ids)) != len(self.bus_ids):
             raise DataError("bus table", "BUS_I", list(self.bus_ids), "bus numbers must be unique")
         self._pos = {b: i for i, b in enumerate(self.bus_ids)}
+        declared_r = {int(k) for k in case.get("negative_resistance", ())}
+        neg_r = []
         for k, row in enumerate(branch):
             for col, nm in ((F_BUS, "F_BUS"), (T_BUS, "T_BUS")):
                 self.index_of(int(row[col]), f"branch {k}", nm)
@@ -109,10 +116,8 @@ class Network:
                     raise DataError(el, nm, float(row[col]), "give a finite number (per unit)")
             if row[BR_R] == 0 and row[BR_X] == 0:
                 raise DataError(f"branch {k}", "BR_X", 0.0, "a branch needs a non-zero impedance R + jX")
-            if row[BR_R] < 0 and k not in self.negative_resistance:
-                raise DataError(el, "BR_R", float(row[BR_R]), "a series resistance cannot be negative: "
-                                "check the sign and the per-unit base (an equivalent's negative "
-                                f"resistance is accepted when declared: negative_resistance = [{k}])")
+            if row[BR_R] < 0:
+                neg_r.append(k)
             if row[BR_X] < 0 and k not in self.series_capacitors:
                 # standard cases have them (series compensation, star equivalents of
                 # three-winding transformers, e.g. MATPOWER's case300): accepted, not silently
@@ -120,6 +125,20 @@ class Network:
                               "capacitor; declare it with series_capacitors = "
                               f"[{k}] in the case to silence this, or correct the sign",
                               DataWarning, stacklevel=3)
+        # negative series resistances are legal in PSS/E and MATPOWER network equivalents
+        # (case9241pegase, ACTIVSg10k): taken as given, in the power flow and the time domain
+        # alike (one admittance matrix), and said once for all of them, not silently
+        self.negative_resistance = set(neg_r)
+        undeclared = [k for k in neg_r if k not in declared_r]
+        if undeclared:
+            shown = ", ".join(f"branch {k} ({int(branch[k, F_BUS])}-{int(branch[k, T_BUS])}) "
+                              f"BR_R = {branch[k, BR_R]:g}" for k in undeclared[:5])
+            more = f" and {len(undeclared) - 5} more" if len(undeclared) > 5 else ""
+            warnings.warn(f"{len(undeclared)} branch(es) with a negative series resistance, taken "
+                          f"as given (network equivalents; such a branch generates active power): "
+                          f"{shown}{more}; declare them with negative_resistance = "
+                          f"{undeclared[:5] if not more else '[...]'} in the case to silence "
+                          "this, or correct the sign", DataWarning, stacklevel=2)
         # the columns the power flow and the simulator read must be finite (others, e.g.
         # MBASE from pandapower's converter, may be NaN)
         for name, table, cols in (

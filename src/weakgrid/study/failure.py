@@ -25,7 +25,8 @@ FAILED_CELLS_NOTE = (
     "series-voltage step (at a sample) or along the states' motion (between samples), and "
     "the failure says at which "
     "series voltage, series power, shunt-bus voltage and machine angle. 'loss of synchronism' "
-    "is a rotor-angle spread beyond the simulator's limit (180°). Either way the controlled "
+    "means the machines' rotor angles swung apart from their initial operating point beyond the "
+    "simulator's limit (180°). Either way the controlled "
     "grid lost its operating point in that cell; the study's notes say where and why.")
 
 
