@@ -137,7 +137,7 @@ def _umask():
     return m
 
 
-@pytest.mark.parametrize("fmt", ["c", "json"])
+@pytest.mark.parametrize("fmt", ["c-law", "json"])
 def test_export_never_leaves_half_an_output(ws, cli, monkeypatch, fmt):
     """C header + source appear together or not at all (a failing second write)."""
     out = ws.root / "o"
@@ -154,6 +154,6 @@ def test_export_never_leaves_half_an_output(ws, cli, monkeypatch, fmt):
 
     monkeypatch.setattr(fileio, "_finish", second_fails)
     code, _, err = cli(["export", ws.controller, "-d", out, "--format", fmt])
-    if fmt == "c":
+    if fmt == "c-law":
         assert code == 3 and "no space left" in err
     ws.check_untouched()

@@ -118,7 +118,7 @@ def test_a_checkpoint_of_another_mesh_is_refused_by_the_solver(states):
 def test_the_key_changes_with_every_input_and_with_the_code(monkeypatch):
     from dataclasses import replace
 
-    import weakgrid.sweep.cache as cache
+    import weakgrid.hashing as cache   # the one content hash (with the code fingerprint)
 
     p = load_preset("case1-paper")
     key = training_key(p, p.settings)

@@ -85,8 +85,7 @@ ANDES_CONVENTIONS = {
     "ESDC2A": {"TR_used": 0.0},   # idem
     "REGCA1": {"LVPL_strict": 0.0},  # LVPL resets S0 only while dS0/dt >= 0 (S0 may stay above it)
     "IEEEX1": {"VR_Vt": 0.0},     # regulator limits VRMAX, VRMIN, not times Vt
-    # output limit tested on the rate feedback (in effect never acts); limits without Vt
-    "EXST1": {"VR_limited": 0.0, "VR_Vt": 0.0},
+    "EXST1": {"VR_limited": 0.0},  # output limit tested on the rate feedback (in effect never acts)
     "IEEEVC": {"on_Sb": 1.0},     # rc, xc on the system base (its IEEEVC has no Sn)
     # unit-gain gate integrator (Tr unused); flow, gate and Dt on the system base; rate bounds -x1/r
     "HYGOV": {"Tr_used": 0.0, "Tw_sysbase": 1.0, "Dt_sysbase": 1.0, "VELM_offset": 1.0},

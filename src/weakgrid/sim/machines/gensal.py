@@ -82,7 +82,7 @@ class GENSAL(SyncMachine):
 
     #: saturation curve through (1.0, S10), (1.2, S12): "quadratic" or "exponential"
     saturation = "quadratic"
-    #: saturation also on the q axis (GENSAE), as a function of |psi''| instead of E'q
+    #: saturation also on the q axis (GENSAE), as a function of ``|psi''|`` instead of E'q
     q_saturation = False
 
     @classmethod

@@ -62,6 +62,7 @@ def load_cases(path=None) -> list[dict]:
 
 
 def case_by_id(case_id, path=None) -> dict:
+    """The entry ``case_id`` of ``cases.toml`` (:func:`load_cases`); KeyError if there is none."""
     for c in load_cases(path):
         if c["id"] == case_id:
             return c
@@ -69,6 +70,7 @@ def case_by_id(case_id, path=None) -> dict:
 
 
 def data_path(rel, root=None) -> str:
+    """Path of the vendored PSID file ``rel`` (relative to ``root``, default ``tests/data/psid``)."""
     return str((Path(root) if root is not None else DATA) / rel)
 
 

@@ -48,7 +48,7 @@ from .dyr import read_dyr
 from .network import build_case
 from .raw import read_raw
 
-#: |ZSORCE| [pu on SBASE] up to which an H = 0 GENCLS is an ideal voltage source at its bus
+#: ``|ZSORCE|`` [pu on SBASE] up to which an H = 0 GENCLS is an ideal voltage source at its bus
 INFINITE_BUS_ZMAX = 1e-3
 #: inertia M [s] of an H = 0 GENCLS behind a non-negligible ZSORCE (PSS/E: infinite)
 INFINITE_M = 1e9

@@ -1,4 +1,4 @@
-"""PSS/E ``.dyr`` dynamic data: records ``IBUS 'MODEL' ID  values... /``.
+"""PSS/E ``.dyr`` dynamic data: records ``IBUS 'MODEL' ID values /``.
 
 A record may span lines and ends at an unquoted ``/`` (what follows on that line is a
 comment; a line starting with ``//`` is an empty record). Model names and text values
