@@ -57,13 +57,7 @@ KNOWN_GAPS = {
 
 def _build_or_skip(case):
     try:
-        import weakgrid.sim.io.psse  # noqa: F401
-    except ImportError:
-        pytest.skip("weakgrid.sim.io.psse (the native PSS/E reader) is not available")
-    try:
         return psid.run_weakgrid(case)
-    except NotImplementedError as e:
-        pytest.skip(f"the PSS/E reader is not complete: {e}")
     except psid.Unsupported as e:
         pytest.skip(str(e))
     except DataError as e:

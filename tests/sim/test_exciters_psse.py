@@ -808,7 +808,7 @@ def test_exac2_andes_gap_halves_with_the_step_and_needs_its_limiter_fixed():
 
 
 # ------------------------------------------------------------------ PSID's PSS/E benchmark records
-# through the native reader (weakgrid.sim.io.psse, branch psse-reader): skipped until it is merged.
+# through the native reader (weakgrid.sim.io.psse).
 # PSID ships no PSS/E results for SCRX, ST6B, ST8C; its tests compare PSID's own initial states
 # (test/results/results_initial_conditions.jl), which are compared here (generator-102-1's
 # exciter states; PSID's lead-lag state is (1 - TA/TB) * input, its PI states are integrals / KI).
@@ -824,10 +824,8 @@ PSID_X0 = {   # PSID test47_x0_init*, test59_x0_init, test61_x0_init: exciter st
 
 
 def _from_psid(model, dyr, tmp_path=None, edit=None):
-    psse = pytest.importorskip("weakgrid.sim.io.psse")
+    from weakgrid.sim.io import psse
     raw = DATA / "psse_reader" / "raw" / f"{model}__ThreeBusMulti.raw"
-    if not raw.exists():
-        pytest.skip("the reader's vendored PSID .raw files are not on this branch yet")
     path = DATA / "psse_exciters" / dyr
     if edit is not None:
         path = tmp_path / dyr

@@ -94,7 +94,6 @@ def test_three_bus_case_is_the_raw_power_flow():
 def test_initial_point_is_an_equilibrium(model, params):
     s = _three_bus(model, params)
     assert _max_derivative(s) < 1e-10
-    c = s.components[model]
     _, ctx = s.residual(0.0, s.z0)
     if params["S10"] > 0:
         assert ctx.out[f"{model}.Se"][0] > 0.01           # saturation acts at the operating point
@@ -267,10 +266,9 @@ def _dyr_record(fname):
 
 def _psse_params(cls, fname):
     model, vals = _dyr_record(fname)
-    rec = getattr(cls, "psse_record", GENROE.psse_record)   # GENROU's: declared by the reader branch
+    rec = cls.psse_record
     assert len(vals) == len(rec), (model, vals)
-    v = cls.psse_params(dict(zip(rec, vals)), _Ctx()) if "psse_params" in cls.__dict__ else \
-        GENROE.psse_params(dict(zip(rec, vals)), _Ctx())
+    v = cls.psse_params(dict(zip(rec, vals)), _Ctx())
     v["Sn"] = _Ctx.mbase
     return model, v
 
@@ -348,9 +346,8 @@ def test_rotor_angle_with_andes_shaft_within_five_percent(cls, dyr, csv):
 @pytest.mark.psse
 @pytest.mark.parametrize("cls, dyr, csv", CASES, ids=[c[1][9:-4] for c in CASES])
 def test_rotor_angle_matches_psse_through_the_psse_reader(cls, dyr, csv):
-    """The same cases read by weakgrid's own PSS/E reader, raw + dyr as shipped (skipped until
-    ``weakgrid.sim.io.psse`` is there)."""
-    psse = pytest.importorskip("weakgrid.sim.io.psse")
+    """The same cases read by weakgrid's own PSS/E reader, raw + dyr as shipped."""
+    from weakgrid.sim.io import psse
     from weakgrid.sim.network import F_BUS, T_BUS
 
     system, _ = psse.from_psse(str(DATA / "ThreeBusMulti.raw"), str(DATA / dyr))

@@ -132,8 +132,6 @@ def test_same_values_as_andes_psse_parser(dyr):
     same file (``andes.load(raw, addfile=dyr, setup=False)``); the ICONs ANDES keeps as
     links/remote buses are checked by the link."""
     andes = pytest.importorskip("andes")
-    if not (RENA / dyr).exists():
-        pytest.skip("PSID's RENA files not vendored (tests/data/psid, branch psse-peer)")
     andes.config_logger(stream_level=40)
     ss = andes.load(str(RENA / "ThreeBusRenewable.raw"), addfile=str(RENA / dyr), setup=False,
                     no_output=True, default_config=True)
@@ -171,8 +169,6 @@ def test_same_field_order_as_andes_on_distinct_values(ec, tmp_path):
     """Records whose CONs are all different, read by ``psse_record`` and by ANDES's parser: each
     name gets the same number (REECA1's CON ``Vref1`` is ANDES's ``Vbias`` -> ``Vref1``)."""
     andes = pytest.importorskip("andes")
-    if not (RENA / "ThreeBusRenewable.raw").exists():
-        pytest.skip("PSID's RENA files not vendored (tests/data/psid, branch psse-peer)")
     icons = {"REGCA1": [1], "REECA1": [0, 1, 0, 1, 0, 1], "REECB1": [0, 1, 0, 1, 1],
              "REPCA1": [0, 0, 0, "'1'", 1, 0, 1]}
     recs = {m: _synthetic(m, icons[m]) for m in ("REGCA1", ec, "REPCA1")}
@@ -200,8 +196,6 @@ def test_andes_route_accepts_busr_zero_as_local():
     """Regression: ANDES's PSS/E parser copies REECB1's ICON BUSR = 0 (PSS/E: local); the ANDES
     importer refused it as remote voltage sensing. It now imports and starts in steady state."""
     andes = pytest.importorskip("andes")
-    if not (RENA / "ThreeBus_REN_A_DEFAULT_FLAG.dyr").exists():
-        pytest.skip("PSID's RENA files not vendored (tests/data/psid, branch psse-peer)")
     from weakgrid.sim.io.andes import from_andes
 
     andes.config_logger(stream_level=40)
@@ -383,8 +377,6 @@ def test_rena_matches_psse_results(dyr, csv, t_end, cols, tol):
     """PSID's case 29 (line 101-103 tripped at 1 s; P, Q, V of the converter; PSID's tolerance: the
     2-norm of the error over the 5 s <= 1e-2) and the two voltage-control variants of the same
     folder (angle and voltage of bus 103 over 20 s; no PSID test: within 5 % of PSS/E's swing)."""
-    if not (RENA / csv).exists():
-        pytest.skip("PSID's RENA files not vendored (tests/data/psid, branch psse-peer)")
     text = (RENA / csv).read_text()
     ref = np.genfromtxt(RENA / csv, delimiter=",", skip_header=1 if text[0].isalpha() else 0)
     s = build_rena((RENA / dyr).read_text())

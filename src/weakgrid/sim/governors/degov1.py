@@ -83,10 +83,6 @@ class DEGOV1(MachineControl):
     limit_fields = {"THR": ("TMIN", "TMAX")}
     droop_flag = True
 
-    @classmethod
-    def psse_params(cls, values, ctx):
-        return dict(values)
-
     def setup(self, system):
         super().setup(system)
         p = self.p

@@ -117,10 +117,6 @@ class GGOV1(MachineControl):
     #: parameter names of the limits of each limited state (for error messages)
     limit_fields = {"VAL": ("Vmin", "Vmax"), "PMW": ("-1.1*R", "1.1*R")}
 
-    @classmethod
-    def psse_params(cls, values, ctx):
-        return dict(values)
-
     def setup(self, system):
         super().setup(system)
         p = self.p

@@ -84,10 +84,6 @@ class PIDGOV(MachineControl):
     #: parameter names of the limits of each limited state (for error messages)
     limit_fields = {"GATE": ("Gmin", "Gmax")}
 
-    @classmethod
-    def psse_params(cls, values, ctx):
-        return dict(values)
-
     def setup(self, system):
         super().setup(system)
         p = self.p

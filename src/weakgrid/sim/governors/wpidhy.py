@@ -85,10 +85,6 @@ class WPIDHY(MachineControl):
     #: parameter names of the limits of each limited state (for error messages)
     limit_fields = {"GATE": ("GATMN", "GATMX")}
 
-    @classmethod
-    def psse_params(cls, values, ctx):
-        return dict(values)
-
     def setup(self, system):
         super().setup(system)
         p = self.p

@@ -28,6 +28,17 @@ def with_default(params, name, default):
                  for p in params)
 
 
+def psse_subtransient_params(values, ctx):
+    """A PSS/E GENROU, GENROE, GENSAL or GENSAE record as parameters: ``M = 2H``, ``xq2 = xd2``
+    (PSS/E's single X''), ``ra = Re(ZSORCE)`` (pu on MBASE; the record has no armature
+    resistance)."""
+    v = dict(values)
+    v["M"] = 2.0 * v.pop("H")
+    v["xq2"] = v["xd2"]
+    v["ra"] = float(ctx.zsorce.real)
+    return v
+
+
 class SyncMachine(Component):
     """Base of synchronous machines.
 

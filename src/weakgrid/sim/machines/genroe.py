@@ -37,17 +37,6 @@ class GENROE(GENROU):
     psse_record = ("Td10", "Td20", "Tq10", "Tq20", "H", "D", "xd", "xq", "xd1", "xq1", "xd2",
                    "xl", "S10", "S12")
 
-    @classmethod
-    def psse_params(cls, values, ctx=None):
-        """PSS/E record values -> weakgrid parameters: ``M = 2H``, ``xq2 = xd2`` (PSS/E's
-        single X''), ``ra = Re(ZSORCE)`` (pu on MBASE; the record has no armature resistance)."""
-        v = dict(values)
-        v["M"] = 2.0 * v.pop("H")
-        v["xq2"] = v["xd2"]
-        if ctx is not None:
-            v["ra"] = float(ctx.zsorce.real)
-        return v
-
     def setup(self, system):
         p0 = {k: [v[k] for v in self._values] for k in ("S10", "S12")}
         for i, (s10, s12) in enumerate(zip(p0["S10"], p0["S12"])):

@@ -38,7 +38,7 @@ import numpy as np
 from ..blocks import quad_saturation_coeffs
 from ..errors import DataError
 from ..params import Param
-from .base import BASE_PARAMS, SyncMachine
+from .base import BASE_PARAMS, SyncMachine, psse_subtransient_params
 from .shaft import swing
 
 
@@ -58,13 +58,8 @@ class GENROU(SyncMachine):
 
     @classmethod
     def psse_params(cls, values, ctx):
-        """PSS/E GENROU: ``M = 2H``, ``xq2 = xd2`` (X''q = X''d in PSS/E's model), ``ra`` =
-        ``Re(ZSORCE)`` (pu on MBASE; the record has no armature resistance)."""
-        v = dict(values)
-        v["M"] = 2.0 * v.pop("H")
-        v["xq2"] = v["xd2"]
-        v["ra"] = ctx.zsorce.real
-        return v
+        """PSS/E GENROU (and GENROE): :func:`~weakgrid.sim.machines.base.psse_subtransient_params`."""
+        return psse_subtransient_params(values, ctx)
 
     params = BASE_PARAMS + (
         Param("xl", 0.0, "pu (machine base)", "leakage reactance", "nonneg", "z"),

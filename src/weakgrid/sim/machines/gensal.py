@@ -44,7 +44,8 @@ import numpy as np
 from ..blocks import quad_saturation_coeffs
 from ..errors import DataError
 from ..params import Param
-from .base import BASE_PARAMS, SyncMachine, saturated_rotor_angle, with_default
+from .base import (BASE_PARAMS, SyncMachine, psse_subtransient_params, saturated_rotor_angle,
+                   with_default)
 from .shaft import swing
 
 
@@ -86,15 +87,9 @@ class GENSAL(SyncMachine):
     q_saturation = False
 
     @classmethod
-    def psse_params(cls, values, ctx=None):
-        """PSS/E record values -> weakgrid parameters: ``M = 2H``, ``xq2 = xd2`` (PSS/E's
-        single X''), ``ra = Re(ZSORCE)`` (pu on MBASE; the record has no armature resistance)."""
-        v = dict(values)
-        v["M"] = 2.0 * v.pop("H")
-        v["xq2"] = v["xd2"]
-        if ctx is not None:
-            v["ra"] = float(ctx.zsorce.real)
-        return v
+    def psse_params(cls, values, ctx):
+        """PSS/E GENSAL (and GENSAE): :func:`~weakgrid.sim.machines.base.psse_subtransient_params`."""
+        return psse_subtransient_params(values, ctx)
 
     # ------------------------------------------------------------------ setup
     def setup(self, system):
@@ -162,7 +157,7 @@ class GENSAL(SyncMachine):
         psi_dq = psi20 * rot
         It_dq = np.conj(It * rot)
         psi2d, psi2q = psi_dq.real, -psi_dq.imag
-        Id, Iq = It_dq.imag, It_dq.real
+        Id = It_dq.imag
         e1q = psi2d + (xd1 - xd2) * Id
         e2d = e1q - (xd1 - xl) * Id
         sat_d = Seq * psi2d if self.q_saturation else self._sat(e1q) * e1q

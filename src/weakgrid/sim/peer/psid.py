@@ -426,14 +426,12 @@ def run_andes(case, root=None, h=None, tol=1e-8):
     notes = andes_data_changes(ss)
     ev = case["event"]
     if case["loads"] != "constant impedance":
-        pq = ss.PQ
+        cfg = ss.PQ.config
+        cfg.p2z, cfg.q2z = 0.0, 0.0
         if case["loads"] == "constant power":
-            ss.PQ.config.p2p, ss.PQ.config.q2q = 1.0, 1.0
-            ss.PQ.config.p2z, ss.PQ.config.q2z = 0.0, 0.0
+            cfg.p2p, cfg.q2q = 1.0, 1.0
         else:
-            ss.PQ.config.p2i, ss.PQ.config.q2i = 1.0, 1.0
-            ss.PQ.config.p2z, ss.PQ.config.q2z = 0.0, 0.0
-        del pq
+            cfg.p2i, cfg.q2i = 1.0, 1.0
     if ev["kind"] == "branch trip":
         lines = _andes_lines(ss, ev["from_bus"], ev["to_bus"])
         if not lines:

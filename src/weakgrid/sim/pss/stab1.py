@@ -44,11 +44,6 @@ class STAB1(MachineControl):
     #: PSS/E .dyr record after ``IBUS 'STAB1' ID``: CONs K/T, T, T1/T3, T3, T2/T4, T4, HLIM.
     psse_record = ("KT", "T", "T1T3", "T3", "T2T4", "T4", "HLIM")
 
-    @classmethod
-    def psse_params(cls, values, ctx):
-        """The record's CONs are the parameters (STAB1 has no ICONs)."""
-        return dict(values)
-
     def setup(self, system):
         super().setup(system)
         p = self.p

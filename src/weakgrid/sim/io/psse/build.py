@@ -37,6 +37,7 @@ Names: machines ``"<MODEL>_<bus>_<id>"`` (``GENROU_102_1``), controls likewise
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from pathlib import Path
 
@@ -317,8 +318,6 @@ class _Builder:
         if link_fn is None:
             raise DataError(r.where, "MODEL", r.model, f"{r.model} cannot be linked from a .dyr "
                             "record (its class has no psse_link)")
-        import dataclasses
-
         names = {m: n for (m, b, i), n in self.devices.items() if (b, i) == key}
         ctx = dataclasses.replace(ctx, gen_row=self.maps.gen_row[key], names=names,
                                   branch_row=self._branch_row)
