@@ -60,7 +60,7 @@ def build_gti_upqc_sg(structure="conventional", mode="energy", p_gti=50.0):
 
 
 def psse_three_bus_case():
-    """PSID's PSS/E benchmark network ``ThreeBusMulti.raw`` (tests/data/psse_machines/), by hand.
+    """PSID's PSS/E benchmark network ``ThreeBusMulti.raw`` (tests/data/psid/GENROU/), by hand.
 
     PSS/E v33 raw, SBASE 100 MVA, 60 Hz, all buses 138 kV: bus 101 slack at 1.05 pu (its
     GENCLS with H = 0 is PSS/E's infinite bus), bus 102 PV at 1.02 pu with 100 MW (MBASE

@@ -815,6 +815,11 @@ def test_exac2_andes_gap_halves_with_the_step_and_needs_its_limiter_fixed():
 from pathlib import Path  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[1] / "data"
+
+
+def _psid_dyr(dyr):
+    """A PSID benchmark .dyr (``ThreeBus_SCRX_withSwitch.dyr``) in its folder of tests/data/psid."""
+    return DATA / "psid" / dyr.split("_")[1].split(".")[0] / dyr
 PSID_X0 = {   # PSID test47_x0_init*, test59_x0_init, test61_x0_init: exciter states of generator-102-1
     "ThreeBus_SCRX.dyr": (0.06459346591111803, 2.1531155307233014),
     "ThreeBus_SCRX_withSwitch.dyr": (0.06332692736702006, 2.1108975792533453),
@@ -826,10 +831,10 @@ PSID_X0 = {   # PSID test47_x0_init*, test59_x0_init, test61_x0_init: exciter st
 def _from_psid(model, dyr, tmp_path=None, edit=None):
     from weakgrid.sim.io import psse
     raw = DATA / "psse_reader" / "raw" / f"{model}__ThreeBusMulti.raw"
-    path = DATA / "psse_exciters" / dyr
+    path = _psid_dyr(dyr)
     if edit is not None:
         path = tmp_path / dyr
-        path.write_text(edit((DATA / "psse_exciters" / dyr).read_text()))
+        path.write_text(edit((_psid_dyr(dyr)).read_text()))
     system, _ = psse.from_psse(raw, path)
     return system
 
@@ -904,7 +909,7 @@ def test_record_layout_read_by_the_reader(model, prm, tmp_path):
     record replaced): read by the native reader into these parameters, starting at rest."""
     cls = _registry()[model]
     rec = " ".join(repr(float(prm[k])) for k in cls.psse_record)
-    base = (DATA / "psse_exciters" / "ThreeBus_SCRX.dyr").read_text().splitlines()[:4]
+    base = (_psid_dyr("ThreeBus_SCRX.dyr")).read_text().splitlines()[:4]
     edit = lambda _t: "\n".join(base) + f"\n    102 '{model}' 1  {rec} /\n"   # noqa: E731
     system = _from_psid("SCRX", "ThreeBus_SCRX.dyr", tmp_path, edit=edit)
     s = _system_setup(system)

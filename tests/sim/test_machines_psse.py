@@ -3,10 +3,11 @@
 Oracles: the saturation curves pass through PSS/E's points (1.0, S10), (1.2, S12); the
 initial point is an equilibrium; unsaturated GENSAL is GENROU without a q-axis transient
 winding (xq1 = xq) and GENSAE is GENSAL; with X'd = X''d the d-axis damper enters nothing;
-PSS/E's own rotor angles (PSID's PSS/E benchmark, tests/data/psse_machines/SOURCE.md) for a
+PSS/E's own rotor angles (PSID's PSS/E benchmark, tests/data/psid/SOURCE.md) for a
 line trip on its three-bus system. Data checks name the refused field and the model.
 """
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +23,14 @@ from weakgrid.sim.system import System
 
 from sim_cases import psse_three_bus_case, two_machine_case
 
-DATA = Path(__file__).resolve().parents[1] / "data" / "psse_machines"
+#: PSID's PSS/E benchmark files, vendored unedited (tests/data/psid/SOURCE.md)
+PSID = Path(__file__).resolve().parents[1] / "data" / "psid"
+
+
+def _psid(fname):
+    """``fname`` (ThreeBus_GENSAL.dyr, TEST_GENROE.csv, ThreeBusMulti.raw) in its PSID folder."""
+    m = re.search(r"GEN(ROU|ROE|SAL|SAE)", fname)
+    return PSID / (m.group(0) if m else "GENROU") / fname
 
 # PSS/E's salient-pole record (GENSAL, GENSAE) of PSID's benchmark: T'do, T''do, T''qo, H,
 # D, Xd, Xq, X'd, X''d, Xl, S(1.0), S(1.2)
@@ -257,7 +265,7 @@ class _Ctx:
 
 def _dyr_record(fname):
     """Values of the machine record at bus 102 (after IBUS 'MODEL' ID) of a vendored .dyr."""
-    for rec in (DATA / fname).read_text().split("/"):
+    for rec in _psid(fname).read_text().split("/"):
         tok = rec.split()
         if len(tok) > 3 and tok[0] == "102":
             return tok[1].strip("'"), [float(v) for v in tok[3:]]
@@ -304,7 +312,7 @@ CASES = [
 
 
 def _psse_csv(fname):
-    d = np.loadtxt(DATA / fname, delimiter=",")
+    d = np.loadtxt(_psid(fname), delimiter=",")
     _, i = np.unique(d[:, 0], return_index=True)         # PSS/E repeats the event instant
     return d[i, 0], d[i, 1]
 
@@ -350,7 +358,7 @@ def test_rotor_angle_matches_psse_through_the_psse_reader(cls, dyr, csv):
     from weakgrid.sim.io import psse
     from weakgrid.sim.network import F_BUS, T_BUS
 
-    system, _ = psse.from_psse(str(DATA / "ThreeBusMulti.raw"), str(DATA / dyr))
+    system, _ = psse.from_psse(str(_psid("ThreeBusMulti.raw")), str(_psid(dyr)))
     net = system.network                  # MATPOWER form: external (PSS/E) bus numbers
     row = [k for k, r in enumerate(net.branch) if {int(r[F_BUS]), int(r[T_BUS])} == {101, 102}]
     assert len(row) == 1
