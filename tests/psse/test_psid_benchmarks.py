@@ -19,6 +19,8 @@ the files (PSID builds part of its dynamics in Julia: ``run = false``, the entry
 An entry without PSS/E results is run to its final time and must complete.
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -27,7 +29,10 @@ from weakgrid.sim.peer import psid
 
 pytestmark = pytest.mark.psse
 
-CASES = psid.load_cases()
+#: the vendored table in this checkout (not the installed package's folder: CI runs these tests
+#: against a wheel, which carries no test data)
+TABLE = Path(__file__).resolve().parents[1] / "data" / "psid" / "cases.toml"
+CASES = psid.load_cases(TABLE)
 
 #: Measured gaps to PSS/E, each with its numbers and what is known of its cause. A listed case
 #: that fails is an expected failure; a listed case that passes fails the suite (strict): the gap
@@ -105,7 +110,7 @@ def test_every_psid_psse_case_is_listed():
     ids = [c["id"] for c in CASES]
     assert len(ids) == len(set(ids))
     used = {c["dyr"] for c in CASES if c["dyr"]} | {c["raw"] for c in CASES} | {c["csv"] for c in CASES if c["csv"]}
-    vendored = {str(p.relative_to(psid.DATA)) for p in psid.DATA.rglob("*") if p.suffix in (".raw", ".dyr", ".csv")}
+    vendored = {str(p.relative_to(TABLE.parent)) for p in TABLE.parent.rglob("*") if p.suffix in (".raw", ".dyr", ".csv")}
     unused = vendored - used - {"DEGOV/ThreeBus_GAST_simple.dyr"}   # PSID's base file of the DEGOV swap
     assert not unused, f"vendored files no entry uses: {sorted(unused)}"
     missing = used - vendored
@@ -114,9 +119,9 @@ def test_every_psid_psse_case_is_listed():
 
 def test_psse_samples_keep_the_pre_event_value():
     # PSS/E repeats the event's time stamp; as PSID, the first (pre-event) sample is kept
-    case = psid.case_by_id("psid20_esac1a")
+    case = psid.case_by_id("psid20_esac1a", TABLE)
     t, M = psid.read_psse_csv(case)
-    raw = np.genfromtxt(psid.data_path(case["csv"]), delimiter=",")
+    raw = np.genfromtxt(psid.case_file(case, "csv"), delimiter=",")
     assert len(raw) == 4002 and (t[1:] > t[:-1]).all() and len(t) == 4001
     k = int(np.flatnonzero(np.isclose(t, 1.0))[0])
     # the terminal voltage (column 3) at t = 1.0 s is still the initial one: the pre-event sample

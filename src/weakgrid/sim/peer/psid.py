@@ -38,7 +38,9 @@ from ..errors import DataError
 from ..events import Event, LineTrip
 from ..network import BR_B, BR_R, BR_X, F_BUS, PD, QD, T_BUS
 
-#: folder of the vendored PSID cases (``tests/data/psid`` of the source tree)
+#: folder of the vendored PSID cases in a source checkout (``tests/data/psid``); an installed
+#: wheel has no tests folder, so callers there pass the ``cases.toml`` path to :func:`load_cases`
+#: (each entry then remembers its folder as ``root``)
 DATA = Path(__file__).resolve().parents[4] / "tests" / "data" / "psid"
 
 #: default simulation step [s] (PSS/E's CSVs are sampled at 5 ms; 1/240 s is weakgrid's usual
@@ -51,13 +53,19 @@ SWING_SHARE = 0.05
 
 # ------------------------------------------------------------------------------ the table
 def load_cases(path=None) -> list[dict]:
-    """The entries of ``cases.toml`` (list of dicts; ``run`` defaults to True)."""
+    """The entries of ``cases.toml`` (list of dicts; ``run`` defaults to True, ``root`` is the
+    folder of ``path``, against which the entry's files are read)."""
     path = Path(path) if path is not None else DATA / "cases.toml"
+    if not path.is_file():
+        raise FileNotFoundError(
+            f"PSID case table {path} not found: pass the path of tests/data/psid/cases.toml of a "
+            "weakgrid source checkout (an installed wheel carries no test data)")
     with open(path, "rb") as f:
         cases = tomllib.load(f)["case"]
     for c in cases:
         c.setdefault("run", True)
         c.setdefault("compare", [])
+        c.setdefault("root", str(path.parent))
     return cases
 
 
@@ -74,6 +82,12 @@ def data_path(rel, root=None) -> str:
     return str((Path(root) if root is not None else DATA) / rel)
 
 
+def case_file(case, key, root=None) -> str:
+    """Path of the entry's file ``case[key]`` (``root``, else the entry's own ``root``, else
+    :data:`DATA`)."""
+    return data_path(case[key], root if root is not None else case.get("root"))
+
+
 def dedupe(t, *ys):
     """Keep the first sample of each repeated time stamp (PSID's ``clean_extra_timestep!``)."""
     t = np.asarray(t, dtype=float)
@@ -85,7 +99,7 @@ def dedupe(t, *ys):
 def read_psse_csv(case, root=None):
     """PSS/E's results of ``case``: ``(t, M)`` with repeated time stamps removed; ``M[:, j]`` is
     the CSV's 1-based column ``j + 1`` (column 1 is the time)."""
-    M = np.genfromtxt(data_path(case["csv"], root), delimiter=",", skip_header=int(case.get("csv_header", 0)))
+    M = np.genfromtxt(case_file(case, "csv", root), delimiter=",", skip_header=int(case.get("csv_header", 0)))
     t, M = dedupe(M[:, 0], M)
     return t, M
 
@@ -272,8 +286,8 @@ def read_psse(case, root=None):
     """``from_psse(raw, dyr)`` of the entry's files, exactly as shipped: ``(system, events)``."""
     from ..io.psse import from_psse
 
-    dyr = data_path(case["dyr"], root) if case.get("dyr") else None
-    return from_psse(data_path(case["raw"], root), dyr)
+    dyr = case_file(case, "dyr", root) if case.get("dyr") else None
+    return from_psse(case_file(case, "raw", root), dyr)
 
 
 def build_weakgrid(case, root=None, route="psse"):
@@ -410,8 +424,8 @@ def compare_case(case, run, root=None):
 def _andes_load(case, root=None):
     from .andes_case import load_case
 
-    dyr = data_path(case["dyr"], root) if case.get("dyr") else None
-    ss = load_case(data_path(case["raw"], root), addfile=dyr)
+    dyr = case_file(case, "dyr", root) if case.get("dyr") else None
+    ss = load_case(case_file(case, "raw", root), addfile=dyr)
     return ss
 
 
