@@ -1,11 +1,46 @@
-"""Arguments shared by the study subcommands (a study file or a shipped study's name)."""
+"""Arguments shared by the study subcommands (a study file or a shipped study's name, and
+``--set DOTTED.FIELD=VALUE`` overrides of its fields)."""
 
 from __future__ import annotations
 
+import argparse
 
-def add_study_argument(p):
-    p.add_argument("study", help="a study file (TOML) or the name of a shipped study "
-                                 "(see `weakgrid run --list`)")
+SET_HELP = ("override a field of the study after reading it and before validation: a dotted "
+            "path (a list element by its id, e.g. scenarios.<id>.t_end) = a TOML value "
+            "(0.3, true, [1, 2], \"text\"; a bare word is taken as a string); repeatable")
+
+
+def add_study_argument(p, nargs=None):
+    p.add_argument("study", nargs=nargs, help="a study file (TOML) or the name of a shipped "
+                                              "study (see `weakgrid run --list`)")
+    add_set_argument(p)
+
+
+def add_set_argument(p):
+    """``--set DOTTED.FIELD=VALUE`` (repeatable) on a command that takes a study."""
+    p.add_argument("--set", dest="overrides", metavar="DOTTED.FIELD=VALUE", action="append",
+                   type=field_value, default=[], help=SET_HELP)
+
+
+def field_value(text) -> tuple[str, object]:
+    """``(path, value)`` of ``DOTTED.FIELD=VALUE``; the value is read as TOML (a bare word
+    that is not TOML is taken as a string: ``load=high``)."""
+    import tomllib
+
+    path, sep, raw = str(text).partition("=")
+    path, raw = path.strip(), raw.strip()
+    if not sep or not path or any(p == "" for p in path.split(".")) or not raw:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not DOTTED.FIELD=VALUE: give e.g. upqc.rating=0.3 or "
+            "scenarios.c1-high-conv.t_end=4")
+    try:
+        return path, tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError as exc:
+        if raw[0] in "[{\"'+-.0123456789" or raw in ("inf", "nan"):
+            raise argparse.ArgumentTypeError(
+                f"{text!r}: the value {raw!r} is not valid TOML ({exc}); quote a string "
+                "(name=\"text\"), write lists as [1, 2]") from None
+        return path, raw
 
 
 def add_operating_point(p):
@@ -15,7 +50,8 @@ def add_operating_point(p):
                    help="UPQC structure (default: the study's upqc.structure)")
 
 
-def study_of(args):
+def study_of(args, name=None):
+    """The study named by ``args.study`` (or ``name``) with ``args.overrides`` applied."""
     from ..study.studyfile import load_study
 
-    return load_study(args.study)
+    return load_study(args.study if name is None else name, getattr(args, "overrides", ()))

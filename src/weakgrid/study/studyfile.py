@@ -37,9 +37,10 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
+from ..dotted import get_path as _get, set_path as _set
 from ..game.errors import ParameterError
 
-__all__ = ["Study", "load_study", "study_from_dict", "get_path", "set_path", "shipped_studies",
+__all__ = ["Study", "load_study", "apply_overrides", "study_from_dict", "get_path", "set_path", "shipped_studies",
            "read_study_dict", "EVENT_KINDS"]
 
 TOP = {"study", "grid", "dynamics", "machine", "upqc", "design", "controllers", "scenarios",
@@ -50,48 +51,16 @@ EVENT_KINDS = ("fault", "line_trip", "load_step")
 
 
 # --------------------------------------------------------------------------- dotted paths
-def _step(obj, key, path):
-    if isinstance(obj, dict):
-        if key not in obj:
-            raise ParameterError(path, None, f"no field '{key}'; fields here: {sorted(obj)}")
-        return obj[key]
-    if isinstance(obj, list):
-        for el in obj:
-            if isinstance(el, dict) and str(el.get("id", el.get("name"))) == key:
-                return el
-        if key.lstrip("-").isdigit() and -len(obj) <= int(key) < len(obj):
-            return obj[int(key)]
-        ids = [el.get("id", el.get("name")) for el in obj if isinstance(el, dict)]
-        raise ParameterError(path, None, f"no element '{key}'; give an index 0..{len(obj) - 1} "
-                             f"or one of {ids}")
-    raise ParameterError(path, obj, "is a value, not a table")
-
-
 def get_path(d: dict, path: str):
-    """The value at dotted ``path`` in study dict ``d`` (e.g. ``"upqc.rating"``)."""
-    obj = d
-    for i, key in enumerate(path.split(".")):
-        obj = _step(obj, key, ".".join(path.split(".")[:i + 1]))
-    return obj
+    """The value at dotted ``path`` in study dict ``d`` (e.g. ``"upqc.rating"``; a list element
+    by its ``id`` or index), see :func:`weakgrid.dotted.get_path`."""
+    return _get(d, path)
 
 
 def set_path(d: dict, path: str, value) -> dict:
-    """Set the value at dotted ``path`` (creating missing tables); returns ``d``."""
-    keys = path.split(".")
-    obj = d
-    for i, key in enumerate(keys[:-1]):
-        if isinstance(obj, dict) and key not in obj:
-            obj[key] = {}
-        obj = _step(obj, key, ".".join(keys[:i + 1]))
-    last = keys[-1]
-    if isinstance(obj, list):
-        target = _step(obj, last, path)
-        obj[obj.index(target)] = value
-    elif isinstance(obj, dict):
-        obj[last] = value
-    else:
-        raise ParameterError(".".join(keys[:-1]), obj, "is a value, not a table")
-    return d
+    """Set the value at dotted ``path`` (creating missing tables and an absent optional field;
+    the study is validated afterwards); returns ``d``."""
+    return _set(d, path, value, create=True)
 
 
 # --------------------------------------------------------------------------- reading
@@ -122,11 +91,82 @@ def _read(p) -> dict:
         raise ParameterError("study", str(p), f"is not valid TOML ({exc})") from None
 
 
-def load_study(src) -> "Study":
-    """Read and validate a study (a path or a shipped study's name)."""
+def load_study(src, overrides=()) -> "Study":
+    """Read and validate a study (a path or a shipped study's name).
+
+    Parameters
+    ----------
+    src : str or Path
+        A study file (TOML) or the name of a shipped study.
+    overrides : iterable of (str, object)
+        ``(dotted path, value)`` pairs set in the file's data after reading and before
+        validation (the command line's ``--set``), see :func:`apply_overrides`.
+    """
     d, source = read_study_dict(src)
     base = Path(source).parent if not source.startswith("shipped:") else None
+    overrides = list(overrides)
+    if overrides:
+        d = apply_overrides(d, overrides, source=source, base_dir=base)
     return study_from_dict(d, source=source, base_dir=base)
+
+
+_PROBE = "__weakgrid_unknown_field__"
+
+
+def apply_overrides(d: dict, overrides, source: str = "", base_dir=None,
+                    field: str = "--set") -> dict:
+    """A copy of study dict ``d`` with ``(dotted path, value)`` pairs set (not yet validated).
+
+    A path must name a field the study has (in the file, or a default the validation fills
+    in), or a field its table accepts (an optional field absent from the file; the study's
+    validation then checks the value). Anything else is refused with the fields that exist
+    at that level.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``field`` (``--set``), the path and the valid keys at that level.
+    """
+    d = copy.deepcopy(d)
+    try:
+        filled = study_from_dict(d, source, base_dir).data
+    except ParameterError:       # the file itself is invalid: its validation says why later
+        filled = None
+    for path, value in overrides:
+        keys = path.split(".") if isinstance(path, str) else []
+        if not _known(d, path) and not (filled is not None and _known(filled, path)):
+            parent = ".".join(keys[:-1])
+            ref = filled if filled is not None and _known(filled, parent) else d
+            if parent and not _known(ref, parent):
+                _get(ref, path, field=field)           # raises: names the missing part
+            holder = _get(ref, parent, field=field) if parent else ref
+            if not isinstance(holder, dict):
+                _get(ref, path, field=field)
+            if not _accepts_new(d, parent, source, base_dir):
+                raise ParameterError(field, path, f"'{keys[-1]}' is not a field of "
+                                     f"{parent or 'the study file'}; fields there: "
+                                     f"{sorted(map(str, holder))}")
+        _set(d, path, value, create=True, field=field)
+    return d
+
+
+def _known(d, path) -> bool:
+    try:
+        _get(d, path)
+        return True
+    except ParameterError:
+        return False
+
+
+def _accepts_new(d, parent, source, base_dir) -> bool:
+    """Does the validation check the keys of the table ``parent`` (an unknown one refused)?"""
+    trial = copy.deepcopy(d)
+    try:
+        _set(trial, f"{parent}.{_PROBE}" if parent else _PROBE, 0, create=True)
+        study_from_dict(trial, source, base_dir)
+    except ParameterError as exc:
+        return _PROBE in str(exc)
+    return False
 
 
 # --------------------------------------------------------------------------- validation

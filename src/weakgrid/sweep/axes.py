@@ -1,7 +1,8 @@
 """Sweep axes over the fields of a nested input (a study as a dict).
 
 A field is named by its dotted path, e.g. ``"upqc.rating"`` or
-``"scenarios.0.fault.duration"`` (an integer part indexes a list). Axes combine
+``"scenarios.0.fault.duration"`` (a list element by its ``id`` or its index; one
+mechanism with study files: :mod:`weakgrid.dotted`). Axes combine
 as a Cartesian product, or as listed points (every axis the same length,
 the k-th values taken together).
 """
@@ -13,6 +14,7 @@ import itertools
 import math
 from dataclasses import dataclass, field
 
+from ..dotted import get_path as _get, set_path as _set
 from ..game.errors import ParameterError
 
 __all__ = ["Axis", "Point", "expand", "get_path", "set_path"]
@@ -65,41 +67,15 @@ class Point:
     inputs: dict = field(repr=False)
 
 
-def _parts(path):
-    return [int(p) if p.lstrip("-").isdigit() else p for p in path.split(".")]
-
-
 def get_path(obj, path: str):
-    """The value at dotted ``path`` of a nested dict/list ``obj``.
-
-    Raises
-    ------
-    ParameterError
-        If a part of the path does not exist (the message lists what does).
-    """
-    cur = obj
-    done = []
-    for p in _parts(path):
-        if isinstance(cur, dict) and p in cur:
-            cur = cur[p]
-        elif isinstance(cur, list) and isinstance(p, int) and -len(cur) <= p < len(cur):
-            cur = cur[p]
-        else:
-            where = ".".join(map(str, done)) or "the input"
-            have = sorted(map(str, cur)) if isinstance(cur, dict) else \
-                (f"indices 0..{len(cur) - 1}" if isinstance(cur, list) else "a value")
-            raise ParameterError("sweep.axes.path", path,
-                                 f"'{p}' is not a field of {where} (it has: {have})")
-        done.append(p)
-    return cur
+    """The value at dotted ``path`` of a nested dict/list ``obj`` (:func:`weakgrid.dotted.get_path`;
+    a list element by its ``id``/``name`` or its index)."""
+    return _get(obj, path, field="sweep.axes.path")
 
 
 def set_path(obj, path: str, value):
     """Set the value at dotted ``path`` (the field must exist: a typo is an error)."""
-    parts = _parts(path)
-    parent = get_path(obj, ".".join(map(str, parts[:-1]))) if len(parts) > 1 else obj
-    get_path(obj, path)  # checks the leaf exists
-    parent[parts[-1]] = value
+    _set(obj, path, value, field="sweep.axes.path")
 
 
 def expand(base: dict, axes, mode: str = "product", *, getter=None,
