@@ -184,14 +184,16 @@ class TrainingCheckpoint:
 LINE_SECONDS = 10.0  # without a terminal, a progress line at most this often
 
 
-def outer_bar(initial: int, tol: float, desc="  training", lines=False):
+def outer_bar(initial: int, tol: float, desc="  training", lines=False, disable=None):
     """A progress bar (stderr, only on a terminal) counting outer iterations; returns
     ``(bar, update(record))``. With ``lines``, when there is no terminal (output to a
     file or a pipe) a line on stdout says how far the training is every
-    :data:`LINE_SECONDS`."""
+    :data:`LINE_SECONDS`. ``disable``: tqdm's (``True`` with ``--quiet``/``--no-progress``,
+    which also silence the lines)."""
     from tqdm.auto import tqdm
 
-    bar = tqdm(desc=desc, unit=" outer it", leave=False, disable=None, initial=initial)
+    bar = tqdm(desc=desc, unit=" outer it", leave=False, disable=disable, initial=initial)
+    lines = lines and disable is not True
     last = [time.monotonic()]
 
     def update(rec):

@@ -225,6 +225,17 @@ def output_folder(text) -> Path:
 
 
 # ------------------------------------------------------------------ long work
+def show_progress(args) -> bool:
+    """Progress bars wanted: neither ``--quiet`` nor ``--no-progress`` (every command has both)."""
+    return not (getattr(args, "quiet", False) or getattr(args, "no_progress", False))
+
+
+def bar_disable(args):
+    """tqdm's ``disable`` for a command's progress bar: ``True`` with ``--quiet`` or
+    ``--no-progress``, else ``None`` (shown on a terminal only; results stay on stdout)."""
+    return None if show_progress(args) else True
+
+
 def add_force_argument(p):
     p.add_argument("--force", action="store_true",
                    help="run even if the estimated memory/time exceeds the limits "

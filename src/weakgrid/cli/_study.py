@@ -19,7 +19,7 @@ def add_study_argument(p, nargs=None):
 def add_set_argument(p):
     """``--set DOTTED.FIELD=VALUE`` (repeatable) on a command that takes a study."""
     p.add_argument("--set", dest="overrides", metavar="DOTTED.FIELD=VALUE", action="append",
-                   type=field_value, default=[], help=SET_HELP)
+                   type=field_value, default=None, help=SET_HELP)
 
 
 def field_value(text) -> tuple[str, object]:
@@ -54,4 +54,4 @@ def study_of(args, name=None):
     """The study named by ``args.study`` (or ``name``) with ``args.overrides`` applied."""
     from ..study.studyfile import load_study
 
-    return load_study(args.study if name is None else name, getattr(args, "overrides", ()))
+    return load_study(args.study if name is None else name, getattr(args, "overrides", None) or ())

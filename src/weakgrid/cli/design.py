@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ._checkpoint import TrainingCheckpoint, add_restart_argument, checkpoint_path, outer_bar
 from ._checkpoint import training_key
-from ._common import HelpFormatter, output_file
+from ._common import HelpFormatter, bar_disable, output_file
 from ._study import add_operating_point, add_study_argument, study_of
 
 NAME = "design"
@@ -74,7 +74,7 @@ def run(args) -> int:
     cp = TrainingCheckpoint(checkpoint_path(out),
                             training_key(problem, settings, NAME, model=d.to_dict()),
                             args.restart, NAME)
-    bar, update = outer_bar(cp.kept, settings.tol_u, lines=True)
+    bar, update = outer_bar(cp.kept, settings.tol_u, lines=True, disable=bar_disable(args))
     try:
         ctl = cp.train(problem, settings, progress=update)
     finally:

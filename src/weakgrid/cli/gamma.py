@@ -9,7 +9,7 @@ from ..fileio import write_json_atomic
 from ..game.gamma_settings import SearchSettings
 from ._checkpoint import (Keeper, add_restart_argument, checkpoint_path, content_key,
                           load_kept, problem_inputs, say_kept)
-from ._common import (HelpFormatter, add_force_argument, add_problem_arguments, guard_training,
+from ._common import (HelpFormatter, bar_disable, add_force_argument, add_problem_arguments, guard_training,
                       output_file, positive_float, positive_int, problem_of, provenance)
 
 NAME = "gamma"
@@ -113,7 +113,8 @@ def run(args) -> int:
     from tqdm.auto import tqdm
 
     # the bar (stderr, only on a terminal) follows the training of the running trial
-    bar = tqdm(desc="  gamma search", unit=" outer it", leave=False, disable=None)
+    bar = tqdm(desc="  gamma search", unit=" outer it", leave=False,
+               disable=bar_disable(args))
     keeper = Keeper(ckpt, key, save_search_checkpoint, resume, NAME)
 
     def keep(state, finished):

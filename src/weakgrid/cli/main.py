@@ -61,11 +61,16 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _add_verbosity(p):
-    """``--quiet``/``-q`` and ``--verbose``/``-v`` on a subcommand (the package's log level;
-    a command that already has ``--quiet`` keeps its own, which also shortens its tables)."""
+    """``--quiet``/``-q``, ``--no-progress`` and ``--verbose``/``-v`` on a subcommand (the
+    package's log level and the progress bars, :func:`._common.bar_disable`; a command that
+    already has ``--quiet`` keeps its own, which also shortens its tables)."""
     if "--quiet" not in p._option_string_actions:
         p.add_argument("--quiet", "-q", action="store_true",
-                       help="print only warnings, errors and the results")
+                       help="print only warnings, errors and the results (no progress bars, "
+                            "no informational messages of the library)")
+    if "--no-progress" not in p._option_string_actions:
+        p.add_argument("--no-progress", action="store_true",
+                       help="no progress bars on stderr (they show only on a terminal)")
     p.add_argument("--verbose", "-v", action="count", default=0,
                    help="more detail (repeatable)")
 

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import HelpFormatter, add_cluster_arguments, check_cluster, output_folder
+from ._common import (HelpFormatter, add_cluster_arguments, check_cluster, output_folder,
+                      show_progress)
 
 NAME = "reproduce"
 
@@ -33,7 +34,7 @@ def run(args) -> int:
 
     check_cluster(args)
     summary = reproduce(args.output, quick=args.quick, scheduler=args.scheduler,
-                        workers=args.workers)
+                        workers=args.workers, progress=show_progress(args))
     width = max((len(c["id"]) for c in summary["claims"]), default=0)
     print("\nclaims of the paper:")
     for c in summary["claims"]:

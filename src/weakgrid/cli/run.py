@@ -6,6 +6,9 @@ from pathlib import Path
 
 from ._common import HelpFormatter, add_cluster_arguments, check_cluster, output_folder
 
+from ._common import show_progress
+from ._study import add_study_argument, study_of
+
 NAME = "run"
 
 
@@ -18,7 +21,7 @@ def add_parser(sub):
                     "controller, and write metrics (CSV, Markdown), figures, run signals and "
                     "report.html.",
         formatter_class=HelpFormatter)
-    p.add_argument("study", nargs="?", help="a study file (TOML) or a shipped study's name")
+    add_study_argument(p, nargs="?")
     p.add_argument("--output", "-o", type=output_folder, default=None,
                    help="output folder (default: <study>-output)")
     p.add_argument("--quick", action="store_true",
@@ -45,11 +48,12 @@ def run(args) -> int:
                              f"name: {shipped_studies()} (`weakgrid run --list`)")
     from ..study.engine import run_studies
 
-    st = load_study(args.study)
+    st = study_of(args)
     check_cluster(args)
     out = args.output or Path(f"{st.name}-output")
     summary = run_studies([st], out, quick=args.quick, title=st.data["study"]["title"] or st.name,
-                          scheduler=args.scheduler, workers=args.workers)
+                          scheduler=args.scheduler, workers=args.workers,
+                          progress=show_progress(args))
     for d in summary["designs"]:
         print(f"  design {d['load']} {d['upqc']}: a = {d['a']}, V̄r = {d['Vr_bar']}, "
               f"ϕs0 = {d['phi_s0']}; modes {d['modes']}")

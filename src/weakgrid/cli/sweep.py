@@ -5,7 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ._common import (HelpFormatter, add_cluster_arguments, add_force_argument, check_cluster,
-                      output_folder)
+                      output_folder, show_progress)
+
+from ._study import add_study_argument, study_of
 
 NAME = "sweep"
 
@@ -25,7 +27,7 @@ def add_parser(sub):
                     "a sweep beyond 30 min or 4 GiB / half the available memory "
                     "(WEAKGRID_MAX_GIB) unless --force.",
         formatter_class=HelpFormatter)
-    p.add_argument("study", help="a study file (TOML) or a shipped study's name")
+    add_study_argument(p)
     p.add_argument("--output", "-o", type=output_folder, default=None,
                    help="output folder (default: <study>-sweep)")
     add_cluster_arguments(p)
@@ -33,7 +35,6 @@ def add_parser(sub):
     p.add_argument("--signals", action="store_true",
                    help="keep every run's signals (Parquet, in the cache folder)")
     p.add_argument("--maps", action="store_true", help="also draw the sweep's maps (PNG)")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_force_argument(p)
     p.set_defaults(func=run)
     return p
@@ -41,12 +42,11 @@ def add_parser(sub):
 
 def run(args) -> int:
     """Run ``weakgrid sweep`` with the parsed ``args``; return the exit status."""
-    from ..study.studyfile import load_study
     from ..study.sweep import run_study_sweep
     from ..study.sweep_estimate import check_sweep, estimate_sweep
     from ..sweep import SweepInterrupted
 
-    st = load_study(args.study)
+    st = study_of(args)
     if args.signals and "sweep" in st.data:
         st.data["sweep"]["signals"] = True
     check_cluster(args)
@@ -58,7 +58,7 @@ def run(args) -> int:
     check_sweep(est, st, quick=args.quick, force=args.force)
     try:
         table = run_study_sweep(st, out, quick=args.quick, scheduler=args.scheduler,
-                                workers=args.workers, progress=not args.no_progress)
+                                workers=args.workers, progress=show_progress(args))
     except SweepInterrupted as exc:
         print(f"weakgrid sweep: {exc}")
         return 130

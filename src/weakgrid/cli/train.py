@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ._checkpoint import (CHECKPOINT_SECONDS, TrainingCheckpoint, add_restart_argument,
                           checkpoint_path, outer_bar, training_key)
-from ._common import (HelpFormatter, add_force_argument, add_problem_arguments, guard_training,
+from ._common import (HelpFormatter, bar_disable, add_force_argument, add_problem_arguments, guard_training,
                       output_file, positive_float, problem_of)
 
 NAME = "train"
@@ -87,7 +87,7 @@ def run(args) -> int:
     from tqdm.auto import tqdm
 
     # the bar (stderr, only on a terminal) counts outer iterations and shows max|Δu| vs δu
-    bar, update = outer_bar(cp.kept, settings.tol_u)
+    bar, update = outer_bar(cp.kept, settings.tol_u, disable=bar_disable(args))
 
     def progress(rec):
         update(rec)

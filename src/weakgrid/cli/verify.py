@@ -9,7 +9,7 @@ from ..fileio import write_json_atomic
 from ..game.dp_settings import DPSettings
 from ._checkpoint import (Keeper, TrainingCheckpoint, add_restart_argument, checkpoint_path,
                           content_key, load_kept, say_kept, training_key)
-from ._common import (HelpFormatter, add_force_argument, add_problem_arguments, guard_dp,
+from ._common import (HelpFormatter, bar_disable, add_force_argument, add_problem_arguments, guard_dp,
                       guard_training, input_file, nonnegative_float, output_file, positive_float,
                       positive_int, problem_of, provenance)
 
@@ -130,7 +130,7 @@ def run(args) -> int:
 
     # the bar (stderr, only on a terminal) counts DP iterations against the cap
     bar = tqdm(desc="  DP", unit=" it", total=settings.max_iterations, leave=False,
-               disable=None, initial=start.iteration if start is not None else 0)
+               disable=bar_disable(args), initial=start.iteration if start is not None else 0)
 
     def progress(r):
         bar.update(1)

@@ -578,7 +578,7 @@ class Simulator:
                                       f"initial angles: {math.degrees(e[i]):+.1f} and "
                                       f"{math.degrees(e[j]):+.1f} deg)")
 
-    def run(self, t_end, events=(), controllers=(), on_failure="raise") -> Results:
+    def run(self, t_end, events=(), controllers=(), on_failure="raise", progress=None) -> Results:
         """Simulate from the current time to ``t_end`` [s].
 
         Parameters
@@ -592,6 +592,8 @@ class Simulator:
         on_failure : {"raise", "return"}
             Raise :class:`SimulationError`, or return the results up to the failure
             with ``Results.failure`` set.
+        progress : callable, optional
+            ``progress(t)`` after every step, with the time reached [s] (a progress bar).
         """
         sys = self.sys
         from .events import flatten
@@ -658,6 +660,8 @@ class Simulator:
                     h = self._step(h)
                     nstep += 1
                     self._check()
+                    if progress is not None:
+                        progress(self.t)
                 hit = abs(self.t - tb) <= eps * max(1.0, abs(tb)) * 10
                 discont = False
                 new_jac = False

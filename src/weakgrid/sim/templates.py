@@ -27,6 +27,10 @@ PMAX = 8
 __all__ = ["classical_parameters", "classical_system", "matpower_case"]
 
 
+def _is_pandapower(case) -> bool:
+    return hasattr(case, "bus") and hasattr(case, "f_hz")
+
+
 def matpower_case(case) -> dict:
     """The MATPOWER case dict of ``case``.
 
@@ -43,7 +47,7 @@ def matpower_case(case) -> dict:
     -------
     dict with ``baseMVA``, ``bus``, ``gen``, ``branch``.
     """
-    if isinstance(case, dict):
+    if isinstance(case, dict) and not _is_pandapower(case):   # a pandapower net is a dict too
         return case
     if isinstance(case, Network):
         return dict(case.case)
@@ -54,7 +58,7 @@ def matpower_case(case) -> dict:
         if fn is None or not callable(fn):
             raise DataError("case", "name", case, "not a function of pandapower.networks (e.g. 'case118')")
         case = fn()
-    if hasattr(case, "bus") and hasattr(case, "f_hz"):
+    if _is_pandapower(case):
         net = Network.from_pandapower(case)
         c = {k: np.array(v, dtype=float) for k, v in net.case.items() if k != "baseMVA"}
         c["baseMVA"] = net.Sb
