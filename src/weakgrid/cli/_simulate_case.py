@@ -95,8 +95,10 @@ def run_case(args) -> int:
     system.setup()
     print(f"initialization: power flow converged (largest mismatch {net.pf.mismatch:.1e} pu), "
           f"{system.nx} states, {system.N - system.nx} algebraic variables")
+    from_file = {id(e) for e in case.events}
     for e in sorted(events, key=lambda e: getattr(e, "t_on", getattr(e, "t", 0.0))):
-        print(f"  event: {describe_event(e)}")
+        print(f"  event: {describe_event(e)}" + (" (in the case file)" if id(e) in from_file
+                                                 else ""))
     if not events:
         print("  no events: the run should stay at the operating point (a flat start check)")
     if args.record:

@@ -10,9 +10,16 @@ SET_HELP = ("override a field of the study after reading it and before validatio
             "(0.3, true, [1, 2], \"text\"; a bare word is taken as a string); repeatable")
 
 
-def add_study_argument(p, nargs=None):
-    p.add_argument("study", nargs=nargs, help="a study file (TOML) or the name of a shipped "
-                                              "study (see `weakgrid run --list`)")
+def add_study_argument(p, nargs=None, case=False):
+    """The positional STUDY (``case``: STUDY|CASE, a plain case file accepted too) and
+    ``--set``."""
+    if case:
+        p.add_argument("study", metavar="STUDY|CASE", nargs=nargs,
+                       help="a study file (.toml) or a shipped study's name (see `weakgrid run "
+                            "--list`); or a case file (.raw, .m, .mat, .json, .xlsx)")
+    else:
+        p.add_argument("study", nargs=nargs, help="a study file (TOML) or the name of a shipped "
+                                                  "study (see `weakgrid run --list`)")
     add_set_argument(p)
 
 
