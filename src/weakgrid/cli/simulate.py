@@ -26,7 +26,9 @@ def add_parser(sub):
                    help="simulated time [s] (default: the scenario's)")
     p.add_argument("--list", action="store_true", help="list scenarios and controllers")
     p.add_argument("--output", "-o", type=output_file(".csv", ".parquet"), default=None,
-                   help="write the run's signals (.csv or .parquet)")
+                   help="write the run: .parquet a run file (every signal by name, units in its "
+                        "metadata, the controller's samples; weakgrid.read_run), .csv every "
+                        "signal in per unit")
     p.set_defaults(func=run)
     return p
 
@@ -39,6 +41,7 @@ def run(args) -> int:
 
     from ..fileio import replace_atomic
     from ..game.errors import ParameterError
+    from ..study.cache import write_run_file
     from ..study.runner import Run, run_scenario
     from ..study.studyfile import load_study
 
@@ -71,12 +74,10 @@ def run(args) -> int:
     for k, v in rec.metrics.items():
         print(f"  {k:26s} {v:.6g}" if isinstance(v, float) else f"  {k:26s} {v}")
     if args.output:
-        t = rec.series["t"]
-        df = pd.DataFrame({k: v for k, v in rec.series.items()
-                           if hasattr(v, "shape") and v.shape == t.shape})
-        if args.output.suffix.lower() == ".parquet":
-            replace_atomic(args.output, df.to_parquet)
-        else:
+        if args.output.suffix.lower() == ".parquet":   # a run file: every signal, by name
+            write_run_file(rec, args.output)
+        else:   # CSV: every signal per instant (per unit), no metadata
+            df = rec.results.to_frame() if rec.results is not None else pd.DataFrame(rec.series)
             replace_atomic(args.output, lambda tmp: df.to_csv(tmp, index=False))
         print(f"  wrote {args.output}")
     return 0 if not rec.metrics["failed"] else 3

@@ -234,8 +234,13 @@ class _Recorder:
                 continue
             hits = [col[n] for n in fnmatch.filter(self.names, w)] if any(ch in w for ch in "*?[") else []
             if not hits:
-                close = [n for n in self.names if w.split(".")[-1] in n][:6]
-                raise DataError("simulation", "record", w, f"no such variable or pattern; e.g. {close}")
+                import difflib
+
+                close = difflib.get_close_matches(w, self.names, n=6, cutoff=0.5) or \
+                    [n for n in self.names if w.split(".")[-1] in n][:6]
+                raise DataError("simulation", "record", w, f"no such variable or pattern; "
+                                f"closest: {close} (names <device>.<signal>, fnmatch patterns "
+                                f"such as '*.omega' allowed)")
             sel += hits
         sel = np.array(sorted(set(sel)), dtype=int)
         self.sel = sel

@@ -42,7 +42,7 @@ import numpy as np
 
 from .errors import DataError
 
-__all__ = ["write_run", "read_run", "read_samples", "read_meta", "run_signals", "FORMAT",
+__all__ = ["write_run", "run_table", "read_run", "read_samples", "read_meta", "run_signals", "FORMAT",
            "FORMAT_VERSION", "META_KEY", "SAMPLE_PREFIX"]
 
 FORMAT = "weakgrid-run"
@@ -128,6 +128,9 @@ def _padded(a, n):
 def write_run(path, results, *, samples=None, meta=None):
     """Write a simulation's trajectories (and controller samples) as one run file.
 
+    The table is :func:`run_table`'s; the file is written atomically
+    (:func:`weakgrid.fileio.replace_atomic`).
+
     Parameters
     ----------
     path : str or Path
@@ -148,11 +151,20 @@ def write_run(path, results, *, samples=None, meta=None):
     Path
         The written file.
     """
-    import pyarrow as pa
     import pyarrow.parquet as pq
 
+    from ..fileio import replace_atomic
+
+    table = run_table(results, samples=samples, meta=meta)
+    return replace_atomic(path, lambda tmp: pq.write_table(table, tmp))
+
+
+def run_table(results, *, samples=None, meta=None):
+    """The :class:`pyarrow.Table` of a run file (arguments as :func:`write_run`'s)."""
+    import pyarrow as pa
+
     from .. import __version__
-    from ..fileio import json_safe, replace_atomic
+    from ..fileio import json_safe
 
     t = np.asarray(results.t, float)
     scols = _sample_columns(samples)
@@ -181,8 +193,7 @@ def write_run(path, results, *, samples=None, meta=None):
             "n_instants": int(len(t)), "n_samples": int(ns)}
     info.update(meta or {})
     schema = pa.schema(fields, metadata={META_KEY: json.dumps(json_safe(info)).encode()})
-    table = pa.Table.from_arrays(arrays, schema=schema)
-    return replace_atomic(path, lambda tmp: pq.write_table(table, tmp))
+    return pa.Table.from_arrays(arrays, schema=schema)
 
 
 def _schema(path):
