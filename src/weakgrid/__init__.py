@@ -12,4 +12,13 @@ Layers (imports flow one way): ``cli → study → (sim, models) → game``.
 
 from ._version import __version__
 
-__all__ = ["__version__"]
+__all__ = ["__version__", "read_run"]
+
+
+def __getattr__(name):
+    # lazy: ``import weakgrid`` stays cheap (no numpy/pandas/pyarrow until a run is read)
+    if name == "read_run":
+        from .sim.runfile import read_run
+
+        return read_run
+    raise AttributeError(f"module 'weakgrid' has no attribute {name!r}")

@@ -90,13 +90,12 @@ class CController:
 def recorded(rec, spec):
     """Per sample: measured signals (arbitrary while bypassed: the controller ignores them),
     enable = 1, Python's active flag, demanded and applied u."""
-    s = rec.series
-    y = s["y_measured"]
+    y = rec.sample("y_measured")
     active = np.all(np.isfinite(y), axis=1)
     y = np.where(np.isfinite(y), y, 0.0)
     meas = np.hstack([y, np.ones((len(y), 1))])
     assert meas.shape[1] == len(spec.state_map.signals) + 1
-    return s["tk"], meas, active, s["u_demanded"], s["u_applied"]
+    return rec.samples["tk"], meas, active, rec.sample("u_demanded"), rec.sample("u_applied")
 
 
 def inputs(spec):

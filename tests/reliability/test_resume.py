@@ -21,8 +21,9 @@ def _rec(sc):
     t = np.linspace(0, 1, 11)
     tk = np.linspace(0, 1, 4)
     return RunRecord(sc, {"id": sc.id, "failed": False, "settling": float("nan")},
-                     {"t": t, "speed": np.sin(t), "tk": tk, "running_cost": tk**2,
-                      "x_design": np.column_stack([tk, -tk])}, {"note": "x"})
+                     {"t": t, "speed": np.sin(t)}, {"note": "x"},
+                     samples={"tk": tk, "running_cost": tk**2, "x_design[0]": tk,
+                              "x_design[1]": -tk})
 
 
 def test_a_finished_run_round_trips_and_a_changed_input_is_redone(tmp_path):
@@ -31,12 +32,13 @@ def test_a_finished_run_round_trips_and_a_changed_input_is_redone(tmp_path):
     save_run(_rec(sc), tmp_path, key)
     got = load_run(tmp_path, sc, key, RunRecord)
     assert got is not None and np.isnan(got.metrics["settling"])
-    np.testing.assert_array_equal(got.series["x_design"], _rec(sc).series["x_design"])
+    np.testing.assert_array_equal(got.sample("x_design"), _rec(sc).sample("x_design"))
+    np.testing.assert_array_equal(got.samples["tk"], np.linspace(0, 1, 4))
     np.testing.assert_array_equal(got.series["speed"], np.sin(np.linspace(0, 1, 11)))
     longer = Scenario("a", C1, "high", "conventional", "pq", 0.2, 0.25, 2.0)
     assert inputs_key(scenario=longer.to_dict()) != key
     assert load_run(tmp_path, longer, inputs_key(scenario=longer.to_dict()), RunRecord) is None
-    (tmp_path / "a.samples.parquet").unlink()  # an incomplete run is redone
+    (tmp_path / "a.parquet").unlink()  # an incomplete run is redone
     assert load_run(tmp_path, sc, key, RunRecord) is None
 
 
@@ -46,8 +48,7 @@ def test_stale_runs_of_an_earlier_plan_are_removed_with_a_warning(tmp_path):
         save_run(_rec(sc), tmp_path, "k")
     said = []
     assert remove_stale(tmp_path, ["keep"], said.append) == ["old"]
-    assert sorted(p.name for p in tmp_path.iterdir()) == [
-        "keep.json", "keep.parquet", "keep.samples.parquet"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.json", "keep.parquet"]
     assert "stale" in said[0] and "old" in said[0]
 
 

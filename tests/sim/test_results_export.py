@@ -33,8 +33,12 @@ def test_export_roundtrip(tmp_path):
     r.to_parquet(tmp_path / "a.parquet")
     a = pd.read_csv(tmp_path / "a.csv")
     b = pd.read_parquet(tmp_path / "a.parquet")
-    assert "G1.Pe [MW]" in a.columns and "G1.Pe [pu (Sb)]" in b.columns
-    assert np.allclose(b["G1.omega [pu]"], r["G1.omega"])
+    # names are the variables' names; units live in attrs / Parquet metadata, not in names
+    assert "G1.Pe" in a.columns and "G1.Pe" in b.columns and not any("[" in c for c in b.columns)
+    assert np.allclose(a["G1.Pe"], r.si("G1.Pe"))
+    assert np.array_equal(b["G1.omega"], r["G1.omega"])
+    f = r.to_frame(si=True)
+    assert list(f.columns) == ["t", *r.names] and f.attrs["units"]["G1.Pe"] == "MW"
     # the fault is visible: two samples at each event time
     assert np.sum(np.isclose(r.t, 0.1)) == 2
 

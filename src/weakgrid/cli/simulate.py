@@ -75,8 +75,14 @@ def add_parser(sub):
                    help="simulated time [s] (default: the scenario's; 20 s for a case, as "
                         "ANDES)")
     p.add_argument("--output", "-o", type=output_file(".csv", ".parquet"), default=None,
+<<<<<<< HEAD
                    help="write the run's signals (.csv or .parquet for a study; .parquet, "
                         "the run file, for a case)")
+=======
+                   help="write the run: .parquet a run file (every signal by name, units in its "
+                        "metadata, the controller's samples; weakgrid.read_run), .csv every "
+                        "signal in per unit")
+>>>>>>> runformat
     p.set_defaults(func=run)
     return p
 
@@ -115,6 +121,7 @@ def run_study(args) -> int:
 
     from ..fileio import replace_atomic
     from ..game.errors import ParameterError
+    from ..study.cache import write_run_file
     from ..study.runner import Run, run_scenario
     from ._study import study_of
 
@@ -147,12 +154,10 @@ def run_study(args) -> int:
     for k, v in rec.metrics.items():
         print(f"  {k:26s} {v:.6g}" if isinstance(v, float) else f"  {k:26s} {v}")
     if args.output:
-        t = rec.series["t"]
-        df = pd.DataFrame({k: v for k, v in rec.series.items()
-                           if hasattr(v, "shape") and v.shape == t.shape})
-        if args.output.suffix.lower() == ".parquet":
-            replace_atomic(args.output, df.to_parquet)
-        else:
+        if args.output.suffix.lower() == ".parquet":   # a run file: every signal, by name
+            write_run_file(rec, args.output)
+        else:   # CSV: every signal per instant (per unit), no metadata
+            df = rec.results.to_frame() if rec.results is not None else pd.DataFrame(rec.series)
             replace_atomic(args.output, lambda tmp: df.to_csv(tmp, index=False))
         print(f"  wrote {args.output}")
     return 0 if not rec.metrics["failed"] else 3

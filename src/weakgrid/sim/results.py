@@ -21,14 +21,11 @@ import math
 import numpy as np
 
 from .errors import DataError
+from .runfile import UNIT_LABELS as _LABEL  # unit kind -> (pu label, SI label)
 
 #: systems with more DAE variables than this record only machine speeds and angles by default
 RECORD_ALL_MAX = 3000
 
-# unit kind -> (pu label, SI label)
-_LABEL = {"pu": ("pu", "pu"), "power": ("pu (Sb)", "MW"), "voltage": ("pu", "kV"),
-          "angle": ("rad", "deg"), "speed": ("pu", "rad/s"), "current": ("pu (Sb)", "kA"),
-          "time": ("s", "s"), "energy": ("pu·s", "MJ")}
 
 
 class Results:
@@ -85,28 +82,44 @@ class Results:
         return [n for n in self.names if pattern in n]
 
     def to_frame(self, si: bool = False, names=None):
-        """A :class:`pandas.DataFrame` with a ``t`` column; column names carry units in brackets."""
+        """A :class:`pandas.DataFrame`: a ``t`` column [s] and one column per variable, named
+        as the variable (``"G1.omega"``); the units are in ``df.attrs["units"]`` (name →
+        unit label, SI labels with ``si=True``), not in the names. Every recorded row is
+        kept (a breakpoint's pre- and post-event values share a ``t``)."""
         import pandas as pd
 
         names = self.names if names is None else list(names)
-        cols = {"t [s]": self.t}
+        cols = {"t": self.t}
         for n in names:
-            cols[f"{n} [{self.unit(n, si)}]"] = self.si(n) if si else self[n]
-        return pd.DataFrame(cols)
+            cols[n] = self.si(n) if si else self[n]
+        df = pd.DataFrame(cols)
+        df.attrs["units"] = {"t": "s", **{n: self.unit(n, si) for n in names}}
+        return df
 
     def to_csv(self, path, si: bool = False, names=None):
-        """Write the trajectories to CSV (atomically: the previous file survives a failure)."""
+        """Write the trajectories to CSV (atomically: the previous file survives a failure).
+        CSV has no metadata: the column names are the variables' names; their units are
+        those of :meth:`unit` (``si`` as given). Prefer :meth:`to_parquet`, which keeps them."""
         from ..fileio import replace_atomic
 
         df = self.to_frame(si, names)
         return replace_atomic(path, lambda tmp: df.to_csv(tmp, index=False))
 
-    def to_parquet(self, path, si: bool = False, names=None):
-        """Write the trajectories to Parquet (pyarrow; atomically)."""
-        from ..fileio import replace_atomic
+    def to_parquet(self, path, names=None, *, samples=None, meta=None):
+        """Write a run file (:func:`weakgrid.sim.runfile.write_run`): every variable (or
+        ``names``) in per unit, units and per-unit bases as Parquet field metadata,
+        breakpoints' pre-event rows flagged; read it with :func:`weakgrid.read_run`."""
+        from .runfile import write_run
 
-        df = self.to_frame(si, names)
-        return replace_atomic(path, lambda tmp: df.to_parquet(tmp, index=False))
+        res = self if names is None else self.subset(names)
+        return write_run(path, res, samples=samples, meta=meta)
+
+    def subset(self, names) -> "Results":
+        """These results restricted to the variables ``names`` (in that order)."""
+        names = list(names)
+        cols = [self._col[n] if n in self._col else self[n] for n in names]
+        return Results(self.t, names, self.data[:, cols], [self.kinds[c] for c in cols],
+                       self.si_factor[cols], failure=self.failure, stats=self.stats)
 
     def plot(self, names, si: bool = False, ax=None, title=None):
         """Plot variables against time; axes labelled with units. Returns the matplotlib axes."""
@@ -221,8 +234,13 @@ class _Recorder:
                 continue
             hits = [col[n] for n in fnmatch.filter(self.names, w)] if any(ch in w for ch in "*?[") else []
             if not hits:
-                close = [n for n in self.names if w.split(".")[-1] in n][:6]
-                raise DataError("simulation", "record", w, f"no such variable or pattern; e.g. {close}")
+                import difflib
+
+                close = difflib.get_close_matches(w, self.names, n=6, cutoff=0.5) or \
+                    [n for n in self.names if w.split(".")[-1] in n][:6]
+                raise DataError("simulation", "record", w, f"no such variable or pattern; "
+                                f"closest: {close} (names <device>.<signal>, fnmatch patterns "
+                                f"such as '*.omega' allowed)")
             sel += hits
         sel = np.array(sorted(set(sel)), dtype=int)
         self.sel = sel

@@ -244,6 +244,7 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                 run, rkey = futs[fut]
                 records[run.id] = rec = fut.result()
                 save_run(rec, runs_dir, rkey)    # kept as soon as it is finished
+                rec.results = None               # every signal is in its run file now
                 bar.set_postfix_str(run.id)
                 bar.update(1)
         else:
@@ -251,6 +252,7 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                 bar.set_postfix_str(run.id)
                 records[run.id] = rec = run_scenario(st, run, trained)
                 save_run(rec, runs_dir, rkey)
+                rec.results = None               # every signal is in its run file now
                 bar.update(1)
         metrics = [records[run.id].metrics for _, run, _, _ in all_runs]
         bar.close()

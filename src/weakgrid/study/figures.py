@@ -54,8 +54,9 @@ def _series(rec, key):
     s = rec.series
     if key == "p_series_kw":
         return (s["t"], s["p_series_mw"] * 1e3) if "p_series_mw" in s else None
-    if key in ("running_cost", "running_cost_w", "value_J"):
-        return (s["tk"], s[key]) if len(s.get("tk", [])) and key in s else None
+    if key in ("running_cost", "running_cost_w", "value_J"):   # per controller sample
+        k = rec.samples
+        return (k["tk"], k[key]) if len(k.get("tk", [])) and key in k else None
     return (s["t"], s[key]) if key in s else None
 
 

@@ -18,7 +18,8 @@ from .controllers import controller_variant, make_controller
 from .failure import failure_text
 from .metrics import backswing, control_cost, itae, running_cost, settling_time, stability_verdict
 
-__all__ = ["Run", "RunRecord", "run_scenario", "enable_windows", "make_events", "sim_settings"]
+__all__ = ["Run", "RunRecord", "run_scenario", "enable_windows", "make_events", "sim_settings",
+           "derive_series", "flat_columns", "record_list"]
 
 Q_DESIGN = 0.01 * np.eye(2)  # the paper's state weight of (18), for the running cost metric
 R_DESIGN = np.eye(2)
@@ -79,12 +80,81 @@ class _MeasureOnly:
 
 @dataclass
 class RunRecord:
-    """What a run produced: metrics (flat dict) and the series the figures need."""
+    """What a run produced: metrics (flat dict), the series the figures need and the
+    simulator's full trajectories.
+
+    Attributes
+    ----------
+    series : dict
+        Per recorded instant (every array as long as ``series["t"]``, so
+        ``pandas.DataFrame(series)`` works): ``t`` [s] and the figure keys, each an alias
+        of a simulator signal (``aliases``) or derived from them (:func:`derive_series`).
+    samples : dict
+        Per controller sample (every array as long as ``samples["tk"]``): ``tk`` [s],
+        ``running_cost`` and, for 2-D quantities (``x_design``, ``y_measured``,
+        ``u_demanded``, ``u_applied``), one column ``key[j]`` each;
+        :meth:`sample` stacks them back.
+    results : weakgrid.sim.results.Results or None
+        Every recorded signal of the simulation by name (None for a run read back from
+        the cache: its run file holds them, :func:`weakgrid.read_run`).
+    aliases : dict
+        Figure key → simulator signal name (``sg_speed`` → ``G1.omega``).
+    """
 
     scenario: Run
     metrics: dict
     series: dict
     info: dict = field(default_factory=dict)
+    samples: dict = field(default_factory=dict)
+    results: object = None
+    aliases: dict = field(default_factory=dict)
+
+    def sample(self, key) -> np.ndarray:
+        """Per-sample quantity ``key``: 1-D, or 2-D (samples × columns ``key[j]``)."""
+        if key in self.samples:
+            return np.asarray(self.samples[key])
+        cols = sorted((int(k[len(key) + 1:-1]), k) for k in self.samples
+                      if k.startswith(key + "[") and k.endswith("]"))
+        if not cols:
+            raise KeyError(f"no per-sample '{key}' in this run; it has {sorted(self.samples)}")
+        return np.column_stack([self.samples[k] for _, k in cols])
+
+
+def flat_columns(d: dict) -> dict:
+    """``d`` with every 2-D array split into 1-D columns ``key[j]``."""
+    out = {}
+    for k, v in d.items():
+        a = np.asarray(v)
+        if a.ndim == 2:
+            for j in range(a.shape[1]):
+                out[f"{k}[{j}]"] = a[:, j]
+        else:
+            out[k] = a
+    return out
+
+
+def derive_series(series: dict, Sb_mva: float) -> dict:
+    """The figure keys computed from the aliased signals (a run read back from its file
+    recomputes them identically): ``vu`` = √(vup² + vuq²) [pu], ``p_series_mw`` =
+    ``p_series`` × Sb [MW]."""
+    out = {}
+    if "vup" in series and "vuq" in series:
+        out["vu"] = np.hypot(series["vup"], series["vuq"])
+    if "p_series" in series:
+        out["p_series_mw"] = series["p_series"] * Sb_mva
+    return out
+
+
+def record_list(study, aliases: dict):
+    """The simulator's ``record`` argument of a study's runs: ``None`` (every signal) unless
+    ``[simulation] record`` selects some (names or fnmatch patterns); the signals the
+    figures and metrics use (``aliases``) are always added."""
+    rec = (study.data.get("simulation") or {}).get("record")
+    if rec is None:
+        return None
+    if isinstance(rec, str):
+        rec = [rec]
+    return list(dict.fromkeys([*rec, *aliases.values()]))
 
 
 def _disable_pss(system):
@@ -205,7 +275,7 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     if dt is None:
         dt, tol = sim_settings(study)
     res = simulate(setup.system, run.t_end, dt=dt, tol=tol, events=events, controllers=[dc],
-                   on_failure="return")
+                   on_failure="return", record=record_list(study, setup.signals))
     wall = time.perf_counter() - t0
     # controller samples: times and (bypass-aware) outputs actually applied
     tk = np.asarray(dc.log_t)
@@ -219,9 +289,12 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     yk[active] = np.asarray(ys).reshape(-1, ny)[: active.sum()]
     t = res.t
     series = {"t": t}
-    for key_, name in setup.signals.items():
-        if name in res:
-            series[key_] = res[name]
+    aliases = {k: n for k, n in setup.signals.items() if n in res}
+    for key_, name in aliases.items():
+        series[key_] = res[name]
+    derived = derive_series(series, setup.Sb_mva)
+    series.update(derived)   # a derived key replaces a same-named alias (vu = |vup + j vuq|)
+    aliases = {k: n for k, n in aliases.items() if k not in derived}
     metrics = {"id": run.id, "case": run.case, "load": run.load, "upqc": run.upqc,
                "controller": run.controller, "design_load": dload, "fault": run.fault_text,
                "failed": res.failure is not None,
@@ -259,20 +332,18 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     metrics["control_cost_demanded"] = control_cost(uk, R_DESIGN, T)
     rc = running_cost(xa, ua, Q_DESIGN, R_DESIGN)
     metrics["running_cost_18"] = float(rc[-1]) if rc.size else 0.0
-    series["tk"], series["running_cost"] = tk, rc
-    series["x_design"] = xk
-    # per sample: the measured signals (NaN while bypassed), demanded and applied u
-    series["y_measured"], series["u_demanded"], series["u_applied"] = yk, uk, ua
-    if "vup" in series and "vuq" in series:
-        vu = np.hypot(series["vup"], series["vuq"])
-        series["vu"] = vu
+    # per sample: the measured signals (NaN while bypassed), design states, demanded and
+    # applied u, the running cost (and J, below)
+    samples = {"tk": tk, "running_cost": rc, "x_design": xk, "y_measured": yk,
+               "u_demanded": uk, "u_applied": ua}
+    if "vu" in series:
+        vu = series["vu"]
         metrics["vu_peak_pu"] = float(np.nanmax(vu)) if vu.size else 0.0
         metrics["vu_rms_pu"] = float(np.sqrt(np.nanmean(vu[post] ** 2))) if post.any() else 0.0
         metrics["vu_rating_pu"] = vmax
         metrics["vu_rating_reached"] = bool(metrics["vu_peak_pu"] >= vmax * (1 - 1e-6))
-    if "p_series" in series:
-        pmw = series["p_series"] * setup.Sb_mva
-        series["p_series_mw"] = pmw
+    if "p_series_mw" in series:
+        pmw = series["p_series_mw"]
         pk = float(np.nanmax(np.abs(pmw[post]))) if post.any() else float("nan")
         metrics["p_series_peak_mw"] = pk
         metrics["p_series_peak_pct_line"] = 100 * pk / abs(setup.line_power_mw) \
@@ -281,10 +352,12 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     metrics.update(_protocol_metrics(study, tk, uk, xk, vmax, after))
     if ctl is not None and len(tk):   # Fig. 10/13: J(x(t)) of (30), running cost with -γ²w'Pw
         J, rcw = value_along(ctl, xa, ua)
-        series["value_J"], series["running_cost_w"] = J, rcw
+        samples["value_J"], samples["running_cost_w"] = J, rcw
     info = {"design": setup.design.to_dict(), "derivation": setup.derivation.to_dict(),
-            "controller": choice.info}
-    return RunRecord(run, metrics, series, info)
+            "controller": choice.info, "Sb_mva": setup.Sb_mva,
+            "sim": {"dt": float(dt), "tol": None if tol is None else float(tol)}}
+    return RunRecord(run, metrics, series, info, samples=flat_columns(samples), results=res,
+                     aliases=aliases)
 
 
 def omega_of(study):

@@ -26,7 +26,9 @@ Tables (defaults in brackets)::
     [sweep]       axes over study fields, mode, scenarios, controllers, maps (weakgrid.study.sweep)
     [simulation]  dt [design.T] (integration step, s), tol [the simulator's default for dt,
                   weakgrid.sim.integrate.default_tol] (Newton tolerance, pu): numerical
-                  settings of every run of the study (weakgrid.study.runner.sim_settings)
+                  settings of every run of the study (weakgrid.study.runner.sim_settings);
+                  record [every signal] (signal names or fnmatch patterns the run files
+                  keep, e.g. ["*.omega", "bus*.v"]; the figures' signals are always kept)
 """
 
 from __future__ import annotations
@@ -378,7 +380,13 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                              f"{preset_names()}")
     sim = d.get("simulation")
     if sim is not None:
-        _keys(sim, {"dt", "tol", "notes"}, "simulation")
+        _keys(sim, {"dt", "tol", "record", "notes"}, "simulation")
+        rec = sim.get("record")
+        if rec is not None and not (isinstance(rec, list) and rec and all(
+                isinstance(r, str) and r.strip() for r in rec)):
+            raise ParameterError("simulation.record", rec, "give a list of signal names or "
+                                 "fnmatch patterns, e.g. [\"*.omega\", \"*.delta\", "
+                                 "\"bus*.v\"] (omit it to record every signal)")
         if "dt" in sim:
             _num(sim, "dt", "simulation", positive=True)
         if "tol" in sim:

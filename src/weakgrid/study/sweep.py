@@ -235,12 +235,10 @@ def run_point(inputs: dict):
         m["status"] = "failed"
         m["failure"] = rec.metrics.get("failure") or "simulation failed"
     m.pop("failed", None)
-    if inputs.get("signals"):
-        s = rec.series
-        t = s["t"]
-        sig = pd.DataFrame({k: v for k, v in s.items() if isinstance(v, np.ndarray) and
-                            v.shape == t.shape})
-        return m, sig
+    if inputs.get("signals"):   # the run file: every signal by name, the samples, metadata
+        from .cache import run_file_table
+
+        return m, run_file_table(rec)
     return m
 
 

@@ -36,6 +36,15 @@ def run_key(inputs: dict, run=None) -> str:
                         "keywords": getattr(run, "keywords", None)})
 
 
+def _write_parquet(table, path):
+    if hasattr(table, "to_parquet"):
+        table.to_parquet(path, index=False)
+    else:
+        import pyarrow.parquet as pq
+
+        pq.write_table(table, path)
+
+
 class ResultCache:
     """A folder of finished runs, one ``<key>.json`` each (and ``<key>.parquet`` signals).
 
@@ -74,9 +83,8 @@ class ResultCache:
     def put(self, record: dict, signals=None) -> Path:
         """Store a finished run (atomically; signals first, so a record implies its signals)."""
         key = record["key"]
-        if signals is not None:
-            replace_atomic(self.folder / f"{key}.parquet",
-                           lambda tmp: signals.to_parquet(tmp, index=False))
+        if signals is not None:   # a DataFrame, or a pyarrow Table (a run file's)
+            replace_atomic(self.folder / f"{key}.parquet", lambda tmp: _write_parquet(signals, tmp))
             record = dict(record, signals_file=f"{key}.parquet")
         files = [self.folder / record["signals_file"]] if record.get("signals_file") else []
         return write_json_atomic(self.path(key), with_checksum(record, files))

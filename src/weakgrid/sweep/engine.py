@@ -86,7 +86,7 @@ def execute(run, inputs: dict, key: str) -> dict:
     """Run one point (on a worker) and return its record; never raises for a failed run.
 
     ``run(inputs)`` returns a dict of metrics, or ``(metrics, signals)`` with signals a
-    DataFrame. Metrics may carry ``status`` ("ok"/"failed") and ``failure`` (its cause)
+    DataFrame or a pyarrow Table (a study's run file). Metrics may carry ``status`` ("ok"/"failed") and ``failure`` (its cause)
     when the run failed without raising (e.g. a simulation that lost synchronism).
     The record keeps the run's wall time ``wall_s`` and the CPU time of the thread that ran
     it, ``cpu_s`` [s] (``wall_s`` above ``cpu_s``: the run waited for a core).
