@@ -75,14 +75,9 @@ def add_parser(sub):
                    help="simulated time [s] (default: the scenario's; 20 s for a case, as "
                         "ANDES)")
     p.add_argument("--output", "-o", type=output_file(".csv", ".parquet"), default=None,
-<<<<<<< HEAD
-                   help="write the run's signals (.csv or .parquet for a study; .parquet, "
-                        "the run file, for a case)")
-=======
                    help="write the run: .parquet a run file (every signal by name, units in its "
-                        "metadata, the controller's samples; weakgrid.read_run), .csv every "
-                        "signal in per unit")
->>>>>>> runformat
+                        "metadata, a study's controller samples; weakgrid.read_run); .csv every "
+                        "signal in per unit (a study only)")
     p.set_defaults(func=run)
     return p
 
