@@ -66,7 +66,6 @@ def _final_state(res) -> list[str]:
 
 def run_case(args) -> int:
     """Run ``weakgrid simulate CASE`` with the parsed ``args``; return the exit status."""
-    from .. import __version__
     from ..game.errors import ParameterError
     from ..sim.integrate import Simulator
     from ..sim.io.cases import load_case
@@ -124,11 +123,10 @@ def run_case(args) -> int:
     if out is not None:
         from ..sim.runfile import write_run
 
-        meta = {"command": "weakgrid simulate", "weakgrid_version": __version__,
-                "case": str(args.study), "format": case.format,
+        meta = {"command": "weakgrid simulate", "case": str(args.study),
+                "case_format": case.format,
                 "dyr": None if args.dyr is None else str(args.dyr),
-                "events": [describe_event(e) for e in events], "t_end": t_end, "dt": args.dt,
-                "failure": None if res.ok else str(res.failure)}
+                "events": [describe_event(e) for e in events], "t_end": t_end, "dt": args.dt}
         write_run(out, res, samples=None, meta=meta)
         print(f"wrote {out}" + ("" if res.ok else f" (the run up to t = {t_last:.4g} s)"))
     if not res.ok:
