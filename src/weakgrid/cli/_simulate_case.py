@@ -22,6 +22,7 @@ from ._common import bar_disable
 log = logging.getLogger("weakgrid.cli.simulate")
 
 T_END_DEFAULT = 20.0          # s, ANDES's default tf
+DT_DEFAULT = 1 / 120          # s, the simulator's default step
 NOTES_SHOWN = 5
 
 
@@ -76,6 +77,7 @@ def run_case(args) -> int:
         raise ParameterError("--output", str(out), "the run of a case is written as a Parquet "
                              "run file: give a name ending in .parquet")
     t_end = float(args.t_end) if args.t_end is not None else T_END_DEFAULT
+    dt = float(args.dt) if args.dt is not None else DT_DEFAULT
     case = load_case(args.study, args.dyr)
     system, net = case.system, case.system.network
     events = events_of(system, args) + list(case.events)
@@ -101,14 +103,14 @@ def run_case(args) -> int:
     if not events:
         print("  no events: the run should stay at the operating point (a flat start check)")
     if args.record:
-        _check_record(system, args.dt, args.record)
+        _check_record(system, dt, args.record)
     first = min([getattr(e, "t_on", getattr(e, "t", 0.0)) for e in events] or [t_end])
-    est = run_estimate(system, t_end, args.dt, first_event=first, record=args.record)
+    est = run_estimate(system, t_end, dt, first_event=first, record=args.record)
     if est.bytes > 2.0**28 or est.seconds > 60.0 or args.force:
         print(f"  {est.describe()}")
     est.check("--t-end", t_end, "give a shorter --t-end, a larger --dt or fewer signals "
               "(--record)", args.force)
-    sim = Simulator(system, dt=args.dt, record=args.record)
+    sim = Simulator(system, dt=dt, record=args.record)
     res, reached = _simulate(sim, t_end, events, args)
     if res is None:          # interrupted
         print(f"weakgrid simulate: interrupted at t = {reached:.4g} s of {t_end:g} s; nothing "
@@ -126,7 +128,7 @@ def run_case(args) -> int:
         meta = {"command": "weakgrid simulate", "case": str(args.study),
                 "case_format": case.format,
                 "dyr": None if args.dyr is None else str(args.dyr),
-                "events": [describe_event(e) for e in events], "t_end": t_end, "dt": args.dt}
+                "events": [describe_event(e) for e in events], "t_end": t_end, "dt": dt}
         write_run(out, res, samples=None, meta=meta)
         print(f"wrote {out}" + ("" if res.ok else f" (the run up to t = {t_last:.4g} s)"))
     if not res.ok:

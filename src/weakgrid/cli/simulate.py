@@ -64,7 +64,7 @@ def add_parser(sub):
                    metavar="BUS,T,DP[,DQ]",
                    help=f"constant-impedance load added, {STEP_FORM}; negative removes "
                         "(repeatable)")
-    c.add_argument("--dt", type=positive_float, default=1 / 120,
+    c.add_argument("--dt", type=positive_float, default=None,
                    help="integration step [s] (default: 1/120 s)")
     c.add_argument("--record", action="append", default=None, metavar="SIGNAL",
                    help="record only these signals (names or patterns such as '*.omega', "
