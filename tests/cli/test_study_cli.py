@@ -38,3 +38,41 @@ def test_modes_writes_the_table_and_the_state_matrix(tmp_path, capsys):
     assert d["B"].shape == (d["A"].shape[0], 2) and d["C"].shape == (1, d["A"].shape[0])
     assert list(d["outputs"])[0].endswith(".omega") and d["C"].sum() == 1.0
     assert "wrote" in capsys.readouterr().out
+
+
+def test_modes_of_a_plain_case_match_the_state_matrix_and_the_simulator(tmp_path, capsys):
+    """`modes CASE`: the CSV's eigenvalues are those of the npz's A (no inputs, every
+    machine's speed as output), and A's eigenvalues are weakgrid.design.modes's of the same
+    case read in Python."""
+    from pathlib import Path
+
+    import numpy as np
+    import pandas as pd
+
+    from weakgrid.design import modes
+    from weakgrid.sim.io.cases import load_case
+
+    data = Path(__file__).resolve().parents[1] / "data" / "psid" / "GENROU"
+    raw, dyr = data / "ThreeBusMulti.raw", data / "ThreeBus_GENROU.dyr"
+    csv, npz = tmp_path / "modes.csv", tmp_path / "A.npz"
+    assert main(["modes", str(raw), "--dyr", str(dyr), "-o", str(csv), "--state-matrix",
+                 str(npz)]) == 0
+    d = np.load(npz)
+    lam = np.linalg.eigvals(d["A"])
+    table = pd.read_csv(csv)
+    upper = lam[lam.imag >= 0]
+    assert len(table) == len(upper)
+    np.testing.assert_allclose(np.sort(table["imag"].to_numpy()), np.sort(upper.imag), atol=1e-8)
+    assert d["B"].shape == (d["A"].shape[0], 0) and list(d["outputs"]) == ["GENROU_102_1.omega"]
+    system = load_case(raw, dyr).system
+    system.setup()
+    ref = np.sort_complex(modes(system).eigenvalues)
+    np.testing.assert_allclose(np.sort_complex(lam), ref, rtol=1e-9, atol=1e-9)
+    assert "no inputs" in capsys.readouterr().out
+
+
+def test_modes_refuses_study_options_on_a_case(capsys, tmp_path):
+    m = tmp_path / "c.m"
+    m.write_text("x")
+    assert main(["modes", str(m), "--load", "high"]) == 2
+    assert "--load" in capsys.readouterr().err
