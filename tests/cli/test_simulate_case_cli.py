@@ -167,3 +167,30 @@ def test_progress_on_stderr_only_without_quiet(flag, capsys, monkeypatch):
     assert ("simulating" in term.getvalue()) == (flag is None)
     assert ("note:" in out) == (flag != "--quiet")
     assert "final state" in out                     # the results stay
+
+
+def test_a_run_beyond_the_limits_is_refused_unless_forced(capsys):
+    """steps × recorded variables: 10⁶ s at 1/120 s needs tens of GiB."""
+    code, text, err = _run(["simulate", RAW, "--dyr", DYR, "--t-end", "1e6"], capsys)
+    assert code == 2
+    assert "--t-end" in err and "GiB" in err and "--force" in err and "recorded variables" in err
+
+
+def test_ctrl_c_says_what_was_kept(tmp_path, capsys, monkeypatch):
+    from weakgrid.sim.integrate import Simulator
+
+    run = Simulator.run
+
+    def interrupted(self, t_end, *a, progress=None, **kw):
+        def stop(t):
+            progress(t)
+            if t >= 0.5:
+                raise KeyboardInterrupt
+        return run(self, t_end, *a, progress=stop if progress else None, **kw)
+
+    monkeypatch.setattr(Simulator, "run", interrupted)
+    out = tmp_path / "run.parquet"
+    code, _, err = _run(["simulate", RAW, "--dyr", DYR, "--t-end", "2", "-o", out], capsys)
+    assert code == 130
+    assert "interrupted at t = 0.5" in err and "nothing was kept" in err
+    assert "was not written" in err and not out.exists()

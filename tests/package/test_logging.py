@@ -52,4 +52,4 @@ def test_every_command_takes_quiet_and_verbose():
 
     sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
     for name, sp in sub.choices.items():
-        assert {"--quiet", "--verbose"} <= set(sp._option_string_actions), name
+        assert {"--quiet", "--verbose", "--no-progress"} <= set(sp._option_string_actions), name
