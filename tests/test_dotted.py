@@ -19,7 +19,7 @@ def test_elements_by_id_name_or_index():
 
 
 @pytest.mark.parametrize("path, words", [
-    ("upqc.ratng", ["'ratng' is not a field of upqc", "['rating']"]),
+    ("upqc.ratng", ["no field 'ratng' in upqc", "['rating']"]),
     ("scenarios.c.t_end", ["no element 'c'", "indices 0..1", "['a', 'b']"]),
     ("upqc.rating.x", ["upqc.rating is a value"]),
     ("nope", ["'nope'", "['gens', 'scenarios', 'upqc']"]),
@@ -39,7 +39,7 @@ def test_set_strict_or_creating():
     d = copy.deepcopy(D)
     set_path(d, "scenarios.b.t_end", 9.0)
     assert d["scenarios"][1]["t_end"] == 9.0
-    with pytest.raises(ParameterError, match="'dt' is not a field"):
+    with pytest.raises(ParameterError, match="no field 'dt'"):
         set_path(d, "simulation.dt", 0.1) if "simulation" in d else set_path(d, "upqc.dt", 0.1)
     set_path(d, "simulation.dt", 0.1, create=True)          # a missing optional table
     assert d["simulation"] == {"dt": 0.1}

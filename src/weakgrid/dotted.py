@@ -40,7 +40,7 @@ def _miss(obj, key, where, path, field):
     """The error for a missing ``key`` at ``where`` (what exists there is listed)."""
     at = where or "the top level"
     if isinstance(obj, dict):
-        fix = f"'{key}' is not a field of {at}; fields there: {sorted(map(str, obj))}"
+        fix = f"no field '{key}' in {at}; fields there: {sorted(map(str, obj))}"
     elif isinstance(obj, list):
         ids = [el.get("id", el.get("name")) for el in obj if isinstance(el, dict)]
         ids = [i for i in ids if i is not None]

@@ -145,7 +145,7 @@ def apply_overrides(d: dict, overrides, source: str = "", base_dir=None,
             if not isinstance(holder, dict):
                 _get(ref, path, field=field)
             if not _accepts_new(d, parent, source, base_dir):
-                raise ParameterError(field, path, f"'{keys[-1]}' is not a field of "
+                raise ParameterError(field, path, f"no field '{keys[-1]}' in "
                                      f"{parent or 'the study file'}; fields there: "
                                      f"{sorted(map(str, holder))}")
         _set(d, path, value, create=True, field=field)
