@@ -194,3 +194,17 @@ def test_ctrl_c_says_what_was_kept(tmp_path, capsys, monkeypatch):
     assert code == 130
     assert "interrupted at t = 0.5" in err and "nothing was kept" in err
     assert "was not written" in err and not out.exists()
+
+
+@pytest.mark.andes
+def test_an_andes_case_runs_with_its_own_events(capsys):
+    """An ANDES case (Kundur, its Toggle at 2 s) with a command-line fault; the file's event
+    after the end is said and left out."""
+    andes = pytest.importorskip("andes")
+    case = andes.get_case("kundur/kundur_full.xlsx")
+    code, text, _ = _run(["simulate", case, "--fault", "8,0.5,0.55", "--t-end", "1.5"],
+                         capsys)
+    assert code == 0, text
+    assert "(andes): 10 buses" in text and "4 machines" in text
+    assert "(in the case file): after the end, not reached" in text
+    assert "fault at bus 8 from 0.5 s to 0.55 s" in text

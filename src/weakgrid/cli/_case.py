@@ -199,7 +199,7 @@ def describe_event(e) -> str:
         return (f"fault at bus {e.bus} from {e.t_on:g} s to {e.t_off:g} s "
                 f"(rf = {e.rf:g}, xf = {e.xf:g} pu)")
     if isinstance(e, LineTrip):
-        return f"branch row {e.branch} opens at {e.t:g} s"
+        return f"branch row {e.branch} {'closes' if e.close else 'opens'} at {e.t:g} s"
     if isinstance(e, LoadStep):
         return f"load step at bus {e.bus} at {e.t:g} s: {e.dP:+g} MW, {e.dQ:+g} Mvar"
     return repr(e)

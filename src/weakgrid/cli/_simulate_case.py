@@ -80,6 +80,10 @@ def run_case(args) -> int:
     dt = float(args.dt) if args.dt is not None else DT_DEFAULT
     case = load_case(args.study, args.dyr)
     system, net = case.system, case.system.network
+    # the case file's own events (ANDES Toggle, Fault) after the end are not reached, as in ANDES
+    start = lambda e: getattr(e, "t_on", getattr(e, "t", 0.0))    # noqa: E731
+    late = [e for e in case.events if start(e) >= t_end]
+    case.events = [e for e in case.events if start(e) < t_end]
     events = events_of(system, args) + list(case.events)
     last = max([getattr(e, "t_off", None) or getattr(e, "t_on", None) or getattr(e, "t", 0.0)
                 for e in events] or [0.0])
@@ -96,6 +100,8 @@ def run_case(args) -> int:
     system.setup()
     print(f"initialization: power flow converged (largest mismatch {net.pf.mismatch:.1e} pu), "
           f"{system.nx} states, {system.N - system.nx} algebraic variables")
+    for e in late:
+        print(f"  event: {describe_event(e)} (in the case file): after the end, not reached")
     from_file = {id(e) for e in case.events}
     for e in sorted(events, key=lambda e: getattr(e, "t_on", getattr(e, "t", 0.0))):
         print(f"  event: {describe_event(e)}" + (" (in the case file)" if id(e) in from_file
