@@ -116,6 +116,7 @@ def run_case(args) -> int:
         print(f"  {est.describe()}")
     est.check("--t-end", t_end, "give a shorter --t-end, a larger --dt or fewer signals "
               "(--record)", args.force)
+    print(f"simulating {t_end:g} s at dt = {dt:.4g} s ({int(round(t_end / dt))} steps)")
     sim = Simulator(system, dt=dt, record=args.record)
     res, reached = _simulate(sim, t_end, events, args)
     if res is None:          # interrupted
