@@ -137,3 +137,15 @@ def test_record_must_be_a_list_of_names(value):
     set_path(d, "simulation", {"record": value})
     with pytest.raises(ParameterError, match="simulation.record"):
         study_from_dict(d, "test")
+
+
+def test_simulate_writes_a_run_file_that_plot_reads(tmp_path, capsys):
+    from weakgrid.cli.main import main
+
+    out = tmp_path / "run.parquet"
+    assert main(["simulate", STUDY, "--scenario", "fault-r", "--controller", "pss-only",
+                 "--t-end", "1.15", "-o", str(out)]) == 0
+    df = weakgrid.read_run(out, ["G*.omega", "G*.delta"])
+    assert df.shape[1] == 7 and df.attrs["meta"]["controller"] == "pss-only"
+    assert main(["plot", str(out), "G*.omega", "bus*.v"]) == 0
+    assert out.with_suffix(".png").is_file()
