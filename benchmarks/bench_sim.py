@@ -9,7 +9,12 @@
    T = 1 ms (zero-order hold, a consistent algebraic re-solve after each sample) driving the UPQC
    with a smooth feedback of the GTI design states, fault 0.2-0.25 s, 5 s at dt = 1 ms; median of 3.
 
-Run:  PYTHONPATH=src python benchmarks/bench_sim.py [kundur] [scenarios] [controlled]
+4. The cost of recording every signal (``record="all"``, what study runs keep in their run
+   files) against selective recording (``record="machines"``: speeds and angles only), measured
+   in the same run, interleaved: the controlled run of 3. and the fault scenarios of 2. (20 of
+   them); medians of ``n`` repeats and their ratio (goal: all / selective ≤ 1.10).
+
+Run:  PYTHONPATH=src python benchmarks/bench_sim.py [kundur] [scenarios] [controlled] [recording]
 """
 
 from __future__ import annotations
@@ -102,7 +107,56 @@ def controlled(n=3, tf=5.0):
     print(f"median wall {statistics.median(walls):.2f} s, {len(ctrl.log_t)} samples, ok={r.ok}, stats {r.stats}")
 
 
+def recording(n=5, tf=5.0, n_scen=20):
+    from sim_cases import build_gti_upqc_sg
+
+    from weakgrid.sim.controllers import DigitalController, UPQCTarget, gti_design_states
+    from weakgrid.sim.events import Fault
+    from weakgrid.sim.integrate import Simulator, simulate
+
+    def K(m):
+        return [float(np.clip(-0.5 * m[0] - 2.0 * m[1], -0.15, 0.15)), float(np.clip(-0.2 * m[1], -0.1, 0.1))]
+
+    def controlled_run(record):
+        s = build_gti_upqc_sg("reduced")
+        ctrl = DigitalController(K, 1e-3, gti_design_states("PV"), UPQCTarget("U"), enable=[(0.25, tf)])
+        t0 = time.perf_counter()
+        r = simulate(s, tf, dt=1e-3, events=[Fault(3, 0.2, 0.25, xf=0.05)], controllers=[ctrl],
+                     on_failure="return", record=record)
+        return time.perf_counter() - t0, r
+
+    def scenario_runs(record):
+        rng = np.random.default_rng(0)
+        wall, cols = 0.0, 0
+        for k in range(n_scen):
+            s = build_gti_upqc_sg("reduced" if k % 2 else "conventional")
+            bus, toff, xf = int(rng.integers(1, 4)), 0.2 + float(rng.uniform(0.03, 0.15)), float(rng.uniform(0.02, 0.2))
+            t0 = time.perf_counter()
+            r = Simulator(s, dt=5e-3, tol=1e-6, record=record).run(
+                5.0, events=[Fault(bus, 0.2, toff, xf=xf)], on_failure="return")
+            wall += time.perf_counter() - t0
+            cols = r.data.shape[1]
+        return wall, cols
+
+    modes = {"all": None, "selective": "machines"}   # None = every signal on these grids
+    walls = {("controlled", m): [] for m in modes} | {("scenarios", m): [] for m in modes}
+    shape = {}
+    for _ in range(n):          # interleaved: drift hits both alike
+        for m, rec in modes.items():
+            w, r = controlled_run(rec)
+            walls[("controlled", m)].append(w)
+            shape[("controlled", m)] = r.data.shape
+            w, c = scenario_runs(rec)
+            walls[("scenarios", m)].append(w)
+            shape[("scenarios", m)] = c
+    print(f"== recording every signal vs selective (speeds and angles), medians of {n} ==")
+    for case in ("controlled", "scenarios"):
+        a, b = (statistics.median(walls[(case, m)]) for m in modes)
+        print(f"{case:10s} all {a:.3f} s ({shape[(case, 'all')]} recorded)  selective {b:.3f} s "
+              f"({shape[(case, 'selective')]})  all/selective {a / b:.3f}")
+
+
 if __name__ == "__main__":
-    which = sys.argv[1:] or ["kundur", "scenarios", "controlled"]
+    which = sys.argv[1:] or ["kundur", "scenarios", "controlled", "recording"]
     for w in which:
         globals()[w]()

@@ -86,3 +86,14 @@ def test_not_a_run_file(tmp_path):
     pd.DataFrame({"a": [1.0]}).to_parquet(q)
     with pytest.raises(DataError, match="not a weakgrid run file"):
         read_run(q)
+
+
+def test_read_run_is_imported_lazily():
+    """``import weakgrid`` stays cheap: no numpy, pandas or pyarrow until a run is read."""
+    import subprocess
+    import sys
+
+    code = ("import sys, weakgrid; heavy = {'numpy', 'pandas', 'pyarrow'} & set(sys.modules); "
+            "assert not heavy, heavy; f = weakgrid.read_run; "
+            "assert f.__module__ == 'weakgrid.sim.runfile'")
+    subprocess.run([sys.executable, "-c", code], check=True)

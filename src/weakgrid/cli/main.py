@@ -28,10 +28,12 @@ from .. import __version__
 from . import export, gamma, reproduce, simulate, train, verify
 from . import design, modes, run  # studies
 from . import sweep  # sweeps of studies
+from . import plot  # run files
 
 SUBCOMMANDS = [train, gamma, verify, export, simulate, reproduce]
 SUBCOMMANDS += [design, run, modes]
 SUBCOMMANDS += [sweep]
+SUBCOMMANDS += [plot]
 
 EXIT_OK, EXIT_INPUT, EXIT_RUN, EXIT_BUG, EXIT_INTERRUPT = 0, 2, 3, 4, 130
 

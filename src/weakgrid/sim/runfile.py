@@ -42,8 +42,8 @@ import numpy as np
 
 from .errors import DataError
 
-__all__ = ["write_run", "run_table", "read_run", "read_samples", "read_meta", "run_signals", "FORMAT",
-           "FORMAT_VERSION", "META_KEY", "SAMPLE_PREFIX"]
+__all__ = ["write_run", "run_table", "read_run", "read_samples", "read_meta", "run_signals",
+           "match_signals", "FORMAT", "FORMAT_VERSION", "META_KEY", "SAMPLE_PREFIX"]
 
 FORMAT = "weakgrid-run"
 FORMAT_VERSION = 1

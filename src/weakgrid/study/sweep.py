@@ -31,7 +31,6 @@ from __future__ import annotations
 import copy
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from ..game.errors import ParameterError
