@@ -159,6 +159,17 @@ class Component:
         self.links.append(dict(link))
         self.n = len(self.names)
 
+    def remove(self, name: str):
+        """Unregister instance ``name`` (before :meth:`System.setup`, which lays the states out
+        again)."""
+        if name not in self.names:
+            raise DataError(self.element(name), "name", name,
+                            f"no such {self.type_name}; known: {self.names}")
+        i = self.names.index(name)
+        for lst in (self.names, self.links, self._values):
+            del lst[i]
+        self.n = len(self.names)
+
     # ------------------------------------------------------------------ setup
     def setup(self, system):
         """Build parameter arrays (system base). Subclasses extend with link resolution."""

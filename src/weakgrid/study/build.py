@@ -33,6 +33,7 @@ The UPQC is either an existing series branch (``upqc.branch``: a branch name, a 
 
 from __future__ import annotations
 
+import logging
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -50,11 +51,15 @@ from ..sim.network import BR_R, BR_X, F_BUS, GEN_BUS, T_BUS, Network
 from ..sim.system import System
 from ..sim.upqc import UPQC
 
-__all__ = ["Setup", "build_setup", "VARIANTS"]
+__all__ = ["Setup", "build_setup", "baseline_machine", "VARIANTS"]
+
+log = logging.getLogger(__name__)
 
 # "upqc": the UPQC in service (driven by a digital controller, or idle);
-# "pq": no UPQC, the controlled GTI's phase by its PQ loops (the conventional baseline)
-VARIANTS = ("upqc", "pq")
+# "pq": no UPQC, the controlled GTI's phase by its PQ loops (the conventional baseline);
+# "no-pss": the UPQC in service and the baseline machine's stabilizer(s) taken out before the
+# initialization (the `none` baseline; :func:`baseline_machine`)
+VARIANTS = ("upqc", "pq", "no-pss")
 
 
 @dataclass
@@ -395,6 +400,45 @@ def _psse_network(study, g, up):
     return net, bus_id, names, k_ref, system
 
 
+def baseline_machine(study, system) -> str | None:
+    """The synchronous machine whose supplementary control the baselines are about.
+
+    The controlled machine (``machine.name``) when it is a synchronous machine; when it is a
+    GTI (which has no stabilizer), the SG the study follows: ``report.speed_of``, else the
+    first ``[[dynamics.generator]]`` (None if there is none or ``speed_of = ""``). Only this machine's
+    stabilizers leave the grid for the ``none`` baseline; every other unit keeps its own.
+    """
+    d = study.data
+    name = d["machine"]["name"]
+    if name in system.machine_names:
+        return name
+    speed_of = d["report"].get("speed_of")
+    return (speed_of if speed_of is not None else _first_generator(d)) or None
+
+
+def _first_generator(d):
+    gens = d["dynamics"]["generator"]
+    return gens[0]["name"] if gens else None
+
+
+def _remove_stabilizers(system, machine):
+    """Take ``machine``'s stabilizers (every ``kind = "pss"`` control linked to it) out of
+    ``system`` before its set-up, which re-initializes the grid without them and checks the
+    initial point."""
+    if machine is None:
+        log.warning("baseline 'none': no synchronous machine to take the stabilizer of (the "
+                    "controlled machine is a GTI and report.speed_of names no SG); 'none' "
+                    "equals 'pss-only'")
+        return
+    removed = system.remove_controls(machine, "pss")
+    if removed:
+        log.info("baseline 'none': %s of %s out of service", ", ".join(
+            f"{m} '{n}'" for m, n in removed), machine)
+    else:
+        log.warning("baseline 'none': machine %s has no stabilizer; 'none' equals 'pss-only'",
+                    machine)
+
+
 def build_setup(study, load: str | None = None, upqc: str | None = None,
                 variant: str = "upqc") -> Setup:
     """Build and set up the study's grid at ``load`` with the UPQC in structure ``upqc``."""
@@ -454,9 +498,11 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
                 if "ref_bus" in gt else r_id
             comp.add_gti(gt["name"], gen=gen_row(gt["bus"], f"dynamics.gti.{i}.bus"),
                          ref_bus=ref, mode=mode, **p)
+    if variant == "no-pss":
+        _remove_stabilizers(s, baseline_machine(study, s))
     up = d["upqc"]
     upqc_name = None
-    if variant == "upqc":
+    if variant in ("upqc", "no-pss"):
         if upqc == "reduced" and ctl_name not in gti_names:
             raise ParameterError("upqc.structure", "reduced", "the reduced UPQC takes its "
                                  "series power from the controlled GTI's dc link; this study's "
@@ -481,8 +527,7 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
     measure = mapped(measure_signals, state_map)
     speed_of = d["report"].get("speed_of")
     speed_of = speed_of if speed_of is not None else (ctl_name if der.machine == "sg" else
-                                               (dyn["generator"][0]["name"]
-                                                if dyn["generator"] else None))
+                                                      _first_generator(d))
     signals = {"shunt_bus_v": f"bus{r_id}.v"}
     if speed_of:
         signals.update(sg_speed=f"{speed_of}.omega", sg_pe=f"{speed_of}.Pe")
