@@ -175,3 +175,26 @@ def test_remove_controls_refuses_an_unknown_machine():
     s = build_setup(load_study("case1-weak-grid")).system
     with pytest.raises(DataError, match="no such machine"):
         s.remove_controls("G9")
+
+
+@pytest.mark.andes
+def test_grid_data_warning_once_per_process_with_a_count(monkeypatch, caplog):
+    """ieee39's nine GENROU with xl >= xd2: one line for the model, however many times a study
+    builds the grid (once per run); the repeats go to DEBUG."""
+    import logging
+    import warnings
+
+    from weakgrid.study import build as build_mod
+
+    pytest.importorskip("andes")
+    monkeypatch.setattr(build_mod, "_SAID", set())
+    st = ieee39_study(["pss-only", "none"])
+    with caplog.at_level(logging.DEBUG, logger="weakgrid.study.build"), \
+            warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for variant in ("upqc", "no-pss", "upqc"):
+            build_setup(st, variant=variant)
+    said = [r for r in caplog.records if "leakage reactance" in r.getMessage()]
+    assert [r.levelno for r in said] == [logging.WARNING, logging.DEBUG, logging.DEBUG]
+    assert "GENROU (9 of 10)" in said[0].getMessage()
+    assert not [w for w in caught if "leakage" in str(w.message)]   # said through the log only

@@ -33,6 +33,7 @@ The UPQC is either an existing series branch (``upqc.branch``: a branch name, a 
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import warnings
@@ -44,7 +45,7 @@ from ..design import derive_design
 from ..design.upqc_insert import insert_upqc_matpower, insert_upqc_pandapower
 from ..game.errors import ParameterError
 from ..logs import quiet_loggers
-from ..sim.errors import DataError
+from ..sim.errors import DataError, DataWarning
 from ..sim.controllers import gti_signals, gti_state_map, mapped, sg_signals, sg_state_map
 from ..sim.gti import GTI
 from ..sim.network import BR_R, BR_X, F_BUS, GEN_BUS, T_BUS, Network
@@ -400,6 +401,27 @@ def _psse_network(study, g, up):
     return net, bus_id, names, k_ref, system
 
 
+_SAID: set = set()   # data warnings already logged by this process
+
+
+@contextlib.contextmanager
+def _data_warnings_once():
+    """Say the grid's data warnings (:class:`~weakgrid.sim.errors.DataWarning`, one per model
+    with a count) once per process, through this module's log: a study builds its grid
+    again for every run, and each build would repeat them. Later repeats go to DEBUG; other
+    warnings pass through unchanged."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", DataWarning)
+        yield
+    for w in caught:
+        if issubclass(w.category, DataWarning):
+            msg = str(w.message)
+            (log.debug if msg in _SAID else log.warning)("grid data: %s", msg)
+            _SAID.add(msg)
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+
 def baseline_machine(study, system) -> str | None:
     """The synchronous machine whose supplementary control the baselines are about.
 
@@ -511,7 +533,8 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
         u.add_upqc(up["name"], branch=k_up, structure=upqc,
                    gti=ctl_name if upqc == "reduced" else None, Vmax=up["rating"])
         upqc_name = up["name"]
-    s.setup()
+    with _data_warnings_once():
+        s.setup()
     der = derive_design(s, ctl_name, k_up, float(d["design"]["T"]), structure=upqc)
     b1 = net.index_of(int(net.branch[k_up, T_BUS]))
     r = net.index_of(r_id)
