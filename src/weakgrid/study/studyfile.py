@@ -40,7 +40,7 @@ from pathlib import Path
 from ..game.errors import ParameterError
 
 __all__ = ["Study", "load_study", "study_from_dict", "get_path", "set_path", "shipped_studies",
-           "read_study_dict", "EVENT_KINDS"]
+           "read_study_dict", "event_end", "EVENT_KINDS"]
 
 TOP = {"study", "grid", "dynamics", "machine", "upqc", "design", "controllers", "scenarios",
        "report", "figures", "claims", "sweep", "simulation"}
@@ -67,16 +67,43 @@ def _step(obj, key, path):
     raise ParameterError(path, obj, "is a value, not a table")
 
 
+def _is_fault(obj) -> bool:
+    return isinstance(obj, dict) and obj.get("kind") == "fault"
+
+
+# a fault's end is given by t_off or by its duration (t_off = t_on + duration); a validated
+# study keeps t_off only, and both are addressable: reading "duration" gives t_off − t_on,
+# setting one of them drops the other (validation derives t_off from the duration and the
+# event's t_on then, whatever order a sweep sets t_on and the duration in)
+_FAULT_END = {"t_off": "duration", "duration": "t_off"}
+
+
+def event_end(ev: dict) -> float | None:
+    """When a fault event ends [s]: its ``t_off``, or ``t_on + duration`` in a study dict
+    not validated again since a sweep set the duration; None for other events."""
+    if "t_off" in ev:
+        return float(ev["t_off"])
+    if "duration" in ev:
+        return float(ev.get("t_on", 0.0)) + float(ev["duration"])
+    return None
+
+
 def get_path(d: dict, path: str):
-    """The value at dotted ``path`` in study dict ``d`` (e.g. ``"upqc.rating"``)."""
+    """The value at dotted ``path`` in study dict ``d`` (e.g. ``"upqc.rating"``; a fault's
+    ``duration`` [s] is ``t_off − t_on`` when only ``t_off`` is given)."""
     obj = d
-    for i, key in enumerate(path.split(".")):
-        obj = _step(obj, key, ".".join(path.split(".")[:i + 1]))
+    keys = path.split(".")
+    for i, key in enumerate(keys):
+        if (i == len(keys) - 1 and key == "duration" and _is_fault(obj) and key not in obj
+                and "t_off" in obj and "t_on" in obj):
+            return round(float(obj["t_off"]) - float(obj["t_on"]), 12)
+        obj = _step(obj, key, ".".join(keys[:i + 1]))
     return obj
 
 
 def set_path(d: dict, path: str, value) -> dict:
-    """Set the value at dotted ``path`` (creating missing tables); returns ``d``."""
+    """Set the value at dotted ``path`` (creating missing tables); returns ``d``. Setting a
+    fault's ``t_off`` or ``duration`` drops the other (validation derives ``t_off``)."""
     keys = path.split(".")
     obj = d
     for i, key in enumerate(keys[:-1]):
@@ -89,6 +116,8 @@ def set_path(d: dict, path: str, value) -> dict:
         obj[obj.index(target)] = value
     elif isinstance(obj, dict):
         obj[last] = value
+        if _is_fault(obj) and last in _FAULT_END:   # the fault's end given the other way
+            obj.pop(_FAULT_END[last], None)
     else:
         raise ParameterError(".".join(keys[:-1]), obj, "is a value, not a table")
     return d
