@@ -198,3 +198,19 @@ def test_grid_data_warning_once_per_process_with_a_count(monkeypatch, caplog):
     assert [r.levelno for r in said] == [logging.WARNING, logging.DEBUG, logging.DEBUG]
     assert "GENROU (9 of 10)" in said[0].getMessage()
     assert not [w for w in caught if "leakage" in str(w.message)]   # said through the log only
+
+
+def test_gti_study_without_an_sg_says_none_equals_pss_only(monkeypatch, caplog):
+    """CIGRE MV: a GTI behind the UPQC, the external grid an infinite bus (speed_of = "")."""
+    import logging
+
+    from weakgrid.study import build as build_mod
+
+    monkeypatch.setattr(build_mod, "_SAID", set())
+    st = load_study("cigre-mv-wind-gti")
+    with caplog.at_level(logging.INFO, logger="weakgrid.study.build"):
+        s = build_setup(st, variant="no-pss").system
+    assert baseline_machine(st, s) is None
+    assert any("'none' equals 'pss-only'" in r.getMessage() and r.levelno == logging.WARNING
+               for r in caplog.records)
+    assert s.nx == build_setup(st).system.nx

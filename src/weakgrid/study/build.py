@@ -415,11 +415,15 @@ def _data_warnings_once():
         yield
     for w in caught:
         if issubclass(w.category, DataWarning):
-            msg = str(w.message)
-            (log.debug if msg in _SAID else log.warning)("grid data: %s", msg)
-            _SAID.add(msg)
+            _say_once(logging.WARNING, f"grid data: {w.message}")
         else:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+
+def _say_once(level: int, msg: str):
+    """Log ``msg`` at ``level`` the first time this process says it, at DEBUG afterwards."""
+    log.log(logging.DEBUG if msg in _SAID else level, msg)
+    _SAID.add(msg)
 
 
 def baseline_machine(study, system) -> str | None:
@@ -448,17 +452,17 @@ def _remove_stabilizers(system, machine):
     ``system`` before its set-up, which re-initializes the grid without them and checks the
     initial point."""
     if machine is None:
-        log.warning("baseline 'none': no synchronous machine to take the stabilizer of (the "
-                    "controlled machine is a GTI and report.speed_of names no SG); 'none' "
-                    "equals 'pss-only'")
+        _say_once(logging.WARNING, "baseline 'none': no synchronous machine to take the "
+                  "stabilizer of (the controlled machine is a GTI and report.speed_of names no "
+                  "SG); 'none' equals 'pss-only'")
         return
     removed = system.remove_controls(machine, "pss")
     if removed:
-        log.info("baseline 'none': %s of %s out of service", ", ".join(
-            f"{m} '{n}'" for m, n in removed), machine)
+        _say_once(logging.INFO, "baseline 'none': " + ", ".join(
+            f"{m} '{n}'" for m, n in removed) + f" of {machine} out of service")
     else:
-        log.warning("baseline 'none': machine %s has no stabilizer; 'none' equals 'pss-only'",
-                    machine)
+        _say_once(logging.WARNING, f"baseline 'none': machine {machine} has no stabilizer; "
+                  "'none' equals 'pss-only'")
 
 
 def build_setup(study, load: str | None = None, upqc: str | None = None,
