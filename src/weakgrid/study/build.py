@@ -401,7 +401,7 @@ def _psse_network(study, g, up):
     return net, bus_id, names, k_ref, system
 
 
-_SAID: set = set()   # data warnings already logged by this process
+_SAID: set = set()   # messages this process has logged (grid data warnings, baseline notes)
 
 
 @contextlib.contextmanager
@@ -431,8 +431,9 @@ def baseline_machine(study, system) -> str | None:
 
     The controlled machine (``machine.name``) when it is a synchronous machine; when it is a
     GTI (which has no stabilizer), the SG the study follows: ``report.speed_of``, else the
-    first ``[[dynamics.generator]]`` (None if there is none or ``speed_of = ""``). Only this machine's
-    stabilizers leave the grid for the ``none`` baseline; every other unit keeps its own.
+    first ``[[dynamics.generator]]`` (None if there is none or ``speed_of = ""``). Only this
+    machine's stabilizers leave the grid for the ``none`` baseline; every other unit keeps
+    its own.
     """
     d = study.data
     name = d["machine"]["name"]
@@ -467,7 +468,9 @@ def _remove_stabilizers(system, machine):
 
 def build_setup(study, load: str | None = None, upqc: str | None = None,
                 variant: str = "upqc") -> Setup:
-    """Build and set up the study's grid at ``load`` with the UPQC in structure ``upqc``."""
+    """Build and set up the study's grid at ``load`` with the UPQC in structure ``upqc``;
+    ``variant`` is one of :data:`VARIANTS` (what a controller needs: :func:`weakgrid.study.
+    controllers.controller_variant`), made before the grid is initialized and checked."""
     d = study.data
     load = load or d["design"].get("load", study.loads[0])
     if load not in study.loads:
