@@ -49,7 +49,7 @@ def test_standard_case_matches_andes(name):
     path, dyr, tf = CASES[name]
     dyr = andes.get_case(dyr) if dyr else None
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)   # ieee39's xl > xd2, said once per machine
+        warnings.simplefilter("ignore", UserWarning)   # ieee39's xl > xd2, said once for the model
         w = run_weakgrid_ss(load_case(path, dyr, fault="auto"), tf, H)
     a = run_andes_ss(load_case(path, dyr, fault="auto"), tf, H)
     assert a["ok"] and w["ok"]

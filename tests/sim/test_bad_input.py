@@ -36,6 +36,45 @@ def test_unknown_parameter_and_machine():
         s.add_governor("TGOV1", "gov", "G9")
 
 
+def test_unusual_data_said_once_per_model_with_a_count():
+    """Two GENROU with xl >= xd2: one warning for the model, counting and naming both (ANDES's
+    ieee39 has nine; one warning per machine repeated nine times on every set-up)."""
+    import warnings
+
+    from weakgrid.sim.errors import DataWarning
+
+    s = System(two_machine_case())
+    s.add_machine("GENROU", "G1", 0, xl=0.2, xd2=0.1, xq2=0.1)
+    s.add_machine("GENROU", "G2", 1, xl=0.15, xd2=0.12, xq2=0.12)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        s.setup()
+    msgs = [str(w.message) for w in caught if issubclass(w.category, DataWarning)]
+    assert len(msgs) == 1, msgs
+    assert msgs[0].startswith("GENROU (2 of 2): leakage reactance xl >= xd2")
+    assert "'G1' xl = 0.2 >= xd2 = 0.1" in msgs[0] and "'G2' xl = 0.15 >= xd2 = 0.12" in msgs[0]
+    assert caught[0].filename.endswith("system.py")     # where the model is set up
+
+
+def test_remove_controls_before_setup():
+    """A machine's stabilizer taken out before the set-up: the system initializes without it
+    (the `none` baseline of a study); the other machine keeps its own."""
+    s = System(two_machine_case())
+    for g, name in ((0, "G1"), (1, "G2")):
+        s.add_generator(name, g, ("GENROU", {}), exciter=("SEXS", {}),
+                        pss=("IEEEST", {"MODE": 3}))
+    assert s.controls_of("G1") == [("IEEEST", "G1.pss")]
+    assert s.remove_controls("G1") == [("IEEEST", "G1.pss")]
+    assert s.controls_of("G1") == [] and s.controls_of("G2") == [("IEEEST", "G2.pss")]
+    s.setup()                                       # the initial-point check passes
+    assert s.components["IEEEST"].names == ["G2.pss"]
+    assert s.remove_controls("G2") == [("IEEEST", "G2.pss")] and "IEEEST" not in s.components
+    assert not s.is_setup
+    s.setup()
+    with pytest.raises(DataError, match="no such machine"):
+        s.remove_controls("G9")
+
+
 def test_unconverged_power_flow():
     case = two_machine_case(p=50.0)          # 5000 MW over a 0.3 pu line: infeasible
     s = System(case)

@@ -25,7 +25,9 @@ def add_parser(sub):
     p.add_argument("--output", "-o", type=output_folder, default=None,
                    help="output folder (default: <study>-output)")
     p.add_argument("--quick", action="store_true",
-                   help="each scenario's quick settings (shorter runs, fewer controllers)")
+                   help="each scenario's quick settings (shorter runs, fewer controllers) "
+                        "and the [sweep.quick] of a study with a [sweep]; what runs is said "
+                        "first, the sweep's runs are a table in the report")
     p.add_argument("--list", action="store_true", help="list the shipped studies")
     add_cluster_arguments(p)
     p.set_defaults(func=run)

@@ -159,6 +159,34 @@ class Component:
         self.links.append(dict(link))
         self.n = len(self.names)
 
+    def remove(self, name: str):
+        """Unregister instance ``name`` (before :meth:`System.setup`, which lays the states out
+        again)."""
+        if name not in self.names:
+            raise DataError(self.element(name), "name", name,
+                            f"no such {self.type_name}; known: {self.names}")
+        i = self.names.index(name)
+        for lst in (self.names, self.links, self._values):
+            del lst[i]
+        self.n = len(self.names)
+
+    def warn_instances(self, rows, what: str, detail, show: int = 5, stacklevel: int = 3):
+        """One :class:`~weakgrid.sim.errors.DataWarning` for every instance ``rows`` of this
+        model that shares an accepted but unusual condition ``what``, with their count and
+        the first ``show`` of them (``detail(i)``: the instance's values), instead of one
+        warning per instance (ANDES's ieee39: nine GENROU with xl >= xd2)."""
+        import warnings
+
+        from .errors import DataWarning
+
+        rows = [int(i) for i in rows]
+        if not rows:
+            return
+        shown = "; ".join(f"'{self.names[i]}' {detail(i)}" for i in rows[:show])
+        more = f"; and {len(rows) - show} more" if len(rows) > show else ""
+        warnings.warn(f"{self.type_name} ({len(rows)} of {self.n}): {what}: {shown}{more}",
+                      DataWarning, stacklevel=stacklevel)
+
     # ------------------------------------------------------------------ setup
     def setup(self, system):
         """Build parameter arrays (system base). Subclasses extend with link resolution."""

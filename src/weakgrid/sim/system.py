@@ -197,6 +197,36 @@ class System:
         """Add a power system stabilizer whose output enters the exciter of ``machine``."""
         return self._add_control("pss", model, name, machine, params)
 
+    def controls_of(self, machine: str, kind: str = "pss") -> list[tuple[str, str]]:
+        """``(model, name)`` of every control of ``kind`` ("pss", "exciter", "governor",
+        "compensator") linked to ``machine``: a machine's stabilizer(s), whatever their model
+        (IEEEST, STAB1, ST2CUT, PSS2A/B/C)."""
+        self.machine_number(machine)   # an unknown machine is refused, naming the known ones
+        return [(c.type_name, nm) for c in self.components.values() if c.kind == kind
+                for nm, lk in zip(c.names, c.links) if lk.get("machine") == machine]
+
+    def remove_controls(self, machine: str, kind: str = "pss") -> list[tuple[str, str]]:
+        """Take every control of ``kind`` linked to ``machine`` out of the system.
+
+        The system must then be set up again (:meth:`setup`): the states are laid out and
+        initialized without them, and the initial point is checked, so the grid starts at
+        equilibrium (zeroing a gain after the initialization would not: a stabilizer's
+        washout state holds the initial signal, and its output would jump at t = 0+).
+
+        Returns
+        -------
+        list of (str, str)
+            ``(model, name)`` of the controls removed (empty if the machine has none).
+        """
+        out = self.controls_of(machine, kind)
+        for model, nm in out:
+            comp = self.components[model]
+            comp.remove(nm)
+            if comp.n == 0:
+                del self.components[model]
+        self.is_setup = False
+        return out
+
     def add_generator(self, name: str, gen: int, machine, exciter=None, governor=None, pss=None):
         """Add a generator = machine + shaft + AVR + governor + PSS.
 

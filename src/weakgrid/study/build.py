@@ -33,6 +33,8 @@ The UPQC is either an existing series branch (``upqc.branch``: a branch name, a 
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -43,18 +45,22 @@ from ..design import derive_design
 from ..design.upqc_insert import insert_upqc_matpower, insert_upqc_pandapower
 from ..game.errors import ParameterError
 from ..logs import quiet_loggers
-from ..sim.errors import DataError
+from ..sim.errors import DataError, DataWarning
 from ..sim.controllers import gti_signals, gti_state_map, mapped, sg_signals, sg_state_map
 from ..sim.gti import GTI
 from ..sim.network import BR_R, BR_X, F_BUS, GEN_BUS, T_BUS, Network
 from ..sim.system import System
 from ..sim.upqc import UPQC
 
-__all__ = ["Setup", "build_setup", "VARIANTS"]
+__all__ = ["Setup", "build_setup", "baseline_machine", "VARIANTS"]
+
+log = logging.getLogger(__name__)
 
 # "upqc": the UPQC in service (driven by a digital controller, or idle);
-# "pq": no UPQC, the controlled GTI's phase by its PQ loops (the conventional baseline)
-VARIANTS = ("upqc", "pq")
+# "pq": no UPQC, the controlled GTI's phase by its PQ loops (the conventional baseline);
+# "no-pss": the UPQC in service and the baseline machine's stabilizer(s) taken out before the
+# initialization (the `none` baseline; :func:`baseline_machine`)
+VARIANTS = ("upqc", "pq", "no-pss")
 
 
 @dataclass
@@ -395,9 +401,76 @@ def _psse_network(study, g, up):
     return net, bus_id, names, k_ref, system
 
 
+_SAID: set = set()   # messages this process has logged (grid data warnings, baseline notes)
+
+
+@contextlib.contextmanager
+def _data_warnings_once():
+    """Say the grid's data warnings (:class:`~weakgrid.sim.errors.DataWarning`, one per model
+    with a count) once per process, through this module's log: a study builds its grid
+    again for every run, and each build would repeat them. Later repeats go to DEBUG; other
+    warnings pass through unchanged."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", DataWarning)
+        yield
+    for w in caught:
+        if issubclass(w.category, DataWarning):
+            _say_once(logging.WARNING, f"grid data: {w.message}")
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+
+def _say_once(level: int, msg: str):
+    """Log ``msg`` at ``level`` the first time this process says it, at DEBUG afterwards."""
+    log.log(logging.DEBUG if msg in _SAID else level, msg)
+    _SAID.add(msg)
+
+
+def baseline_machine(study, system) -> str | None:
+    """The synchronous machine whose supplementary control the baselines are about.
+
+    The controlled machine (``machine.name``) when it is a synchronous machine; when it is a
+    GTI (which has no stabilizer), the SG the study follows: ``report.speed_of``, else the
+    first ``[[dynamics.generator]]`` (None if there is none or ``speed_of = ""``). Only this
+    machine's stabilizers leave the grid for the ``none`` baseline; every other unit keeps
+    its own.
+    """
+    d = study.data
+    name = d["machine"]["name"]
+    if name in system.machine_names:
+        return name
+    speed_of = d["report"].get("speed_of")
+    return (speed_of if speed_of is not None else _first_generator(d)) or None
+
+
+def _first_generator(d):
+    gens = d["dynamics"]["generator"]
+    return gens[0]["name"] if gens else None
+
+
+def _remove_stabilizers(system, machine):
+    """Take ``machine``'s stabilizers (every ``kind = "pss"`` control linked to it) out of
+    ``system`` before its set-up, which re-initializes the grid without them and checks the
+    initial point."""
+    if machine is None:
+        _say_once(logging.WARNING, "baseline 'none': no synchronous machine to take the "
+                  "stabilizer of (the controlled machine is a GTI and report.speed_of names no "
+                  "SG); 'none' equals 'pss-only'")
+        return
+    removed = system.remove_controls(machine, "pss")
+    if removed:
+        _say_once(logging.INFO, "baseline 'none': " + ", ".join(
+            f"{m} '{n}'" for m, n in removed) + f" of {machine} out of service")
+    else:
+        _say_once(logging.WARNING, f"baseline 'none': machine {machine} has no stabilizer; "
+                  "'none' equals 'pss-only'")
+
+
 def build_setup(study, load: str | None = None, upqc: str | None = None,
                 variant: str = "upqc") -> Setup:
-    """Build and set up the study's grid at ``load`` with the UPQC in structure ``upqc``."""
+    """Build and set up the study's grid at ``load`` with the UPQC in structure ``upqc``;
+    ``variant`` is one of :data:`VARIANTS` (what a controller needs: :func:`weakgrid.study.
+    controllers.controller_variant`), made before the grid is initialized and checked."""
     d = study.data
     load = load or d["design"].get("load", study.loads[0])
     if load not in study.loads:
@@ -454,9 +527,11 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
                 if "ref_bus" in gt else r_id
             comp.add_gti(gt["name"], gen=gen_row(gt["bus"], f"dynamics.gti.{i}.bus"),
                          ref_bus=ref, mode=mode, **p)
+    if variant == "no-pss":
+        _remove_stabilizers(s, baseline_machine(study, s))
     up = d["upqc"]
     upqc_name = None
-    if variant == "upqc":
+    if variant in ("upqc", "no-pss"):
         if upqc == "reduced" and ctl_name not in gti_names:
             raise ParameterError("upqc.structure", "reduced", "the reduced UPQC takes its "
                                  "series power from the controlled GTI's dc link; this study's "
@@ -465,7 +540,8 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
         u.add_upqc(up["name"], branch=k_up, structure=upqc,
                    gti=ctl_name if upqc == "reduced" else None, Vmax=up["rating"])
         upqc_name = up["name"]
-    s.setup()
+    with _data_warnings_once():
+        s.setup()
     der = derive_design(s, ctl_name, k_up, float(d["design"]["T"]), structure=upqc)
     b1 = net.index_of(int(net.branch[k_up, T_BUS]))
     r = net.index_of(r_id)
@@ -481,8 +557,7 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
     measure = mapped(measure_signals, state_map)
     speed_of = d["report"].get("speed_of")
     speed_of = speed_of if speed_of is not None else (ctl_name if der.machine == "sg" else
-                                               (dyn["generator"][0]["name"]
-                                                if dyn["generator"] else None))
+                                                      _first_generator(d))
     signals = {"shunt_bus_v": f"bus{r_id}.v"}
     if speed_of:
         signals.update(sg_speed=f"{speed_of}.omega", sg_pe=f"{speed_of}.Pe")

@@ -11,15 +11,21 @@ kind               what
 ``nonlinear-29``   the paper's initial nonlinear controller (29) (options: gain, phase)
 ``lqr``            discrete LQR of the design model's linearization (options: Q, R)
 ``pq``             conventional PQ control of a GTI (PID, paper's gains), no UPQC
-``pss-only``       UPQC idle (u = 0): the SG's PSS and governor alone
-``none``           UPQC idle and the PSS out of service: no supplementary control
+``pss-only``       UPQC idle (u = 0): the grid as it is, the SG's PSS and governor alone
+``none``           UPQC idle and the SG's stabilizer(s) out of service: no supplementary
+                   control. Only the baseline machine's (the controlled machine if it is an
+                   SG, else the SG the study follows, ``report.speed_of``: see
+                   :func:`weakgrid.study.build.baseline_machine`) stabilizers are taken out,
+                   whatever their model, before the grid is initialized: every other unit
+                   keeps its own and the grid starts at equilibrium
 ``file``           a trained controller file (``weakgrid train``/``design``; option: path)
 =================  ==========================================================================
 
 A study names the controllers it compares in ``[controllers] compare``; options go in
 ``[controllers.NAME]`` (with ``kind = …`` when NAME is not itself a kind). A new kind is one
 function ``builder(ctx) -> ControllerChoice`` added to :data:`CONTROLLER_KINDS` (and, if it
-needs a grid variant other than the UPQC in service, an entry in :data:`VARIANT_OF`).
+needs a grid variant other than the UPQC in service, an entry in :data:`VARIANT_OF`: a change
+to the grid is made before its initialization, never after it).
 """
 
 from __future__ import annotations
@@ -45,15 +51,12 @@ class ControllerChoice:
     name : str
     policy : callable or None
         ``u = policy(x)`` for the design state x = [ϕ̂, υ] (None: UPQC idle).
-    pss : bool
-        Whether the SGs' PSS stay in service.
     info : dict
         Training record (weights, iterations, time) or parameters, for the report.
     """
 
     name: str
     policy: object
-    pss: bool = True
     info: dict = field(default_factory=dict)
 
 
@@ -147,10 +150,6 @@ def _idle(ctx):
     return ControllerChoice(ctx.name, None)
 
 
-def _none(ctx):
-    return ControllerChoice(ctx.name, None, pss=False)
-
-
 def _file(ctx):
     from ..models import load_controller
 
@@ -162,14 +161,15 @@ def _file(ctx):
 
 
 CONTROLLER_KINDS = {"hji": _hji, "hji-bounded": _hji_bounded, "nonlinear-29": _n29, "lqr": _lqr, "pq": _idle,
-                    "pss-only": _idle, "none": _none, "file": _file}
-# grid variant a kind needs (default "upqc"): the PQ baseline has no UPQC
-VARIANT_OF = {"pq": "pq"}
+                    "pss-only": _idle, "none": _idle, "file": _file}
+# grid variant a kind needs (default "upqc"): the PQ baseline has no UPQC; `none` has the UPQC
+# and the baseline machine's stabilizers out of service (:data:`weakgrid.study.build.VARIANTS`)
+VARIANT_OF = {"pq": "pq", "none": "no-pss"}
 
 
 def controller_variant(study, name) -> str:
     """The grid variant controller ``name`` needs: ``"pq"`` (no UPQC) for the PQ baseline,
-    else ``"upqc"``."""
+    ``"no-pss"`` (the baseline machine's stabilizers out) for ``none``, else ``"upqc"``."""
     return VARIANT_OF.get(controller_kind(study, name), "upqc")
 
 

@@ -8,7 +8,10 @@ operating point, runs every (scenario, controller), and writes:
 
 * ``runs/<run id>.parquet`` (every signal) and ``runs/<run id>.json`` (scenario, metrics, design),
 * ``controllers/<study>-<load>-<upqc>.controller.json``,
-* ``figures/*.png|svg``, ``metrics.csv``, ``metrics.md``, ``claims.json``, ``report.html``.
+* ``figures/*.png|svg``, ``metrics.csv``, ``metrics.md``, ``claims.json``, ``report.html``,
+* for a study with a ``[sweep]`` (its ``[sweep.quick]`` with ``quick``): ``sweep.parquet``
+  (``sweep-quick.parquet``), its ``[[sweep.maps]]`` in ``maps/`` and, in the report, the maps
+  and a table of the sweep's runs. What runs (the runs, the sweep's size) is logged first.
 
 Every file is written atomically (:mod:`weakgrid.fileio`).
 """
@@ -35,7 +38,7 @@ from .figures import figure_specs, write_figures
 from .report import write_html, write_tables
 from ..sweep import open_client, run_sweep
 from .runner import Run, RunRecord, run_scenario
-from .sweep import run_point, sweep_points
+from .sweep import _axes, describe_sweep, run_point, sweep_points
 from .sweep_estimate import estimate_sweep, run_cost
 from .sweep_maps import draw_maps, map_summaries
 
@@ -137,6 +140,11 @@ def _design_notes(study, setup, check):
     return notes
 
 
+def _sweep_file(quick: bool) -> str:
+    """The sweep's table in the output folder (Parquet, every metric of every run)."""
+    return f"sweep{'-quick' if quick else ''}.parquet"
+
+
 def _run_task(study, run, trained):
     """One (scenario, controller) on a worker: the record without the study object."""
     return run_scenario(study, run, trained)
@@ -162,6 +170,16 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
         runs = [Run.of(st, sc, c) for sc, c in st.runs(quick)]
         keys = sorted({r.design_key for r in runs if controller_kind(st, r.controller) == "hji"})
         plan.append((st, runs, keys))
+    swept = [st for st in studies if maps and st.data.get("sweep")]
+    for st, runs, _ in plan:   # what this command runs, before it runs it
+        log(f"{st.name}: {len(runs)} run{'s' if len(runs) != 1 else ''}"
+            + (" (--quick: each scenario's quick settings)" if quick else "") + ": "
+            + ", ".join(r.id for r in runs))
+        if st in swept:
+            n_maps = len(st.data["sweep"].get("maps", []))
+            log(describe_sweep(st, quick) + f"; its results: the report's section \"Sweep of "
+                f"{st.name}\"" + (f" and {n_maps} map{'s' if n_maps != 1 else ''}"
+                                   if n_maps else "") + f", {_sweep_file(quick)}")
     total = sum(len(r) + len(k) for _, r, k in plan)
     # a used folder: runs this plan does not make are stale; finished runs with the same
     # inputs are kept and not redone (an interrupted run continues where it stopped)
@@ -227,7 +245,6 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
             records[run.id] = rec
             n_kept += 1
             bar.update(1)
-    swept = [st for st in studies if maps and st.data.get("sweep")]
     n_tasks = len(todo) + sum(len(sweep_points(st, quick)) for st in swept)
     serial = workers == 0 or (scheduler is None and n_tasks <= 3)
     sweep_table = None
@@ -266,13 +283,18 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
             sweep_table = run_sweep(pts, run_point, cache_dir=out / "sweep-cache",
                                     workers=0 if serial else None, client=client,
                                     progress=progress, log=log, cost=run_cost,
-                                    table_path=out / f"sweep{'-quick' if quick else ''}.parquet",
+                                    table_path=out / _sweep_file(quick),
                                     desc="maps")
-    map_list = []
+    map_list, sweeps = [], []
     for st in swept:
         sub = sweep_table[sweep_table["scenario"].isin(st.data["sweep"]["scenarios"])]
         sub = sub.dropna(axis=1, how="all")
-        map_list += [dict(m, study=st.name) for m in draw_maps(st, sub, out / "maps", quick)]
+        drawn = draw_maps(st, sub, out / "maps", quick)
+        map_list += [dict(m, study=st.name) for m in drawn]
+        sweeps.append({"study": st.name, "file": _sweep_file(quick), "frame": sub,
+                       "axes": list(_axes(st.data["sweep"], quick)),
+                       "text": describe_sweep(st, quick),
+                       "open": not any(m.get("path") for m in drawn)})
     summaries = map_summaries(map_list)
     figs = write_figures(records, out / "figures", fig_specs)
     csv, md = write_tables(metrics, out)
@@ -290,7 +312,7 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                         figures=[p for p in figs if p.suffix == ".png"],
                         designs=designs, notes=notes, protocol=PROTOCOL,
                         maps=[dict(s_, path=m["path"], study=m["study"]) for s_, m in
-                              zip(summaries, map_list)],
+                              zip(summaries, map_list)], sweeps=sweeps,
                         meta={"version": __version__, "n_runs": len(metrics), "wall_s": wall,
                               "mode": "quick" if quick else "full", "parameters": params,
                               "title": title or ", ".join(st.name for st in studies)})

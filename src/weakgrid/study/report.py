@@ -11,7 +11,7 @@ import pandas as pd
 from ..fileio import write_text_atomic
 from .failure import FAILED_CELLS_NOTE
 
-__all__ = ["metrics_frame", "write_tables", "write_html"]
+__all__ = ["metrics_frame", "write_tables", "write_html", "sweep_html"]
 
 COLUMNS = [
     ("id", "run"), ("load", "load"), ("upqc", "UPQC"), ("controller", "controller"),
@@ -33,6 +33,43 @@ COLUMNS = [
     ("vdc_final_dev_pu", "Vdc at the end − Vc0 [pu]"), ("failed", "failed"),
     ("wall_s", "wall time [s]"),
 ]
+
+
+# the sweep table's metrics (of those a run measures), when any run has them
+SWEEP_METRICS = ("speed_peak_dev_pu", "speed_settling_s", "speed_verdict", "vdc_peak_dev_pu",
+                 "vdc_settling_s", "control_cost", "vu_peak_pu", "u_demanded_peak_pu",
+                 "clip_fraction", "omega_reach")
+
+
+def sweep_html(entry: dict) -> str:
+    """The report's section of a study's sweep: what it ran and one row per run (the swept
+    fields, controller, status, the main metrics; the half-step runs of the numerical check
+    left out), open when the study draws no map of it.
+
+    ``entry``: ``study``, ``text`` (what the sweep runs), ``file`` (its Parquet table, every
+    metric), ``frame`` (the sweep's table), ``axes`` (the swept paths), ``open``.
+    """
+    e = html.escape
+    df = entry["frame"]
+    if "dt_factor" in df:
+        df = df[df["dt_factor"] == 1.0]
+    labels = dict(COLUMNS)
+    cols = [a for a in entry["axes"] if a in df]
+    if "scenario" in df and df["scenario"].nunique() > 1:
+        cols.append("scenario")
+    cols += [c for c in ("controller", "status") if c in df]
+    if "failure" in df and df["failure"].fillna("").astype(str).str.len().gt(0).any():
+        cols.append("failure")
+    cols += [m for m in SWEEP_METRICS if m in df and df[m].notna().any()]
+    head = "".join(f"<th>{e(labels.get(c, c))}</th>" for c in cols)
+    rows = "".join("<tr>" + "".join(f"<td>{e(_fmt(r[c]) if r[c] is not None else '')}</td>"
+                                    for c in cols) + "</tr>" for r in df.to_dict("records"))
+    n_fail = int((df["status"] != "ok").sum()) if "status" in df else 0
+    return (f"<h2>Sweep of {e(entry['study'])}</h2><p>{e(entry['text'])}. Every metric of "
+            f"every run: <code>{e(entry['file'])}</code>.</p><details"
+            f"{' open' if entry.get('open') else ''}><summary>{len(df)} runs"
+            f"{f', {n_fail} failed' if n_fail else ''}</summary><table><tr>{head}</tr>{rows}"
+            "</table></details>")
 
 
 def metrics_frame(metrics: list[dict]) -> pd.DataFrame:
@@ -84,9 +121,10 @@ def data_uri(path) -> str:
 
 
 def write_html(path, *, claims, metrics, figures, designs, meta, notes=None, maps=None,
-               protocol=None) -> Path:
+               protocol=None, sweeps=None) -> Path:
     """One self-contained HTML page (figures embedded as data URIs): claims with verdicts,
-    maps of where they hold, the protocol, design models, figures, metrics."""
+    maps of where they hold, the sweeps' runs (``sweeps``: see :func:`sweep_html`), the
+    protocol, design models, figures, metrics."""
     e = html.escape
     title = meta.get("title", "study")
     parts = [f"<!doctype html><meta charset='utf-8'><title>weakgrid — {e(title)}</title>"
@@ -131,6 +169,7 @@ def write_html(path, *, claims, metrics, figures, designs, meta, notes=None, map
                 parts.append(f"<figure><img src='{data_uri(m['path'])}' alt='"
                              f"{e(m['claim'])} map'><figcaption>{e(m['claim'])}: "
                              f"{e(m['title'])}</figcaption></figure>")
+    parts += [sweep_html(sw) for sw in sweeps or []]
     cols = [("case", "study"), ("load", "load"), ("upqc", "UPQC"), ("T", "T [s]"), ("a", "a"),
             ("Vr_bar", "V̄r [pu]"), ("phi_s0", "ϕs0 [rad]"),
             ("preset", "settings preset (T, a, V̄r, ϕs0)"),

@@ -157,12 +157,6 @@ def record_list(study, aliases: dict):
     return list(dict.fromkeys([*rec, *aliases.values()]))
 
 
-def _disable_pss(system):
-    pss = system.components.get("IEEEST")
-    if pss is not None:
-        pss.p["KS"] = np.zeros_like(pss.p["KS"])
-
-
 def enable_windows(bypass, t_end):
     """Windows the controller is active: the complement of the bypass windows in [0, t_end+1]."""
     out, t = [], 0.0
@@ -252,8 +246,6 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
             build_setup(study, dload, run.upqc).design
     ctl = (trained or {}).get((dload, run.upqc))
     choice = make_controller(study, run.controller, design, ctl)
-    if not choice.pss:
-        _disable_pss(setup.system)
     T = setup.design.T
     xs, ys = [], []
     policy = choice.policy

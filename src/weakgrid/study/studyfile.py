@@ -43,7 +43,7 @@ from ..dotted import get_path as _get, set_path as _set
 from ..game.errors import ParameterError
 
 __all__ = ["Study", "load_study", "apply_overrides", "study_from_dict", "get_path", "set_path", "shipped_studies",
-           "read_study_dict", "EVENT_KINDS"]
+           "read_study_dict", "event_end", "EVENT_KINDS"]
 
 TOP = {"study", "grid", "dynamics", "machine", "upqc", "design", "controllers", "scenarios",
        "report", "figures", "claims", "sweep", "simulation"}
@@ -53,16 +53,54 @@ EVENT_KINDS = ("fault", "line_trip", "load_step")
 
 
 # --------------------------------------------------------------------------- dotted paths
+def _is_fault(obj) -> bool:
+    return isinstance(obj, dict) and obj.get("kind") == "fault"
+
+
+# a fault's end is given by t_off or by its duration (t_off = t_on + duration); a validated
+# study keeps t_off only, and both are addressable: reading "duration" gives t_off − t_on,
+# setting one of them drops the other (validation derives t_off from the duration and the
+# event's t_on then, whatever order a sweep sets t_on and the duration in)
+_FAULT_END = {"t_off": "duration", "duration": "t_off"}
+
+
+def event_end(ev: dict) -> float | None:
+    """When a fault event ends [s]: its ``t_off``, or ``t_on + duration`` in a study dict
+    not validated again since a sweep set the duration; None for other events."""
+    if "t_off" in ev:
+        return float(ev["t_off"])
+    if "duration" in ev:
+        return float(ev.get("t_on", 0.0)) + float(ev["duration"])
+    return None
+
+
+def _parent(d: dict, path: str):
+    """``(parent, last key)`` of dotted ``path`` (the parent looked up with
+    :func:`weakgrid.dotted.get_path`; the top level for a one-part path)."""
+    head, _, last = path.rpartition(".")
+    return (_get(d, head) if head else d), last
+
+
 def get_path(d: dict, path: str):
     """The value at dotted ``path`` in study dict ``d`` (e.g. ``"upqc.rating"``; a list element
-    by its ``id`` or index), see :func:`weakgrid.dotted.get_path`."""
+    by its ``id`` or index), see :func:`weakgrid.dotted.get_path`; a fault's ``duration`` [s]
+    is ``t_off − t_on`` when only ``t_off`` is given."""
+    if path.endswith(".duration"):
+        obj, last = _parent(d, path)
+        if _is_fault(obj) and last not in obj and "t_off" in obj and "t_on" in obj:
+            return round(float(obj["t_off"]) - float(obj["t_on"]), 12)
     return _get(d, path)
 
 
 def set_path(d: dict, path: str, value) -> dict:
     """Set the value at dotted ``path`` (creating missing tables and an absent optional field;
-    the study is validated afterwards); returns ``d``."""
-    return _set(d, path, value, create=True)
+    the study is validated afterwards); returns ``d``. Setting a fault's ``t_off`` or
+    ``duration`` drops the other (validation derives ``t_off``)."""
+    _set(d, path, value, create=True)
+    obj, last = _parent(d, path)
+    if _is_fault(obj) and last in _FAULT_END:   # the fault's end given the other way
+        obj.pop(_FAULT_END[last], None)
+    return d
 
 
 # --------------------------------------------------------------------------- reading

@@ -12,7 +12,7 @@ A study's ``[sweep]`` table::
     [sweep.axes]                             # dotted study paths (list elements by id) → values
     "upqc.rating" = [0.1, 0.15, 0.3, 0.6, 1.0]
     "scenarios.c1-high-conv.load" = ["high", "low"]
-    "scenarios.c1-high-conv.events.0.t_off" = [0.22, 0.25, 0.3]
+    "scenarios.c1-high-conv.events.0.t_off" = [0.22, 0.25, 0.3]   # or ….duration (s)
     [sweep.quick]                            # replaces axes (and t_end) for `--quick`
     [sweep.dt_check]                         # points (path = values) run again at half the step:
     "upqc.rating" = [0.15]                   # the numerical uncertainty (ties in the maps)
@@ -37,7 +37,8 @@ from ..game.errors import ParameterError
 from ..sweep import Point, canonical_json, expand, run_sweep
 from .studyfile import get_path, set_path, study_from_dict
 
-__all__ = ["SWEEP_KEYS", "validate_sweep", "sweep_points", "run_point", "run_study_sweep"]
+__all__ = ["SWEEP_KEYS", "validate_sweep", "sweep_points", "describe_sweep", "run_point",
+           "run_study_sweep"]
 
 SWEEP_KEYS = {"axes", "mode", "scenarios", "controllers", "t_end", "design_load", "signals",
               "quick", "maps", "dt_check"}
@@ -90,23 +91,39 @@ def validate_sweep(d: dict, study) -> None:
             if not isinstance(vals, list) or not vals:
                 raise ParameterError(f"{where}.\"{path}\"", vals, "give a non-empty list")
             for v in vals:
-                _check_axis_value(d, where, path, v)
+                _check_axis_value(d, where, path, v, axes)
     for where, t in (("sweep.t_end", sw.get("t_end")),
                      ("sweep.quick.t_end", (sw.get("quick") or {}).get("t_end"))):
         if t is not None and (isinstance(t, bool) or not isinstance(t, (int, float))
                               or not 0 < t < float("inf")):
             raise ParameterError(where, t, "give the simulated time of every run, a number "
                                  "> 0 (s)")
+    for where, axes in (("sweep.axes", sw.get("axes")),
+                        ("sweep.quick.axes", (sw.get("quick") or {}).get("axes"))):
+        ends = {}
+        for path in axes or {}:   # a fault's end swept once: t_off or its duration
+            head, _, last = path.rpartition(".")
+            if last in ("t_off", "duration"):
+                if head in ends:
+                    raise ParameterError(f"{where}.\"{path}\"", path, f"{head} is swept by "
+                                         f"{ends[head]} already: sweep the fault's t_off or its "
+                                         "duration, not both")
+                ends[head] = path
     for path, vals in (sw.get("dt_check") or {}).items():
         if path not in sw.get("axes", {}) or not isinstance(vals, list):
             raise ParameterError(f"sweep.dt_check.\"{path}\"", vals, "give a list of values of "
                                  "a swept field (a path of [sweep.axes])")
 
 
-def _check_axis_value(d, where, path, value):
-    """A value of an axis must be valid for its field: the study with it is validated."""
+def _check_axis_value(d, where, path, value, axes=None):
+    """A value of an axis must be valid for its field: the study with it is validated (a
+    fault's t_on with the first value of its swept duration, if swept: the end follows it)."""
     trial = {k: copy.deepcopy(v) for k, v in d.items() if k != "sweep"}
+    head, _, last = path.rpartition(".")
+    with_end = f"{head}.duration"
     try:
+        if last == "t_on" and with_end in (axes or {}):
+            set_path(trial, with_end, copy.deepcopy(axes[with_end][0]))
         set_path(trial, path, copy.deepcopy(value))
         study_from_dict(trial)
     except ParameterError as exc:
@@ -159,6 +176,26 @@ def sweep_points(study, quick: bool = False, scenarios=None, controllers=None):
                              dict(copy.deepcopy(pt.inputs), dt_factor=0.5))
                 out.append(half)
     return out
+
+
+def describe_sweep(study, quick: bool = False) -> str:
+    """One line saying what the study's sweep runs: its run count and how it is made up (the
+    axes and their sizes, the controllers, the scenarios, the runs at half the step)."""
+    sw = study.data["sweep"]
+    pts = sweep_points(study, quick)
+    half = sum(1 for p in pts if p.params.get("dt_factor", 1.0) != 1.0)
+    axes = _axes(sw, quick)
+    scs = sw["scenarios"]
+    ctls = sw.get("controllers")
+    parts = [f"{p} ({len(v)})" for p, v in axes.items()]
+    parts.append(f"controllers ({len(ctls)}: {', '.join(ctls)})" if ctls else
+                 "each scenario's controllers")
+    t_end = ((sw.get("quick") or {}).get("t_end") if quick else None) or sw.get("t_end")
+    src = "[sweep.quick]" if quick and "axes" in (sw.get("quick") or {}) else "[sweep]"
+    return (f"{study.name}: its sweep {src}, {len(pts)} runs: {' × '.join(parts)} on "
+            f"scenario{'s' if len(scs) > 1 else ''} {', '.join(scs)}"
+            + (f", {t_end:g} s each" if t_end else "")
+            + (f" ({half} of them at half the step: the numerical uncertainty)" if half else ""))
 
 
 def _points_mode(base, axes):

@@ -36,7 +36,7 @@ from ..game.errors import ParameterError
 from ..game.estimate import GiB, available_memory, format_duration, proc_kib, training_estimate
 from ..sweep import canonical_json, run_key
 from ..sweep.cache import ResultCache
-from .studyfile import get_path, study_from_dict
+from .studyfile import event_end, get_path, study_from_dict
 from .sweep import _NOT_DESIGN, _axes, run_point, sweep_points
 
 __all__ = ["SweepEstimate", "check_sweep", "estimate_sweep", "planned_runs", "probe", "run_cost"]
@@ -145,7 +145,7 @@ def _steps(inputs: dict) -> float:
 def _event_window(events):
     """(start of the first, end of the last) disturbance [s], or (None, None)."""
     starts = [float(e.get("t_on", e.get("t", 0.0))) for e in events]
-    ends = [float(e.get("t_off", e.get("t_on", e.get("t", 0.0)))) for e in events]
+    ends = [s if event_end(e) is None else event_end(e) for s, e in zip(starts, events)]
     return (min(starts), max(ends)) if starts else (None, None)
 
 
@@ -181,9 +181,9 @@ def run_cost(inputs: dict) -> float:
     t_end = n * dt
     on = 0.0
     for e in _scenario(d, inputs["scenario"]).get("events") or []:
-        if "t_off" in e:
+        if event_end(e) is not None:
             t_on = float(e.get("t_on", e.get("t", 0.0)))
-            on += max(min(float(e["t_off"]), t_end) - min(t_on, t_end), 0.0)
+            on += max(min(event_end(e), t_end) - min(t_on, t_end), 0.0)
     return quiet + 3.0 * (n - quiet) + (FAULT_STEP_WEIGHT - 3.0) * on / dt
 
 

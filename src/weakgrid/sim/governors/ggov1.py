@@ -52,8 +52,6 @@ db Tsa Tsb Rup Rdown``.
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 
 from ..blocks import IntegratorNonWindup, Lag, LeadLag, TransportDelay, Washout, deadband
@@ -137,9 +135,9 @@ class GGOV1(MachineControl):
                     raise DataError(el, lead, float(p[lead][i]),
                                     f"a lead/derivative without its lag ({lag} = 0) is improper; "
                                     f"give {lag} > 0 or {lead} = 0")
-            if p["Rup"][i] < 10 or p["Rdown"][i] > -10:
-                warnings.warn(f"{el}: Rup = {p['Rup'][i]:g}, Rdown = {p['Rdown'][i]:g} (load-limit rate "
-                              "limits) are not represented", stacklevel=2)
+        self.warn_instances(np.nonzero((p["Rup"] < 10) | (p["Rdown"] > -10))[0],
+                            "load-limit rate limits Rup, Rdown are not represented",
+                            lambda i: f"Rup = {p['Rup'][i]:g}, Rdown = {p['Rdown'][i]:g}")
         Tbase = np.where(p["Trate"] > 0, p["Trate"], self.Sn)
         self.kT = Tbase / system.Sb                          # turbine base -> system base
         self.PELF = Lag(1.0, p["Tpelec"])

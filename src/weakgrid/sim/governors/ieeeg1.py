@@ -20,8 +20,6 @@ steady; a warning names the device (as ANDES).
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 
 from ..blocks import IntegratorNonWindup, Lag, LeadLag, hard_limit
@@ -121,10 +119,10 @@ class IEEEG1(MachineControl):
         tm0 = sig["tm0"][m]
         tm02 = np.where(self.has2, sig["tm0"][np.maximum(self.mach2, 0)], 0.0)
         hp, lp = self.Kn[0::2].sum(axis=0), self.Kn[1::2].sum(axis=0)
-        for i in np.nonzero(self.has2 & (np.abs(tm0 * lp - tm02 * hp) > 1e-6))[0]:
-            warnings.warn(f"{self.element(i)}: the initial powers of the two machines ({tm0[i]:.6g}, "
-                          f"{tm02[i]:.6g} pu) do not split as K1..K8 ({hp[i]:.3g}/{lp[i]:.3g}); "
-                          "the initial point is not steady", stacklevel=2)
+        self.warn_instances(np.nonzero(self.has2 & (np.abs(tm0 * lp - tm02 * hp) > 1e-6))[0],
+                            "the initial powers of the two machines do not split as K1..K8; the "
+                            "initial point is not steady",
+                            lambda i: f"({tm0[i]:.6g}, {tm02[i]:.6g} pu vs {hp[i]:.3g}/{lp[i]:.3g})")
         self.P0 = tm0 + tm02
         self.tm02 = tm02
         x[self.sl(0)] = self.LL.init(np.zeros(self.n))

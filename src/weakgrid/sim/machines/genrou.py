@@ -31,8 +31,6 @@ ieee39 data) is unusual but well defined and is accepted with a warning, as ANDE
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 
 from ..blocks import quad_saturation_coeffs
@@ -89,16 +87,16 @@ class GENROU(SyncMachine):
             if not p["xl"][i] < min(p["xd1"][i], p["xq1"][i]):
                 raise DataError(self.element(i), "xl", self._values[i]["xl"],
                                 "leakage reactance must be < xd1 and < xq1")
-            if not p["xl"][i] < p["xd2"][i]:   # unusual but well defined (ANDES's ieee39 data): warn, as ANDES
-                warnings.warn(f"{self.element(i)}: leakage reactance xl = {p['xl'][i]:g} >= xd2 = "
-                              f"{p['xd2'][i]:g} (normally xl < xd2); accepted, as in ANDES", UserWarning,
-                              stacklevel=2)
             # xq1 = xq (no q-axis transient effect, ANDES's wecc data) is well defined, and so is
             # xd2 = xd1 / xq2 = xq1 (no sub-transient effect: gd2 = gq2 = 0, the damper states
             # drop out of the flux; PSS/E runs such data, e.g. PSID's STAB1 case)
             if not (p["xd2"][i] <= p["xd1"][i] <= p["xd"][i]) or not (p["xq2"][i] <= p["xq1"][i] <= p["xq"][i]):
                 raise DataError(self.element(i), "xd1", self._values[i]["xd1"],
                                 "need xd2 <= xd1 <= xd and xq2 <= xq1 <= xq")
+        # unusual but well defined (ANDES's ieee39 data): said once for the model, as ANDES accepts it
+        self.warn_instances(np.nonzero(~(p["xl"] < p["xd2"]))[0],
+                            "leakage reactance xl >= xd2 (normally xl < xd2); accepted, as in ANDES",
+                            lambda i: f"xl = {p['xl'][i]:g} >= xd2 = {p['xd2'][i]:g}")
         xl = p["xl"]
         self.gd1 = (p["xd2"] - xl) / (p["xd1"] - xl)
         self.gq1 = (p["xq2"] - xl) / (p["xq1"] - xl)

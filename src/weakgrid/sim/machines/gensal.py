@@ -37,8 +37,6 @@ the PSS/E-only models GENSAL, GENSAE, GENROE; ``psse_shaft = 0`` gives ANDES's
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 
 from ..blocks import quad_saturation_coeffs
@@ -119,9 +117,9 @@ class GENSAL(SyncMachine):
                 raise DataError(self.element(i), "S12", val["S12"],
                                 f"{name} needs S(1.2) >= S(1.0) = {val['S10']:g} (saturation grows "
                                 "with flux); S10 = 0 disables saturation")
-            if not p["xl"][i] < p["xd2"][i]:
-                warnings.warn(f"{self.element(i)}: leakage reactance xl = {p['xl'][i]:g} >= xd2 = "
-                              f"{p['xd2'][i]:g} (normally xl < xd2); accepted", UserWarning, stacklevel=2)
+        self.warn_instances(np.nonzero(~(p["xl"] < p["xd2"]))[0],
+                            "leakage reactance xl >= xd2 (normally xl < xd2); accepted",
+                            lambda i: f"xl = {p['xl'][i]:g} >= xd2 = {p['xd2'][i]:g}")
         xl = p["xl"]
         self.gd1 = (p["xd2"] - xl) / (p["xd1"] - xl)
         self.gd2 = (p["xd1"] - p["xd2"]) / (p["xd1"] - xl) ** 2
