@@ -737,3 +737,24 @@ def test_the_readme_lists_every_model_with_a_psse_record():
     listed = set(re.findall(r"\b[A-Z][A-Z0-9]{2,}\b", part)) - {"PSS", "PAG"}
     have = {n for n, c in _registry().items() if getattr(c, "psse_record", None)}
     assert listed == have
+
+
+def test_units_sharing_a_bus_keep_their_own_solved_q():
+    """Eight units on bus 102 of PSID's MultiGen case: PSS/E initializes each from its own solved
+    QG (its CSV's VARS at t = 0, [Mvar / 100]), not from an equal share of the bus's Q."""
+    mg = Path(__file__).resolve().parents[1] / "data" / "psid" / "MultiGen"
+    system, _ = from_psse(mg / "FourBusMulti.raw", mg / "FourBus_multigen.dyr")
+    system.setup()
+    first = np.genfromtxt(mg / "gen_trip_results.csv", delimiter=",", max_rows=1)
+    ids = ["1", "EG", "ND", "RG", "S", "SG", "SH", "SW", "WG"]   # the CSV's machine order
+    pf = system.network.pf
+    for k, gid in enumerate(ids):
+        row = system.psse_gen_row[(101 if gid == "1" else 102, gid)]
+        assert pf.Qg[row] == pytest.approx(first[3 + 5 * k], abs=1e-4), gid
+        assert pf.Pg[row] == pytest.approx(first[2 + 5 * k], abs=1e-4), gid
+    # an equal split (the default of a MATPOWER case) gives the condenser 'ND' (QG = 0) the
+    # same Q as the others
+    net = system.network
+    net.gen_split = "equal"
+    net.solve_power_flow()
+    assert net.pf.Qg[system.psse_gen_row[(102, "ND")]] > 0.3

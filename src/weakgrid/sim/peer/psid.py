@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError
-from ..events import Event, LineTrip
+from ..events import Event, GeneratorTrip, LineTrip
 from ..network import BR_B, BR_R, BR_X, F_BUS, PD, QD, T_BUS
 
 #: folder of the vendored PSID cases in a source checkout (``tests/data/psid``); an installed
@@ -163,6 +163,17 @@ class Names:
                             f"expected one machine of PSS/E bus {bus} id '{gid}' among {names}")
         return hits[0]
 
+    def gen_row(self, bus, gid) -> int:
+        """0-based gen-table row of PSS/E unit (bus, id) (weakgrid's PSS/E reader only)."""
+        table = getattr(self.sys, "psse_gen_row", None)
+        gid = _strip_id(gid)
+        hits = [r for (b, i), r in (table or {}).items() if int(b) == int(bus) and _strip_id(i) == gid]
+        if self.ss is not None or len(hits) != 1:
+            raise DataError(f"unit ({bus}, '{gid}')", "gen row", hits,
+                            f"expected one generator of PSS/E bus {bus} id '{gid}' in the reader's "
+                            f"psse_gen_row {sorted(table or {})}")
+        return int(hits[0])
+
     def component(self, kind, bus, gid):
         """(component, position) of the ``kind`` control ("exciter", ...) of machine (bus, id)."""
         m = self.machine(bus, gid)
@@ -247,6 +258,8 @@ def weakgrid_events(case, system, names):
     kind = ev["kind"]
     if kind == "branch trip":
         return [LineTrip(int(r), ev["t"]) for r in names.branch_rows(ev["from_bus"], ev["to_bus"], ev["ckt"])]
+    if kind == "gen trip":
+        return [GeneratorTrip(names.gen_row(ev["bus"], ev["id"]), ev["t"])]
     if kind == "source change" and ev.get("signal") == "vref":
         comp, k = names.component(ev["model"], ev["bus"], ev["id"])
         return [ReferenceChange(comp, k, ev["t"], ev["value"])]
