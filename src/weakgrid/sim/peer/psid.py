@@ -65,6 +65,7 @@ def load_cases(path=None) -> list[dict]:
     for c in cases:
         c.setdefault("run", True)
         c.setdefault("compare", [])
+        c.setdefault("results_from", "PSS/E")   # whose simulation the CSV holds (PSID's DEGOV: PowerWorld)
         c.setdefault("root", str(path.parent))
     return cases
 
