@@ -44,10 +44,6 @@ KNOWN_GAPS = {
         "half the jump",
     "psid29_rena_freq_flag": "as psid29_rena_default_flags (P 25.5 %, Q 27.1 % of the swing; "
         "2-norms within PSID's tolerance)",
-    "psid41_stab1": "runs since GENROU accepts X''d = X'd (PSS/E does), but V is 1.03e-2 pu off "
-        "(22 % of PSS/E's swing) and speed 2.8e-4 pu (31 %); the same STAB1 in a hand-built "
-        "copy of the case matches within 0.9 % (tests/sim/test_pss_psse.py): the difference is "
-        "in this case's reading or its voltage-reference event, not found yet",
     "psid57_degov_nodelay": "the CSV is PowerWorld's, not PSS/E's (cases.toml: PSID's omega_pw, 1/240-s "
         "samples, absolute speed): with PSS/E's GENCLS (te/omega, damping D alone, which PSS/E's own "
         "OMIB results need) 8.7e-5 pu of speed against PSID's 4.7e-5 (9.5 % of the swing); "

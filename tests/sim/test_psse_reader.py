@@ -758,3 +758,20 @@ def test_units_sharing_a_bus_keep_their_own_solved_q():
     net.gen_split = "equal"
     net.solve_power_flow()
     assert net.pf.Qg[system.psse_gen_row[(102, "ND")]] > 0.3
+
+
+def test_basfrq_override_is_the_runs_base_frequency():
+    """PSS/E's base frequency is a setting of the run (psspy.base_frequency): ``basfrq`` replaces
+    the file's BASFRQ everywhere (network, machines), with a note; PSID's STAB1 .raw says 50 Hz."""
+    folder = Path(__file__).resolve().parents[1] / "data" / "psid" / "STAB1"
+    raw, dyr = folder / "OMIB_SSS.raw", folder / "OMIB_SSS.dyr"
+    s50, _ = from_psse(raw, dyr)
+    s60, _ = from_psse(raw, dyr, basfrq=60.0)
+    assert s50.network.f_hz == 50.0 and s60.network.f_hz == 60.0
+    fn = lambda s: s.components["GENROU"]._values[0]["fn"]   # noqa: E731
+    assert fn(s50) == 50.0 and fn(s60) == 60.0
+    assert any("60 Hz (basfrq), not the file's BASFRQ = 50 Hz" in n for n in s60.import_notes)
+    assert not any("basfrq" in n for n in s50.import_notes)
+    with pytest.raises(DataError) as e:
+        from_psse(raw, dyr, basfrq=0.0)
+    assert e.value.field == "basfrq"

@@ -297,11 +297,13 @@ def convert_loads(system, kind):
 
 # ------------------------------------------------------------------------------ weakgrid
 def read_psse(case, root=None):
-    """``from_psse(raw, dyr)`` of the entry's files, exactly as shipped: ``(system, events)``."""
+    """``from_psse(raw, dyr)`` of the entry's files, exactly as shipped: ``(system, events)``; an
+    entry's ``basfrq`` [Hz] is the frequency PSS/E's results were computed at, where it differs
+    from the file's BASFRQ (``from_psse(..., basfrq=)``, PSS/E's ``base_frequency`` setting)."""
     from ..io.psse import from_psse
 
     dyr = case_file(case, "dyr", root) if case.get("dyr") else None
-    return from_psse(case_file(case, "raw", root), dyr)
+    return from_psse(case_file(case, "raw", root), dyr, basfrq=case.get("basfrq"))
 
 
 def build_weakgrid(case, root=None, route="psse"):
