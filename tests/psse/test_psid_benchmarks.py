@@ -53,7 +53,9 @@ KNOWN_GAPS = {
         "3.1e-5 (6.0 % of the swing); 3.05e-5 (3.4 %) with the governor's power alone divided by the speed",
     "psid59_st6b": "refused at initialization, naming ILR: the operating point needs ILR >= "
         "2.1508 pu and the file has 2.15 (PSID raises the limit silently; PSS/E's results for "
-        "ST6B are not shipped)",
+        "ST6B are not shipped). The data's own: PSS/E's field current at this operating point is "
+        "2.15312 pu (psid26_sexs, same machine and .raw; weakgrid 2.153116), so the limiter binds "
+        "at t = 0 in PSS/E as well",
 }
 
 
