@@ -166,10 +166,12 @@ class Names:
 
     def gen_row(self, bus, gid) -> int:
         """0-based gen-table row of PSS/E unit (bus, id) (weakgrid's PSS/E reader only)."""
+        if self.ss is not None:
+            raise Unsupported(f"unit ({bus}, '{gid}'): the ANDES route's names carry no PSS/E id")
         table = getattr(self.sys, "psse_gen_row", None)
         gid = _strip_id(gid)
         hits = [r for (b, i), r in (table or {}).items() if int(b) == int(bus) and _strip_id(i) == gid]
-        if self.ss is not None or len(hits) != 1:
+        if len(hits) != 1:
             raise DataError(f"unit ({bus}, '{gid}')", "gen row", hits,
                             f"expected one generator of PSS/E bus {bus} id '{gid}' in the reader's "
                             f"psse_gen_row {sorted(table or {})}")
