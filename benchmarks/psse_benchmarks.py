@@ -146,6 +146,8 @@ def table(results):
                 atxt += f"; 2-norm {a['psid_norm']:.3g}"
             if an.get("changes"):
                 atxt += " [ANDES's parser: " + ", ".join(an["changes"]) + "]"
+            if c.get("results_from", "PSS/E") != "PSS/E":
+                st += f" (the CSV is {c['results_from']}'s, not PSS/E's: see cases.toml)"
             lines.append(f"| {c['id']} | {models} | {q} | {sw} | {wtxt} | {atxt} | {tol} | {st} |")
     return "\n".join(lines)
 

@@ -44,19 +44,18 @@ KNOWN_GAPS = {
         "half the jump",
     "psid29_rena_freq_flag": "as psid29_rena_default_flags (P 25.5 %, Q 27.1 % of the swing; "
         "2-norms within PSID's tolerance)",
-    "psid41_stab1": "runs since GENROU accepts X''d = X'd (PSS/E does), but V is 1.03e-2 pu off "
-        "(22 % of PSS/E's swing) and speed 2.8e-4 pu (31 %); the same STAB1 in a hand-built "
-        "copy of the case matches within 0.9 % (tests/sim/test_pss_psse.py): the difference is "
-        "in this case's reading or its voltage-reference event, not found yet",
-    "psid57_degov_nodelay": "4.71e-5 pu of speed against PSID's 4.7e-5 (5.14 % of PSS/E's swing), "
-        "the same at 1/960 s; with the 1 s delay the case passes (3.05e-5, 3.36 %)",
+    "psid57_degov_nodelay": "the CSV is PowerWorld's, not PSS/E's (cases.toml: PSID's omega_pw, 1/240-s "
+        "samples, absolute speed): with PSS/E's GENCLS (te/omega, damping D alone, which PSS/E's own "
+        "OMIB results need) 8.7e-5 pu of speed against PSID's 4.7e-5 (9.5 % of the swing); "
+        "dividing only the governor's power by the speed (weakgrid's GENCLS before) fits these "
+        "results better (4.7e-5, 5.1 %)",
+    "psid57_degov_delay": "as psid57_degov_nodelay (PowerWorld's results): 5.4e-5 pu against PSID's "
+        "3.1e-5 (6.0 % of the swing); 3.05e-5 (3.4 %) with the governor's power alone divided by the speed",
     "psid59_st6b": "refused at initialization, naming ILR: the operating point needs ILR >= "
         "2.1508 pu and the file has 2.15 (PSID raises the limit silently; PSS/E's results for "
-        "ST6B are not shipped)",
-    "psid01_omib": "GENCLS with PSS/E's swing equation (mechanical input as power): 2.34e-3 rad "
-        "against PSID's 2e-3 (4.88 % of PSS/E's swing); with ANDES's torque form 1.25e-3 rad "
-        "(2.61 %), but DEGOV on GENCLS needs the power form, so PSS/E's GENCLS shaft is "
-        "not settled",
+        "ST6B are not shipped). The data's own: PSS/E's field current at this operating point is "
+        "2.15312 pu (psid26_sexs, same machine and .raw; weakgrid 2.153116), so the limiter binds "
+        "at t = 0 in PSS/E as well",
 }
 
 

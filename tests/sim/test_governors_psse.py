@@ -11,8 +11,8 @@ Oracles, per model (ANDES 2.0 has none of them, so there is no ANDES peer):
   an isochronous governor);
 * each limit driven (load steps beyond the unit's range), the limited quantity held exactly;
 * bad data refused with a DataError naming the field;
-* PSS/E's own results where PowerSimulationsDynamics.jl ships them (DEGOV, marked ``psse``;
-  read from the vendored PSID files, tests/data/psid).
+* the results PowerSimulationsDynamics.jl ships for DEGOV (PowerWorld's, not PSS/E's: see
+  tests/data/psid/cases.toml; read from the vendored PSID files, tests/data/psid).
 """
 
 from pathlib import Path
@@ -171,16 +171,23 @@ def test_degov1_eigenvalues_as_psid(M, monkeypatch):
 
 @pytest.mark.parametrize("M", [0, 1])
 def test_degov1_droop(M):
-    """Throttle (M = 0) or electrical-power (M = 1) droop: omega_ss - 1 = -DROOP * dP (machine base)."""
+    """Throttle (M = 0) or electrical-power (M = 1) droop: omega_ss - 1 = -DROOP * d(feedback)
+    (machine base). PSS/E's GENCLS balances PMECH/omega against Pe/omega, so in the steady state
+    PMECH = THR*omega = Pe: the throttle settles at Pe/omega."""
     s = island_system(("DEGOV1", dict(DEGOV1, M=M, K=5.0)))
     dP = 10.0
     res = simulate(s, 60.0, dt=0.02, events=[LoadStep(2, 0.5, dP=dP)])
-    pe0, pe1 = s.sig_defaults["Pe0"][0], island_pe(s, dP)
-    expected = -DEGOV1["DROOP"] * (pe1 - pe0) * 100.0 / SN
+    pe0, pe1 = (v * 100.0 / SN for v in (s.sig_defaults["Pe0"][0], island_pe(s, dP)))
+    if M == 1:
+        expected = -DEGOV1["DROOP"] * (pe1 - pe0)
+    else:
+        expected = 0.0
+        for _ in range(50):   # the throttle is Pe/omega
+            expected = -DEGOV1["DROOP"] * (pe1 / (1 + expected) - pe0)
     assert abs(expected) > 3e-3
     assert res["G.omega"][-1] - 1 == pytest.approx(expected, rel=1e-5)
-    assert res["G.Pe"][-1] == pytest.approx(pe1, rel=1e-7)
-    assert res["G.gov.THR"][-1] == pytest.approx(pe1 * 100.0 / SN, rel=1e-6)   # lossless: throttle = Pe
+    assert res["G.Pe"][-1] == pytest.approx(pe1 * SN / 100.0, rel=1e-7)
+    assert res["G.gov.THR"][-1] == pytest.approx(pe1 / (1 + expected), rel=1e-6)   # lossless: THR*omega = Pe
 
 
 def test_degov_is_isochronous():
@@ -253,7 +260,7 @@ def test_degov_bad_data(model, params, field):
     assert e.value.field == field
 
 
-# ------------------------------------------------------- PSS/E's own results (PSID benchmark)
+# ------------------------------------------ PSID's DEGOV benchmark (PowerWorld's results)
 def _psid_csv(path):
     return np.loadtxt(PSID / path, delimiter=",")
 
@@ -264,16 +271,19 @@ def _psid_csv(path):
     (1.0, "DEGOV/degov_delay_speed_final.csv", 3.1e-5)], ids=["nodelay", "delay"])
 def test_degov_against_psse(TD, csv, psid_tol):
     """PSID test_case57: GENCLS (H = 8, D = 0.03, x'd = 0.25) + DEGOV at bus 102, line 101-102
-    tripped at 1 s; rotor speed against PSS/E's. Measured: 4.71e-5 pu (no delay; PSID's own
-    tolerance 4.7e-5) and 3.05e-5 pu (1 s delay; PSID 3.1e-5) on swings of 9.2e-4 / 9.1e-4 pu,
-    the same at 1/960 s (the gap grows linearly in time: PSS/E's swing period is 0.5 % shorter)."""
+    tripped at 1 s; rotor speed against the CSV PSID ships -- PowerWorld's results, not PSS/E's
+    (PSID names them omega_pw; 1/240-s samples, absolute speed: tests/data/psid/cases.toml).
+    With PSS/E's GENCLS (electrical torque Pe/omega: PSS/E's own OMIB results need it) the
+    difference is 8.7e-5 pu (no delay) and 5.4e-5 pu (1 s delay) on swings of 9.2e-4 / 9.1e-4 pu,
+    below 10 % of the swing: the governor's dynamics are PowerWorld's, the machine's damping
+    convention is not (with the governor's power alone divided by the speed: 4.7e-5 / 3.05e-5)."""
     ref = _psid_csv(csv)
     s = threebus_system(("DEGOV", dict(DEGOV, TD=TD)), machine="GENCLS").setup()
     res = simulate(s, 5.0, dt=1 / 240, events=[LineTrip(0, 1.0)])
     w = np.interp(ref[:, 0], res.t, res["G.omega"])
     err = np.max(np.abs(w - ref[:, 1]))
-    assert err < psid_tol * 1.02
-    assert err < 0.052 * np.ptp(ref[:, 1])
+    assert err < 2 * psid_tol
+    assert err < 0.10 * np.ptp(ref[:, 1])
 
 
 # ============================================================================== PIDGOV
@@ -316,7 +326,8 @@ def test_pidgov_droop_on_power():
 
 
 def test_pidgov_droop_on_gate():
-    """Flag 1: omega_ss - 1 = -Rperm*(gate_ss - gate0), gate_ss the gate giving PMECH = te*omega."""
+    """Flag 1: omega_ss - 1 = -Rperm*(gate_ss - gate0), gate_ss the gate giving PMECH = Pe (PSS/E's
+    GENCLS balances PMECH/omega against Pe/omega)."""
     from weakgrid.sim.governors._gate import power_gate
 
     s = island_system(("PIDGOV", dict(PIDGOV_ISLAND, Flag=1)))
@@ -324,9 +335,7 @@ def test_pidgov_droop_on_gate():
     gov = s.components["PIDGOV"]
     te1 = island_pe(s, 10.0) * 100.0 / SN
     g0 = power_gate(gov, np.array([P0 / SN]))[0]
-    dw = 0.0
-    for _ in range(50):     # PMECH = te*omega in the steady state (tm = PMECH/omega)
-        dw = -PIDGOV["Rperm"] * (power_gate(gov, np.array([te1 * (1 + dw)]))[0] - g0)
+    dw = -PIDGOV["Rperm"] * (power_gate(gov, np.array([te1]))[0] - g0)   # PMECH = Pe in the steady state
     assert abs(dw) > 5e-4
     assert res["G.omega"][-1] - 1 == pytest.approx(dw, rel=1e-5)
 
@@ -488,10 +497,10 @@ def test_ggov1_initial_point_is_an_equilibrium(params):
 
 
 def _ggov1_valve(gov, te, dw, i=0):
-    """Valve stroke giving PMECH = te*omega in the steady state (tm = PMECH/omega)."""
+    """Valve stroke giving PMECH = Pe in the steady state (PSS/E's GENCLS: PMECH/omega = Pe/omega)."""
     p = {k: v[i] for k, v in gov.p.items()}
     w = 1 + dw
-    wf = (te * w + p["Dm"] * w) / p["Kturb"] + p["Wfnl"]
+    wf = (te + p["Dm"] * w) / p["Kturb"] + p["Wfnl"]
     return wf / (w if p["Flag"] > 0 else 1.0)
 
 
@@ -540,7 +549,8 @@ def test_ggov1_load_limiter_takes_control():
     fsr0 = 0.6 / 1.5 + 0.2
     Ldref = (fsr0 + 0.02 - 0.2) * 1.5                 # TLIM = fsr0 + 0.02
     s = island_system(("GGOV1", dict(GGOV1, Ldref=Ldref)))
-    res = simulate(s, 80.0, dt=0.05, events=[LoadStep(2, 0.5, dP=10.0)], tol=1e-11)
+    # 120 s: the island GENCLS has D = 0 and PSS/E's GENCLS adds no speed damping of its own
+    res = simulate(s, 120.0, dt=0.05, events=[LoadStep(2, 0.5, dP=10.0)], tol=1e-11)
     fsr, fsrt, fsrn = res["G.gov.FSR"], res["G.gov.FSRT"], res["G.gov.FSRN"]
     assert fsr[-1] == pytest.approx(fsrt[-1], abs=1e-9)
     assert res["G.gov.ERR"][-1] > 0.01 and fsrn[-1] > fsr[-1]   # the governor asks for more fuel

@@ -136,6 +136,49 @@ def test_dual_input_frequency_response_is_its_transfer_function(model, prm):
     assert abs(_freq_resp(_linearize(s, model), [1e-4])[0]) < 1e-2 * np.max(np.abs(H))
 
 
+# IEEEST's filter: PSS/E's (1 + A5 s + A6 s^2)/((1 + A1 s + A2 s^2)(1 + A3 s + A4 s^2))
+IEEEST_BASE = dict(MODE=1, T1=0.3, T2=0.05, T3=0.2, T4=0.1, T5=1.65, T6=1.65, KS=3.0, LSMAX=9.0, LSMIN=-9.0)
+
+
+def _ieeest_tf(s, p, andes=False):
+    num = 1 + p.get("A5", 0) * s + p.get("A6", 0) * s ** 2
+    d34 = 1 + p.get("A3", 0) * s + p.get("A4", 0) * s ** 2
+    if andes and p.get("A4", 0) <= 0:   # ANDES 2.0: the second factor bypassed when A4 = 0
+        num, d34 = 1.0, 1.0
+    filt = num / ((1 + p.get("A1", 0) * s + p.get("A2", 0) * s ** 2) * d34)
+    return p["KS"] * filt * _ll(s, p["T1"], p["T2"]) * _ll(s, p["T3"], p["T4"]) * _wo(s, p["T5"]) \
+        * (p["T6"] / p["T5"] if p["T5"] > 0 else 1.0)
+
+
+@pytest.mark.parametrize("filt", [
+    dict(A1=1.013, A2=0.013, A5=1.013, A6=0.113),            # PSS/E's usual data: A3 = A4 = 0
+    dict(A1=0.2, A2=0.01, A3=0.1, A4=0.02, A5=0.3, A6=0.05),  # both factors second order
+    dict(A1=0.2, A3=0.1, A6=0.05, A5=0.4),                     # two first-order factors, A6 > 0
+    dict(A3=0.1, A5=0.4),                                      # a first-order lead-lag only
+    dict(A1=0.5),                                              # a lag only
+])
+def test_ieeest_frequency_response_is_pss_e_filter(filt):
+    prm = dict(IEEEST_BASE, **filt)
+    s = _system(("IEEEST", prm))
+    H = _freq_resp(_linearize(s, "IEEEST"), W)
+    assert np.max(np.abs(H / _ieeest_tf(1j * W, prm) - 1)) < 1e-6
+
+
+def test_ieeest_andes_convention_drops_the_numerator_when_a4_is_zero():
+    prm = dict(IEEEST_BASE, A1=1.013, A2=0.013, A5=1.013, A6=0.113)
+    s = _system(("IEEEST", dict(prm, F2_bypass=1.0)))
+    H = _freq_resp(_linearize(s, "IEEEST"), W)
+    assert np.max(np.abs(H / _ieeest_tf(1j * W, prm, andes=True) - 1)) < 1e-6
+    # and that is far from PSS/E's filter (its numerator alone has a gain of 115 at 5 Hz)
+    assert np.max(np.abs(H / _ieeest_tf(1j * W, prm) - 1)) > 0.5
+
+
+def test_ieeest_improper_filter_is_refused_naming_the_zero():
+    with pytest.raises(DataError, match="higher order") as e:
+        _system(("IEEEST", dict(IEEEST_BASE, A1=0.2, A6=0.05)))
+    assert e.value.field == "A6"
+
+
 # ------------------------------------------------------------------------- limits
 def _feedthrough(s, d):
     """vs right after a speed step d at the initial point (every state still at rest)."""

@@ -737,3 +737,41 @@ def test_the_readme_lists_every_model_with_a_psse_record():
     listed = set(re.findall(r"\b[A-Z][A-Z0-9]{2,}\b", part)) - {"PSS", "PAG"}
     have = {n for n, c in _registry().items() if getattr(c, "psse_record", None)}
     assert listed == have
+
+
+def test_units_sharing_a_bus_keep_their_own_solved_q():
+    """Eight units on bus 102 of PSID's MultiGen case: PSS/E initializes each from its own solved
+    QG (its CSV's VARS at t = 0, [Mvar / 100]), not from an equal share of the bus's Q."""
+    mg = Path(__file__).resolve().parents[1] / "data" / "psid" / "MultiGen"
+    system, _ = from_psse(mg / "FourBusMulti.raw", mg / "FourBus_multigen.dyr")
+    system.setup()
+    first = np.genfromtxt(mg / "gen_trip_results.csv", delimiter=",", max_rows=1)
+    ids = ["1", "EG", "ND", "RG", "S", "SG", "SH", "SW", "WG"]   # the CSV's machine order
+    pf = system.network.pf
+    for k, gid in enumerate(ids):
+        row = system.psse_gen_row[(101 if gid == "1" else 102, gid)]
+        assert pf.Qg[row] == pytest.approx(first[3 + 5 * k], abs=1e-4), gid
+        assert pf.Pg[row] == pytest.approx(first[2 + 5 * k], abs=1e-4), gid
+    # an equal split (the default of a MATPOWER case) gives the condenser 'ND' (QG = 0) the
+    # same Q as the others
+    net = system.network
+    net.gen_split = "equal"
+    net.solve_power_flow()
+    assert net.pf.Qg[system.psse_gen_row[(102, "ND")]] > 0.3
+
+
+def test_basfrq_override_is_the_runs_base_frequency():
+    """PSS/E's base frequency is a setting of the run (psspy.base_frequency): ``basfrq`` replaces
+    the file's BASFRQ everywhere (network, machines), with a note; PSID's STAB1 .raw says 50 Hz."""
+    folder = Path(__file__).resolve().parents[1] / "data" / "psid" / "STAB1"
+    raw, dyr = folder / "OMIB_SSS.raw", folder / "OMIB_SSS.dyr"
+    s50, _ = from_psse(raw, dyr)
+    s60, _ = from_psse(raw, dyr, basfrq=60.0)
+    assert s50.network.f_hz == 50.0 and s60.network.f_hz == 60.0
+    fn = lambda s: s.components["GENROU"]._values[0]["fn"]   # noqa: E731
+    assert fn(s50) == 50.0 and fn(s60) == 60.0
+    assert any("60 Hz (basfrq), not the file's BASFRQ = 50 Hz" in n for n in s60.import_notes)
+    assert not any("basfrq" in n for n in s50.import_notes)
+    with pytest.raises(DataError) as e:
+        from_psse(raw, dyr, basfrq=0.0)
+    assert e.value.field == "basfrq"

@@ -3,9 +3,10 @@
 Read with the native PSS/E reader (:func:`weakgrid.sim.io.psse.from_psse`) and faulted: a
 three-phase fault at CORONADO 500 kV (bus 1101, where PSID's tutorial on this case trips a
 line) for 3 cycles. Oracles: the initial point is an equilibrium (every derivative 0 at t = 0),
-and the grid rides through a cleared fault (no failure, speeds back near nominal). The test
-skips, naming them, while the reader or the PSS/E records of the models the case uses are not
-in the library.
+and the grid rides through a cleared fault (no failure, speeds back near nominal). The case
+holds its operating point since the units sharing a bus (39 of its 55 generator buses) keep
+their own solved QG of the .raw, as PSS/E initializes them: with an equal share of each bus's Q
+a SEXS needed a field voltage above its EMAX and setup refused the case.
 
 No ANDES result beside it: ANDES 2.0 reads the same two files (109 GENROU, 109 SEXS, 47 GAST,
 37 TGOV1, 25 HYGOV, 10 IEEEST, 37 REGCA1 + REECB1 + REPCA1) and solves the power flow, but its
@@ -50,6 +51,31 @@ def test_every_model_of_the_dyr_has_a_registry_class():
     assert not missing, f"weakgrid lacks {missing}"
 
 
+def test_units_sharing_a_bus_start_within_their_limits():
+    """39 of the case's 55 generator buses hold several units. Each starts from its own solved QG
+    of the .raw (PSS/E's split): every exciter then starts inside its limits. With an equal share
+    of the bus's Q the SEXS of unit (3135, 'NG') would need 3.206 pu > EMAX = 3.0 (setup refused
+    it, naming EMAX)."""
+    from weakgrid.sim.io import psse
+
+    system, _ = psse.from_psse(RAW, DYR)
+    system.setup()
+    sexs = system.components["SEXS"]
+    k = sexs.names.index("SEXS_3135_NG")
+    vf0 = system.sig_defaults["vf0"][system.machine_number(sexs.links[k]["machine"])]
+    assert sexs.p["EMIN"][k] < vf0 < sexs.p["EMAX"][k]          # 1.37 pu
+    row = system.psse_gen_row[(3135, "NG")]
+    assert system.network.pf.Qg[row] * system.Sb == pytest.approx(system.network.gen[row, 2], abs=0.5)
+    # an equal share of each bus's Q: that SEXS needs 3.206 pu, above its EMAX
+    from weakgrid.sim.errors import DataError
+
+    equal, _ = psse.from_psse(RAW, DYR)
+    equal.network.gen_split = "equal"
+    with pytest.raises(DataError, match="SEXS_3135_NG") as e:
+        equal.setup()
+    assert e.value.field == "EMAX"
+
+
 @pytest.mark.slow
 def test_wecc240_imports_and_rides_through_a_three_phase_fault():
     from weakgrid.sim.io import psse
@@ -61,20 +87,9 @@ def test_wecc240_imports_and_rides_through_a_three_phase_fault():
     models = dyr_models()
     lacking = sorted(m for m in models if getattr(reg.get(m), "psse_record", None) is None)
     assert not lacking, f"models of the case without a PSS/E record layout: {lacking}"
-    from weakgrid.sim.errors import DataError
-
     system, events = psse.from_psse(RAW, DYR)      # every one of the 448 records is read
     assert events == []
-    try:
-        system.setup()
-    except DataError as e:
-        # measured 2026-12-01: the case's own data cannot hold its operating point — SEXS
-        # exciters (e.g. at bus 3135, id 'NG') need a field voltage above their EMAX (3.206 >
-        # 3.0 pu); clamped (limits="warn"), the machine behind it is not in equilibrium
-        # (GENROU_5032_R.e1q). PSS/E reports such units as "initial conditions suspect" and
-        # runs; weakgrid refuses, naming the device and the field. Known gap of issue 26.
-        assert e.field in ("EMAX", "EMIN", "derivative"), e
-        pytest.xfail(f"the case's data do not hold its operating point: {e}")
+    system.setup()
     F, _ = system.residual(0.0, system.z0)
     k = int(np.argmax(np.abs(F)))
     assert abs(F[k]) < 1e-6, f"not an equilibrium at t = 0: {system.var_name(k)} = {F[k]:.3g}"

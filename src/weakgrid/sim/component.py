@@ -114,6 +114,13 @@ class Component:
     psse_record: tuple[str, ...] | None = None
     #: how many of the last fields of :attr:`psse_record` may be missing (defaults apply)
     psse_record_optional: int = 0
+    #: the model injects current and can be disconnected by a generator trip
+    #: (:class:`~weakgrid.sim.events.GeneratorTrip`): its injection goes through :meth:`connected`
+    disconnectable: bool = False
+    #: outputs that record zero once an instance is disconnected (its power and currents)
+    injection_outputs: tuple[str, ...] = ()
+    #: per instance 1.0 (connected) or 0.0 (disconnected by a generator trip); None: all connected
+    live: np.ndarray | None = None
 
     @classmethod
     def psse_params(cls, values: dict, ctx) -> dict:
@@ -191,6 +198,11 @@ class Component:
     def setup(self, system):
         """Build parameter arrays (system base). Subclasses extend with link resolution."""
         self.p = {p.name: np.array([v[p.name] for v in self._values], dtype=float) for p in self.params}
+
+    def connected(self, I):
+        """The currents ``I`` (last axis: instances) with those of disconnected instances
+        removed (:mod:`weakgrid.sim.disconnect`)."""
+        return I if self.live is None else I * self.live
 
     def resolve_gen_rows(self, system):
         """Set ``self.gen`` (the 0-based gen-table row of each instance's ``gen`` link) and

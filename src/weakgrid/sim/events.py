@@ -1,4 +1,4 @@
-"""Timed events: three-phase bus faults, branch trips and load steps.
+"""Timed events: three-phase bus faults, branch trips, generator trips and load steps.
 
 Events are applied exactly at their time: the integrator steps onto ``t``,
 calls :meth:`Event.apply`, and re-solves the network with the states fixed.
@@ -106,6 +106,37 @@ class LineTrip(Event):
 
     def __repr__(self):
         return f"LineTrip(branch={self.branch}, t={self.t}, close={self.close})"
+
+
+class GeneratorTrip(Event):
+    """Disconnect the unit on gen-table row ``gen`` (0-based) at ``t`` [s]: PSS/E's machine
+    trip, PSID's ``GeneratorTrip``.
+
+    The unit is the machine or converter on that row (all models sharing it) with its controls
+    (exciter, governor, stabilizer, REECA1/REECB1, REPCA1, ...): from ``t`` on it injects no
+    current, its states are frozen and its power outputs record zero
+    (:mod:`weakgrid.sim.disconnect`). The network itself is unchanged (the row's bus stays).
+    A PSS/E unit (bus, id) is row ``system.psse_gen_row[(bus, id)]`` of a system read by
+    :func:`weakgrid.sim.io.psse.from_psse`.
+    """
+
+    def __init__(self, gen, t):
+        self.gen, self.t = gen, float(t)
+
+    def validate(self, system):
+        Event.validate(self, system)
+        ng = system.network.gen.shape[0]
+        if not isinstance(self.gen, (int, np.integer)) or not 0 <= self.gen < ng:
+            raise DataError(repr(self), "gen", self.gen, f"give a gen-table row 0..{ng - 1}")
+        from .disconnect import unit_instances
+
+        unit_instances(system, int(self.gen))   # a row without models, or with a source: refused now
+
+    def apply(self, sim):
+        sim.sys.disconnect_unit(int(self.gen))
+
+    def __repr__(self):
+        return f"GeneratorTrip(gen={self.gen}, t={self.t})"
 
 
 class LoadStep(Event):

@@ -65,6 +65,11 @@ class Network:
         A negative series resistance (legal in PSS/E and MATPOWER network equivalents,
         e.g. case9241pegase, ACTIVSg10k) enters the admittance matrix as given, so the power
         flow and the time domain see the same branch.
+        ``gen_split`` says how several in-service generators of one bus share the bus's solved
+        reactive power (and, at the slack bus, its active power): ``"equal"`` (default), or
+        ``"case"`` — each keeps its own ``QG`` (``PG``) of the case and the difference between
+        the solved total and their sum is shared equally (a solved PSS/E case: the split PSS/E
+        initializes its machines from).
     f_hz : float
         Nominal frequency [Hz].
 
@@ -85,6 +90,9 @@ class Network:
         self.case = copy.deepcopy({k: case[k] for k in ("baseMVA", "bus", "gen", "branch")})
         # branches with a negative series reactance on purpose (series capacitors)
         self.series_capacitors = {int(k) for k in case.get("series_capacitors", ())}
+        self.gen_split = case.get("gen_split", "equal")
+        if self.gen_split not in ("equal", "case"):
+            raise DataError("case", "gen_split", self.gen_split, 'use "equal" or "case"')
         self.Sb = float(self.case["baseMVA"])
         if not self.Sb > 0:
             raise DataError("case", "baseMVA", self.Sb, "must be > 0 MVA")
@@ -357,6 +365,15 @@ class Network:
                             "it with an in-service branch, add a slack bus to its island, or "
                             "set BUS_TYPE = 4 (isolated)")
 
+    def _split(self, total, stored):
+        """Share ``total`` [pu] among the generators of one bus, whose case values are
+        ``stored`` [MW or Mvar] (see ``gen_split``)."""
+        n = len(stored)
+        if self.gen_split == "equal" or n == 1:
+            return np.full(n, total / n)
+        own = np.asarray(stored, dtype=float) / self.Sb
+        return own + (total - own.sum()) / n
+
     def _finish_pf(self, V, check_tol):
         Y = self.ybus_sparse()
         Sinj = V * np.conj(Y @ V)
@@ -376,11 +393,11 @@ class Network:
                 mismatch = max(mismatch, abs(Sgen_bus[i]))
                 continue
             if btype[i] == 3:
-                Pg[g] = Sgen_bus[i].real / len(g)
+                Pg[g] = self._split(Sgen_bus[i].real, gen[g, PG])
             else:
                 Pg[g] = gen[g, PG] / self.Sb
                 mismatch = max(mismatch, abs(Sgen_bus[i].real - Pg[g].sum()))
-            Qg[g] = Sgen_bus[i].imag / len(g)
+            Qg[g] = self._split(Sgen_bus[i].imag, gen[g, QG])
         if not np.all(np.isfinite(V)) or mismatch > check_tol:
             raise PowerFlowError(f"power flow solution has a bus mismatch of {mismatch:.3g} pu "
                                  f"(> {check_tol:g}). Fix: check branch data and loading; "

@@ -133,6 +133,7 @@ class System:
         self._machines: list[tuple[str, str]] = []   # (type, name) in machine-number order
         self._machine_num: dict[str, int] = {}
         self.is_setup = False
+        self.disconnected = None
 
     # ---------------------------------------------------------------- building
     def _component(self, type_name: str, kind: str | None = None) -> Component:
@@ -309,7 +310,9 @@ class System:
         self._sig_keys = SIGNALS
         self._sig_stack = np.zeros((len(SIGNALS), nm))
         self.sig_defaults = dict(zip(SIGNALS, self._sig_stack))
+        self.disconnected = None   # units a GeneratorTrip disconnected (weakgrid.sim.disconnect)
         for c in self.comps:
+            c.live = None
             c.setup(self)
         # one dynamic model per static generator, or several that share it (gammap, gammaq)
         shares = {}
@@ -566,7 +569,20 @@ class System:
             c.compute(ctx)
         for c in self.comps:
             c.finish(ctx)
+        if self.disconnected is not None:
+            self.disconnected.apply(ctx)
         return ctx
+
+    def disconnect_unit(self, gen) -> list[str]:
+        """Disconnect the unit on gen-table row ``gen`` (0-based) from now on: its machine or
+        converter and their controls (:mod:`weakgrid.sim.disconnect`). Returns their names."""
+        from .disconnect import Disconnected, unit_instances
+
+        inst = unit_instances(self, gen)
+        if self.disconnected is None:
+            self.disconnected = Disconnected()
+        self.disconnected.add(inst)
+        return [c.names[i] for c, i in inst]
 
     def device_residual(self, t, z):
         ctx = self.evaluate(t, z)

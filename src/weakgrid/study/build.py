@@ -394,7 +394,7 @@ def _psse_network(study, g, up):
     if ins:     # a new bus and series branch (pu on the system base), appended to the tables
         case, k_up, _, _ = insert_upqc_matpower(net.case, k_ref, ins["side"], ins.get("r", 0.0), ins["x"])
         case.update(series_capacitors=sorted(net.series_capacitors),
-                    negative_resistance=sorted(net.negative_resistance))
+                    negative_resistance=sorted(net.negative_resistance), gen_split=net.gen_split)
         system.network = Network(case, f_hz=net.f_hz)
         names[up["name"]] = k_up
         return system.network, bus_id, names, k_up, system

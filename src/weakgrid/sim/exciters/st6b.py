@@ -33,7 +33,11 @@ Difference from PowerSimulationsDynamics.jl (PSID, read for structure, BSD-3): P
 times the field current (with a warning) when the limiter would be active — its PSS/E benchmark
 record ``ThreeBus_ST6B.dyr`` (``ILR = 2.15``, ``KCI = 1.0577``, ``KLR = 17.33``) has the limiter
 active at its operating point (``KLR*(KCI*ILR - XadIfd) = 2.096 < VR = 2.111``); weakgrid refuses
-it unedited (naming ``ILR``) rather than change the data.
+it unedited (naming ``ILR``) rather than change the data. The limiter's form is IEEE 421.5's (and
+Dynawo's ``BaseSt6``: ``KLR*(ILR*KCL - Ifd)``, low-limited at VRMIN), and the field current is
+PSS/E's own: the same GENROU at the same operating point (PSID's SEXS benchmark, same ``.raw``)
+starts at PSS/E's Efd = XadIfd = 2.15312 pu, weakgrid's 2.153116 — so in PSS/E too the limiter
+binds from t = 0 (it needs ILR >= 2.15082 pu; the file has 2.15, IEEE's typical value is 4.164).
 """
 
 from __future__ import annotations

@@ -87,6 +87,7 @@ ANDES_CONVENTIONS = {
     "IEEEX1": {"VR_Vt": 0.0},     # regulator limits VRMAX, VRMIN, not times Vt
     "EXST1": {"VR_limited": 0.0},  # output limit tested on the rate feedback (in effect never acts)
     "IEEEVC": {"on_Sb": 1.0},     # rc, xc on the system base (its IEEEVC has no Sn)
+    "IEEEST": {"F2_bypass": 1.0},  # (1 + A5 s + A6 s^2)/(1 + A3 s + A4 s^2) bypassed when A4 = 0
     # unit-gain gate integrator (Tr unused); flow, gate and Dt on the system base; rate bounds -x1/r
     "HYGOV": {"Tr_used": 0.0, "Tw_sysbase": 1.0, "Dt_sysbase": 1.0, "VELM_offset": 1.0},
     "ESST4B": {"PI_nonwindup": 0.0},   # PI regulators with tracking anti-windup (Ks = 2)

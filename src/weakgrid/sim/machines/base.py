@@ -56,6 +56,8 @@ class SyncMachine(Component):
     kind = "machine"
     order = 0
     gen_shared = True        # with converters or other machines, by the shares gammap, gammaq
+    disconnectable = True    # a generator trip removes its current (inject)
+    injection_outputs = ("Pe", "Qe", "te", "Id", "Iq")
     units = {"delta": "angle", "omega": "speed", "Pe": "power", "Qe": "power", "te": "power",
              "tm": "power", "Id": "current", "Iq": "current"}
 
@@ -100,7 +102,7 @@ class SyncMachine(Component):
 
     def inject(self, ctx, I):
         """Add the machines' network currents ``I`` to ``ctx.I`` (accumulating on shared buses)."""
-        scatter_add(ctx.I, self._bi, I, self._uniq)
+        scatter_add(ctx.I, self._bi, self.connected(I), self._uniq)
 
     def publish(self, ctx, omega, delta, Pe, Qe, V, XadIfd):
         m = self._mi

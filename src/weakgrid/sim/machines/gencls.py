@@ -8,6 +8,15 @@ Equations (system base, ANDES ``GENCLS`` with ``Flux0``)::
     te = (vq + ra*Iq)*Iq + (vd + ra*Id)*Id
     shaft: see :mod:`weakgrid.sim.machines.shaft`
 
+PSS/E's GENCLS (``psse_shaft = 1``, set by the PSS/E reader): the electrical torque is the air-gap
+power over the speed, ``te/omega`` (the constant EMF E' is not scaled by the speed, unlike the
+sub-transient EMF of PSS/E's GENROU family), so the shaft is
+``M dw/dt = (Pm - D dw)/omega - te/omega``: its speed damping is ``D`` alone, as PSS/E's
+results show (PSID's OMIB benchmark, ``Test01``: the rotor-angle oscillation decays at
+-0.159 1/s in PSS/E, -0.159 1/s here; with ``te`` undivided it decays at -0.199 1/s, the extra
+``Pm/omega`` damping, and is 4.9 % of PSS/E's swing off) and as OpenIPSL's PSS/E GENCLS
+(``(P0 - P - D dw)/2H``, verified against PSS/E) has it.
+
 ``vf`` is held at its initial value unless an exciter is attached.
 """
 
@@ -101,7 +110,10 @@ class GENCLS(SyncMachine):
         omega = ctx.x[..., self._sls[1]]
         tm = ctx.sig["tm"][..., self.m]
         ctx.out["GENCLS.vf"] = ctx.sig["vf"][..., self.m]
-        d_delta, d_omega = swing(omega, tm, self._te, self.p["M"], self.p["D"], self.wb,
+        te = self._te
+        if self._psse_shaft is not None:   # PSS/E: the air-gap power over the speed (docstring)
+            te = np.where(self._psse_shaft, te / omega, te)
+        d_delta, d_omega = swing(omega, tm, te, self.p["M"], self.p["D"], self.wb,
                                  self._psse_shaft)
         ctx.f[..., self._sls[0]] = d_delta
         ctx.f[..., self._sls[1]] = d_omega

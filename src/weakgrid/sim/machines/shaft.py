@@ -20,6 +20,8 @@ the mechanical input as *power* ``Pm``: the mechanical torque is ``(Pm - D dw)/o
 Both forms agree at rated speed (same initial point); they differ by :math:`\sim P_m\,\Delta\omega`
 in a swing. On PSID's PSS/E benchmark (line trip, 20 s; GENROU, GENROE, GENSAL, GENSAE)
 ANDES's form leaves 0.5–1.4 % of PSS/E's rotor-angle swing, PSS/E's 0.05–0.13 %.
+PSS/E's GENCLS passes ``te/omega`` (its air-gap power over the speed; see
+:mod:`weakgrid.sim.machines.gencls`): its swing is damped by ``D`` alone, as PSS/E's OMIB results show.
 """
 
 from __future__ import annotations

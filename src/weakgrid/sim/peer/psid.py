@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError
-from ..events import Event, LineTrip
+from ..events import Event, GeneratorTrip, LineTrip
 from ..network import BR_B, BR_R, BR_X, F_BUS, PD, QD, T_BUS
 
 #: folder of the vendored PSID cases in a source checkout (``tests/data/psid``); an installed
@@ -65,6 +65,7 @@ def load_cases(path=None) -> list[dict]:
     for c in cases:
         c.setdefault("run", True)
         c.setdefault("compare", [])
+        c.setdefault("results_from", "PSS/E")   # whose simulation the CSV holds (PSID's DEGOV: PowerWorld)
         c.setdefault("root", str(path.parent))
     return cases
 
@@ -163,6 +164,19 @@ class Names:
                             f"expected one machine of PSS/E bus {bus} id '{gid}' among {names}")
         return hits[0]
 
+    def gen_row(self, bus, gid) -> int:
+        """0-based gen-table row of PSS/E unit (bus, id) (weakgrid's PSS/E reader only)."""
+        if self.ss is not None:
+            raise Unsupported(f"unit ({bus}, '{gid}'): the ANDES route's names carry no PSS/E id")
+        table = getattr(self.sys, "psse_gen_row", None)
+        gid = _strip_id(gid)
+        hits = [r for (b, i), r in (table or {}).items() if int(b) == int(bus) and _strip_id(i) == gid]
+        if len(hits) != 1:
+            raise DataError(f"unit ({bus}, '{gid}')", "gen row", hits,
+                            f"expected one generator of PSS/E bus {bus} id '{gid}' in the reader's "
+                            f"psse_gen_row {sorted(table or {})}")
+        return int(hits[0])
+
     def component(self, kind, bus, gid):
         """(component, position) of the ``kind`` control ("exciter", ...) of machine (bus, id)."""
         m = self.machine(bus, gid)
@@ -247,6 +261,8 @@ def weakgrid_events(case, system, names):
     kind = ev["kind"]
     if kind == "branch trip":
         return [LineTrip(int(r), ev["t"]) for r in names.branch_rows(ev["from_bus"], ev["to_bus"], ev["ckt"])]
+    if kind == "gen trip":
+        return [GeneratorTrip(names.gen_row(ev["bus"], ev["id"]), ev["t"])]
     if kind == "source change" and ev.get("signal") == "vref":
         comp, k = names.component(ev["model"], ev["bus"], ev["id"])
         return [ReferenceChange(comp, k, ev["t"], ev["value"])]
@@ -283,11 +299,13 @@ def convert_loads(system, kind):
 
 # ------------------------------------------------------------------------------ weakgrid
 def read_psse(case, root=None):
-    """``from_psse(raw, dyr)`` of the entry's files, exactly as shipped: ``(system, events)``."""
+    """``from_psse(raw, dyr)`` of the entry's files, exactly as shipped: ``(system, events)``; an
+    entry's ``basfrq`` [Hz] is the frequency PSS/E's results were computed at, where it differs
+    from the file's BASFRQ (``from_psse(..., basfrq=)``, PSS/E's ``base_frequency`` setting)."""
     from ..io.psse import from_psse
 
     dyr = case_file(case, "dyr", root) if case.get("dyr") else None
-    return from_psse(case_file(case, "raw", root), dyr)
+    return from_psse(case_file(case, "raw", root), dyr, basfrq=case.get("basfrq"))
 
 
 def build_weakgrid(case, root=None, route="psse"):

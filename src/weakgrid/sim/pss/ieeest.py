@@ -1,14 +1,24 @@
 """IEEEST: IEEE standard PSS (PSS/E IEEEST; input modes 1, 3, 4, 5).
 
-Block diagram::
+Block diagram (PSS/E's Model Library; IEEE 421.5 PSS1A's filter)::
 
-    sig --[1/(1 + A1 s + A2 s^2)]--[(1 + A5 s + A6 s^2)/(1 + A3 s + A4 s^2)]
+    sig --[(1 + A5 s + A6 s^2) / ((1 + A1 s + A2 s^2)(1 + A3 s + A4 s^2))]
         --[(1+sT1)/(1+sT2)]--[(1+sT3)/(1+sT4)]--[KS]--[sT5/(1+sT6)]--> clip(LSMIN, LSMAX) = vs
 
 Input ``sig`` by ``MODE``: 1 speed deviation ``omega - 1`` [pu]; 3 electrical
 power on the machine base [pu]; 4 accelerating power ``tm - tm0`` [pu, system
 base]; 5 terminal voltage [pu]. The output is added to the exciter's summing
 junction. The output is cut (set to 0) when the terminal voltage leaves ``[VCL, VCU]``.
+
+The filter is one transfer function: its numerator is realized over whichever denominator
+factor has at least its order (``(A3, A4)`` first, else ``(A1, A2)``, else their product when
+both are first order), the other factor is a plain second-order lag. So PSS/E's usual data
+``A1 = 1.013, A2 = 0.013, A3 = A4 = 0, A5 = 1.013, A6 = 0.113`` (PSID's MultiGen and IEEEST
+benchmarks, the WECC 240-bus case) filter as ``(1 + A5 s + A6 s^2)/(1 + A1 s + A2 s^2)``, as PSS/E
+and PowerSimulationsDynamics.jl compute it. ANDES 2.0 pairs the numerator with ``(A3, A4)`` only
+and bypasses that factor when ``A4 = 0`` (numerator dropped); ``F2_bypass = 1`` reproduces it
+(``from_andes(..., conventions="andes")``). A numerator of higher order than the whole
+denominator (improper) is refused naming A5/A6.
 
 Zero-parameter conventions (as PSS/E and ANDES): ``VCU = 0`` / ``VCL = 0`` means no
 upper / lower cut-off; ``T5 = 0`` turns the washout ``sT5/(1+sT6)`` into the lag
@@ -63,6 +73,8 @@ class IEEEST(MachineControl):
         Param("LSMIN", -0.3, "pu", "output lower limit", ""),
         Param("VCU", 999.0, "pu", "voltage cutoff upper", ""),
         Param("VCL", -999.0, "pu", "voltage cutoff lower", ""),
+        Param("F2_bypass", 0.0, "-", "1: ANDES 2.0's filter, (1 + A5 s + A6 s^2)/(1 + A3 s + A4 s^2) "
+              "bypassed when A4 = 0; 0: PSS/E's (the numerator over the whole denominator)", "flag"),
     )
     states = ("F1a", "F1b", "F2a", "F2b", "LL1", "LL2", "WO")
     outputs = ("sig", "vss")
@@ -85,9 +97,37 @@ class IEEEST(MachineControl):
         # one input mode for all instances (the usual case): that signal alone, no select
         self._mode = int(p["MODE"][0]) if np.all(p["MODE"] == p["MODE"][0]) else None
         self._pe_scale = system.Sb / self.Sn   # Pe on the machine base (MODE 3)
-        self._filt1 = bool(np.any((p["A1"] > 0) | (p["A2"] > 0)))
-        self._filt2 = bool(np.any((p["A3"] > 0) | (p["A4"] > 0)))
+        self._pair_filter()
+        self._filt1 = bool(np.any((self._lp[0] > 0) | (self._lp[1] > 0)))
+        self._filt2 = bool(np.any((self._ll[0] > 0) | (self._ll[1] > 0)))
         self._no_cut = bool(np.all(self.VCL <= -999.0) and np.all(self.VCU >= 999.0))
+
+    def _pair_filter(self):
+        """Split the filter into a lag ``1/(1 + a1 s + a2 s^2)`` (``self._lp``) and a lead-lag
+        ``(1 + A5 s + A6 s^2)/(1 + b1 s + b2 s^2)`` (``self._ll``, ``self._num``) whose
+        denominator has at least the numerator's order (see the module docstring)."""
+        p = self.p
+        A1, A2, A3, A4, A5, A6 = (p[k].copy() for k in ("A1", "A2", "A3", "A4", "A5", "A6"))
+        andes = (p["F2_bypass"] > 0) & (A4 <= 0)     # ANDES 2.0: the second factor bypassed
+        A3[andes] = A5[andes] = A6[andes] = 0.0
+
+        def order(a, b):
+            return np.where(b > 0, 2, np.where(a > 0, 1, 0))
+
+        n, o12, o34 = order(A5, A6), order(A1, A2), order(A3, A4)
+        on34 = o34 >= n
+        on12 = ~on34 & (o12 >= n)
+        both = ~on34 & ~on12 & (o12 + o34 >= n)       # two first-order factors, A6 > 0
+        for i in np.nonzero(~(on34 | on12 | both))[0]:
+            raise DataError(self.element(i), "A6" if A6[i] > 0 else "A5", float(A6[i] or A5[i]),
+                            "the filter (1 + A5 s + A6 s^2)/((1 + A1 s + A2 s^2)(1 + A3 s + A4 s^2)) "
+                            "has a numerator of higher order than its denominator: set A5/A6 to 0 "
+                            "or give the denominator (A1..A4) at least that order")
+        b1 = np.where(on34, A3, np.where(on12, A1, A1 + A3))
+        b2 = np.where(on34, A4, np.where(on12, A2, A1 * A3))
+        a1 = np.where(on34, A1, np.where(on12, A3, 0.0))
+        a2 = np.where(on34, A2, np.where(on12, A4, 0.0))
+        self._lp, self._ll, self._num = (a1, a2), (b1, b2), (A5, A6)
 
     def _signal(self, ctx):
         p = self.p
@@ -140,16 +180,17 @@ class IEEEST(MachineControl):
         sl = self._sls
         u = self._signal(ctx)
         if self._filt1:
-            y1, f[..., sl[0]], f[..., sl[1]] = self._second_order(x[..., sl[0]], x[..., sl[1]], u, p["A1"], p["A2"])
-        else:   # no filter: output = input, derivatives 0
+            y1, f[..., sl[0]], f[..., sl[1]] = self._second_order(x[..., sl[0]], x[..., sl[1]], u, *self._lp)
+        else:   # no lag: output = input, derivatives 0
             y1 = u
         if self._filt2:
-            # (1 + A5 s + A6 s^2)/(1 + A3 s + A4 s^2): w = y1/(den), output = w + A5 w' + A6 w''
-            w, f[..., sl[2]], f[..., sl[3]] = self._second_order(x[..., sl[2]], x[..., sl[3]], y1, p["A3"], p["A4"])
-            has = (p["A3"] > 0) | (p["A4"] > 0)
-            wdot = np.where(p["A4"] > 0, x[..., sl[3]], np.where(p["A3"] > 0, f[..., sl[2]], 0.0))
-            wdd = np.where(p["A4"] > 0, f[..., sl[3]], 0.0)
-            y2 = np.where(has, w + p["A5"] * wdot + p["A6"] * wdd, y1)
+            # (1 + A5 s + A6 s^2)/(1 + b1 s + b2 s^2): w = y1/(den), output = w + A5 w' + A6 w''
+            b1, b2 = self._ll
+            A5, A6 = self._num
+            w, f[..., sl[2]], f[..., sl[3]] = self._second_order(x[..., sl[2]], x[..., sl[3]], y1, b1, b2)
+            wdot = np.where(b2 > 0, x[..., sl[3]], np.where(b1 > 0, f[..., sl[2]], 0.0))
+            wdd = np.where(b2 > 0, f[..., sl[3]], 0.0)
+            y2 = w + A5 * wdot + A6 * wdd
         else:
             y2 = y1
         x4, x5, x6 = x[..., sl[4]], x[..., sl[5]], x[..., sl[6]]

@@ -84,6 +84,8 @@ class PVD1(Component):
     )
     states = ("L", "WO", "Ipout", "Iqout")
     outputs = ("fHz", "R", "Ipul", "Ipcmd", "Iqcmd", "Pe", "Qe")
+    disconnectable = True    # a generator trip removes its current (compute)
+    injection_outputs = ("Pe", "Qe")
     units = {"Pe": "power", "Qe": "power"}
 
     @classmethod
@@ -209,7 +211,7 @@ class PVD1(Component):
         fHz = self.p["fn"] * (1.0 + df)
         ipcmd, iqcmd, R, _, ipul = self._commands(v, V, fHz, ipout, iqout, self._ip_gates(x))
         vs = np.where(v > 1e-6, v, 1e-6)
-        scatter_add(ctx.I, self.bus, (ipout - 1j * iqout) * V / vs, self._uniq)
+        scatter_add(ctx.I, self.bus, self.connected((ipout - 1j * iqout) * V / vs), self._uniq)
         f = ctx.f
         f[..., sl[0]] = err / self.Lb._Ts
         f[..., sl[1]] = self.WOb.deriv(wo, L)

@@ -119,6 +119,8 @@ class REGCA1(Component):
         return {"gen": int(ctx.gen_row)}
     states = ("S0", "S1", "S2")
     outputs = ("Ipout", "Iqout", "Pe", "Qe", "LVG", "LVPL", "Ipcmd", "Iqcmd")
+    disconnectable = True    # a generator trip removes its current (compute)
+    injection_outputs = ("Ipout", "Iqout", "Pe", "Qe")
     units = {"Pe": "power", "Qe": "power"}
 
     @classmethod
@@ -237,7 +239,7 @@ class REGCA1(Component):
         iqout = np.clip(s1 - hvg, p["Iolim"], 9999.0)
         vs = np.where(v > 1e-6, v, 1e-6)
         I = (ipout - 1j * iqout) * V / vs
-        scatter_add(ctx.I, self.bus, I, self._uniq)
+        scatter_add(ctx.I, self.bus, self.connected(I), self._uniq)
         # commands: constant unless an electrical control (REECA1) publishes them
         shape = x.shape[:-1] + (self.n,)
         ctx.sig["REGCA1.Ipcmd"] = np.broadcast_to(self.Ipcmd0, shape).copy()

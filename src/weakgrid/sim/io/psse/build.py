@@ -136,7 +136,8 @@ def _current_loads(system, maps, notes):
             **dict(zip(("kpp", "kpi", "kpz", "kqp", "kqi", "kqz"), shares)))
 
 
-def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = "ideal"):
+def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = "ideal",
+              basfrq: float | None = None):
     """Build a weakgrid :class:`System` from a PSS/E ``.raw`` file and, optionally, a ``.dyr`` file.
 
     Parameters
@@ -155,6 +156,11 @@ def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = 
         ANDES does (the swing bus's as an :class:`~weakgrid.sim.sources.InfiniteBus`, the others
         as :class:`~weakgrid.sim.sources.PVSource`; noted), ``"refuse"`` raises
         :class:`DataError` naming them.
+    basfrq : float, optional
+        The base frequency of the simulation [Hz], in place of the ``.raw``'s ``BASFRQ`` (PSS/E:
+        ``psspy.base_frequency``, a setting of the run; noted). For results computed at another
+        frequency than the file states, e.g. PSID's STAB1 benchmark: its ``.raw`` says 50 Hz,
+        PSS/E's results are at 60 Hz (PowerSimulationsDynamics.jl reads it at 60 Hz too).
 
     Returns
     -------
@@ -176,6 +182,14 @@ def from_psse(raw, dyr=None, *, include_events: bool = True, static_gens: str = 
                         "use 'ideal' (simulate them as ANDES does) or 'refuse'")
     rc = read_raw(raw)
     rname = Path(rc.path).name
+    if basfrq is not None:
+        if not (isinstance(basfrq, (int, float)) and basfrq > 0):
+            raise DataError("from_psse", "basfrq", basfrq, "give the base frequency in Hz (> 0), or None "
+                            "for the .raw's BASFRQ")
+        if float(basfrq) != rc.basfrq:
+            rc.notes.append(f"{rname}: base frequency {float(basfrq):g} Hz (basfrq), not the file's "
+                            f"BASFRQ = {rc.basfrq:g} Hz")
+        rc.basfrq = float(basfrq)
     bad = [f"{sec} {label} (line {ln})" for sec, items in rc.unsupported.items()
            for ln, on, label in items if on]
     if bad:

@@ -16,7 +16,10 @@ Buses keep their PSS/E numbers. Conversions (all to per unit on ``SBASE`` at the
   its branch is switched (noted when non-zero).
 * **generators**: rows of the gen table (``MBASE``, ``PT``/``PB``, ``QT``/``QB``); the voltage set
   point is the *solved* voltage ``VM`` of the bus (equal to ``VS`` unless the machine regulated a
-  remote bus or sat at a reactive limit in the solved case: noted).
+  remote bus or sat at a reactive limit in the solved case: noted). Generators sharing a bus keep
+  their own solved ``QG`` (and ``PG`` at the swing bus) of the file, as PSS/E initializes its
+  machines (``gen_split = "case"`` of the network; only the difference between the re-solved
+  total and their sum is shared equally), not an equal share.
 * **two-winding transformers**: PSS/E's model ``bus I — t1:1 — Z — 1:t2 — bus J`` (``t1``, ``t2``
   the winding ratios in pu of the bus base voltages from ``CW``; ``Z`` on ``SBASE`` from ``CZ``) is
   MATPOWER's branch with ``TAP = t1/t2``, ``SHIFT = ANG1`` and series impedance ``Z·t2²``.
@@ -323,5 +326,7 @@ def build_case(raw: RawCase):
         raise DataError(f"{fname}", "IDE", "no 3", "the case has no swing bus (IDE = 3)")
     case = {"baseMVA": Sb, "bus": B, "gen": np.array(G, dtype=float).reshape(-1, 10),
             "branch": np.array(L, dtype=float).reshape(-1, 13),
-            "series_capacitors": series_caps, "negative_resistance": neg_r}
+            "series_capacitors": series_caps, "negative_resistance": neg_r,
+            # generators sharing a bus keep their own solved PG (swing bus) and QG: PSS/E's split
+            "gen_split": "case"}
     return case, maps
