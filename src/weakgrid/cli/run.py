@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import HelpFormatter, add_cluster_arguments, check_cluster, output_folder
+from ._common import (HelpFormatter, add_cluster_arguments, add_force_argument, check_cluster,
+                      output_folder)
 
 NAME = "run"
 
@@ -25,6 +26,7 @@ def add_parser(sub):
                    help="each scenario's quick settings (shorter runs, fewer controllers)")
     p.add_argument("--list", action="store_true", help="list the shipped studies")
     add_cluster_arguments(p)
+    add_force_argument(p, overwrite="files in the output folder", limits=False)
     p.set_defaults(func=run)
     return p
 
@@ -49,7 +51,7 @@ def run(args) -> int:
     check_cluster(args)
     out = args.output or Path(f"{st.name}-output")
     summary = run_studies([st], out, quick=args.quick, title=st.data["study"]["title"] or st.name,
-                          scheduler=args.scheduler, workers=args.workers)
+                          scheduler=args.scheduler, workers=args.workers, force=args.force)
     for d in summary["designs"]:
         print(f"  design {d['load']} {d['upqc']}: a = {d['a']}, V̄r = {d['Vr_bar']}, "
               f"ϕs0 = {d['phi_s0']}; modes {d['modes']}")

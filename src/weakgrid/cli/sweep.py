@@ -34,7 +34,7 @@ def add_parser(sub):
                    help="keep every run's signals (Parquet, in the cache folder)")
     p.add_argument("--maps", action="store_true", help="also draw the sweep's maps (PNG)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    add_force_argument(p)
+    add_force_argument(p, overwrite="files in the output folder")
     p.set_defaults(func=run)
     return p
 
@@ -58,7 +58,8 @@ def run(args) -> int:
     check_sweep(est, st, quick=args.quick, force=args.force)
     try:
         table = run_study_sweep(st, out, quick=args.quick, scheduler=args.scheduler,
-                                workers=args.workers, progress=not args.no_progress)
+                                workers=args.workers, progress=not args.no_progress,
+                                force=args.force, maps=args.maps)
     except SweepInterrupted as exc:
         print(f"weakgrid sweep: {exc}")
         return 130

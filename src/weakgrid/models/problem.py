@@ -42,7 +42,7 @@ from ..game import (
     paper_basis,
     solve_hji,
 )
-from ..fileio import safe_name
+from ..fileio import check_file_name, safe_name
 from ..game.bases import PolynomialBasis
 from ..game.errors import ShapeError
 from .design import UPQCDesignModel, gti_design_model, sg_design_model
@@ -338,7 +338,8 @@ def problem_from_dict(d: dict, source: str = "") -> TrainingProblem:
     s = {k: (_num(s, k, "solver") if k.startswith("tol") else _int(s, k, "solver")) for k in s}
     settings = SolverSettings(**s)
     # a name read from a file becomes part of output file names: keep it inside the folder
-    name = safe_name(d.get("preset", {}).get("name", Path(source).stem if source else "custom"),
-                     "custom")
+    pre = d.get("preset", {})
+    name = check_file_name(pre["name"], "preset.name") if isinstance(pre, dict) and "name" in pre \
+        else safe_name(Path(source).stem if source else "custom", "custom")
     return TrainingProblem(name, system, basis, cost, mesh, policy, settings,
                            d.get("published", {}), d, source)
