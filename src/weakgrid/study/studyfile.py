@@ -121,6 +121,10 @@ def _read(p) -> dict:
             return tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError("study", str(p), f"is not valid TOML ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise ParameterError("study", str(p), f"is not UTF-8 text (byte "
+                             f"{exc.object[exc.start:exc.start + 1]!r} at position {exc.start}): "
+                             "save the study file as UTF-8 TOML") from None
 
 
 def load_study(src) -> "Study":
