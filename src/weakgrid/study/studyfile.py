@@ -76,8 +76,13 @@ def get_path(d: dict, path: str):
     return obj
 
 
+_ONE_OF = {"duration": "t_off", "t_off": "duration"}   # a fault gives one of them
+
+
 def set_path(d: dict, path: str, value) -> dict:
-    """Set the value at dotted ``path`` (creating missing tables); returns ``d``."""
+    """Set the value at dotted ``path`` (creating missing tables); returns ``d``. Setting a
+    fault's ``duration`` replaces its ``t_off`` and setting ``t_off`` its ``duration`` (a
+    study file giving both is refused)."""
     keys = path.split(".")
     obj = d
     for i, key in enumerate(keys[:-1]):
@@ -89,6 +94,8 @@ def set_path(d: dict, path: str, value) -> dict:
         target = _step(obj, last, path)
         obj[obj.index(target)] = value
     elif isinstance(obj, dict):
+        if last in _ONE_OF:     # a fault's duration set later replaces its t_off (and back)
+            obj.pop(_ONE_OF[last], None)
         obj[last] = value
     else:
         raise ParameterError(".".join(keys[:-1]), obj, "is a value, not a table")
