@@ -82,11 +82,10 @@ class Manifest:
         """The existing files among ``paths`` that weakgrid did not write."""
         return [Path(p) for p in paths if Path(p).exists() and not self.owns(p)]
 
-    def claim(self, paths, force: bool = False) -> None:
-        """List ``paths`` as weakgrid's before writing them; refuse if one exists and is not
-        weakgrid's (unless ``force``)."""
+    def check(self, paths, force: bool = False) -> None:
+        """Refuse (naming the file and the fix) if one of ``paths`` exists and is not
+        weakgrid's, unless ``force``; writes nothing."""
         paths = list(paths)
-        rels = [self.rel(p) for p in paths]
         theirs = self.foreign(paths)
         if theirs and not force:
             more = f" (and {len(theirs) - 1} more: {', '.join(p.name for p in theirs[1:4])}" \
@@ -96,6 +95,13 @@ class Manifest:
                 f"{theirs[0]} is in the way: weakgrid wants to write that name but did not "
                 f"write the file there{more}; it is left alone. Fix: move it, give another "
                 f"output folder, or --force to overwrite it")
+
+    def claim(self, paths, force: bool = False) -> None:
+        """List ``paths`` as weakgrid's before writing them; refuse if one exists and is not
+        weakgrid's (unless ``force``), as :meth:`check`."""
+        paths = list(paths)
+        self.check(paths, force)
+        rels = [self.rel(p) for p in paths]
         new = set(rels) - self.files
         if new or not self.path.exists():
             self.files |= new

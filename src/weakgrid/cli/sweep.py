@@ -42,7 +42,7 @@ def add_parser(sub):
 def run(args) -> int:
     """Run ``weakgrid sweep`` with the parsed ``args``; return the exit status."""
     from ..study.studyfile import load_study
-    from ..study.sweep import run_study_sweep
+    from ..study.sweep import claim_sweep_outputs, run_study_sweep
     from ..study.sweep_estimate import check_sweep, estimate_sweep
     from ..sweep import SweepInterrupted
 
@@ -51,6 +51,8 @@ def run(args) -> int:
         st.data["sweep"]["signals"] = True
     check_cluster(args)
     out = args.output or Path(f"{st.name}-sweep")
+    if "sweep" in st.data:      # a file of the user's in the way: refused before any work
+        claim_sweep_outputs(st, out, args.quick, args.maps, args.force, write=False)
     # before anything is written: what the runs still to do will cost (refused beyond limits)
     est = estimate_sweep(st, out / "cache", quick=args.quick, workers=args.workers,
                          scheduler=args.scheduler)

@@ -38,7 +38,8 @@ from ..game.errors import ParameterError
 from ..sweep import Point, canonical_json, expand, run_sweep
 from .studyfile import get_path, set_path, study_from_dict
 
-__all__ = ["SWEEP_KEYS", "validate_sweep", "sweep_points", "run_point", "run_study_sweep"]
+__all__ = ["SWEEP_KEYS", "validate_sweep", "sweep_points", "run_point", "run_study_sweep",
+           "claim_sweep_outputs"]
 
 SWEEP_KEYS = {"axes", "mode", "scenarios", "controllers", "t_end", "design_load", "signals",
               "quick", "maps", "dt_check"}
@@ -286,6 +287,23 @@ def run_point(inputs: dict):
     return m
 
 
+def claim_sweep_outputs(study, output, quick=False, maps=False, force=False,
+                        write=True) -> Path:
+    """List the files a sweep writes into ``output`` (its table; the maps' files with
+    ``maps``) in the folder's manifest before anything is written; a file of another origin
+    in the way is refused unless ``force`` (:class:`weakgrid.manifest.Manifest`; ``write =
+    False``: only the check, nothing written). Returns the table's path."""
+    from ..manifest import Manifest
+
+    out = Path(output)
+    table_path = out / f"{study.name}-sweep{'-quick' if quick else ''}.parquet"
+    files = [table_path] + ([out / "maps" / f"map-{study.name}-{m.get('id', m['claim'])}.png"
+                             for m in study.data["sweep"].get("maps", [])] if maps else [])
+    m = Manifest(out)
+    (m.claim if write else m.check)(files, force=force)
+    return table_path
+
+
 def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
                     progress=True, log=None, cache_dir=None, force=False,
                     maps=False) -> pd.DataFrame:
@@ -297,14 +315,10 @@ def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
     in the way stops the sweep before any run unless ``force``
     (:class:`weakgrid.manifest.Manifest`).
     """
-    from ..manifest import Manifest
     from .sweep_estimate import run_cost
 
     out = Path(output)
-    table_path = out / f"{study.name}-sweep{'-quick' if quick else ''}.parquet"
-    files = [table_path] + ([out / "maps" / f"map-{study.name}-{m.get('id', m['claim'])}.png"
-                             for m in study.data["sweep"].get("maps", [])] if maps else [])
-    Manifest(out).claim(files, force=force)
+    table_path = claim_sweep_outputs(study, out, quick, maps, force)
     pts = sweep_points(study, quick)
     return run_sweep(pts, run_point, cache_dir=cache_dir or out / "cache", scheduler=scheduler,
                      workers=workers, progress=progress, log=log, cost=run_cost,
