@@ -69,7 +69,10 @@ class Manifest:
         """``path`` relative to the folder (POSIX form); it must lie inside the folder."""
         p = Path(path)
         try:
-            return p.relative_to(self.folder).as_posix()
+            rel = p.relative_to(self.folder)
+            if ".." in rel.parts:
+                raise ValueError(rel)
+            return rel.as_posix()
         except ValueError:
             raise _parameter_error()(self.option, str(p), f"lies outside the output folder "
                                      f"{self.folder}; weakgrid writes only there") from None

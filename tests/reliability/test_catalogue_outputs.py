@@ -189,7 +189,12 @@ def test_bad_input(case, ws, cli, monkeypatch):
     def started(*a, **k):   # must be refused before any work: fail fast instead of running
         raise AssertionError("the engine started its work")
 
+    import weakgrid.study.runner as runner
+    import weakgrid.study.sweep_estimate as sweep_estimate
+
     monkeypatch.setattr(engine, "build_setup", started)
+    monkeypatch.setattr(sweep_estimate, "estimate_sweep", started)
+    monkeypatch.setattr(runner, "simulate", started)
     if "reproduce" in _id(case):
         monkeypatch.setattr(rp, "paper_studies", lambda: [small_study(2, 0.3)])
     check_bad_input(case, ws, cli)
@@ -277,6 +282,7 @@ def test_a_manifest_lists_before_the_write_and_never_leaves_the_folder(tmp_path)
     m = Manifest(tmp_path / "o")
     m.claim([tmp_path / "o" / "a.json"])
     assert Manifest(tmp_path / "o").owns(tmp_path / "o" / "a.json")   # listed, not written
-    with pytest.raises(ParameterError, match="outside the output folder"):
-        m.claim([tmp_path / "elsewhere.json"])
+    for outside in (tmp_path / "elsewhere.json", tmp_path / "o" / "runs" / ".." / ".." / "x"):
+        with pytest.raises(ParameterError, match="outside the output folder"):
+            m.claim([outside])
     assert m.remove([tmp_path / "o" / "a.json"]) == []                # nothing to delete

@@ -156,7 +156,7 @@ CATALOGUE = [
     ("run-scenario-id-parent", "names from files", run('id = "c1-low-conv-redesign"', 'id = "../redesign"'), 2, ["scenarios.4.id", "'../redesign'"]),
     ("sweep-scenario-id-separator", "names from files", sweep('id = "c1-low-red"', 'id = "low/red"'), 2, ["scenarios.3.id", "'low/red'"]),
     ("simulate-scenario-id-absolute", "names from files", lambda ws: ["simulate", ws.study_with('id = "c1-low-red"', f'id = "{ws.root.parent}/sc"')], 2, ["scenarios.3.id", "/sc'"]),
-    ("run-controller-name-parent", "names from files", run(COMPARE, 'compare = ["hji", "../lqr2", "nonlinear-29"'), 2, ["controllers.compare", "'../lqr2'"]),
+    ("run-controller-name-parent", "names from files", lambda ws: ["run", ws.study_with(COMPARE, 'compare = ["hji", "../lqr2", "nonlinear-29"', "[controllers.lqr]", '[controllers."../lqr2"]\nkind = "lqr"\n\n[controllers.lqr]'), "--workers", "0", "-o", ws.root / "r"], 2, ["controllers.compare", "'../lqr2'", "output file name"]),
     ("run-figure-id-parent", "names from files", run('id = "fig07"', 'id = "../fig07"'), 2, ["figures.0.id", "'../fig07'"]),
     ("run-figure-id-absolute", "names from files", lambda ws: ["run", ws.study_with('id = "fig08"', f'id = "{ws.root.parent}/fig"'), "--workers", "0", "-o", ws.root / "r"], 2, ["figures.1.id", "/fig'"]),
     ("sweep-map-id-parent", "names from files", sweep('claim = "C1-cost"\ntitle', 'claim = "C1-cost"\nid = "../map"\ntitle'), 2, ["sweep.maps.0.id", "'../map'"]),
@@ -213,7 +213,12 @@ def test_bad_input(case, ws, cli, monkeypatch):
     def passed(*a, **k):    # a `run` entry must be refused before any work: fail fast
         raise AssertionError("the study passed validation and the engine started its work")
 
+    import weakgrid.study.runner as runner
+    import weakgrid.study.sweep_estimate as sweep_estimate
+
     monkeypatch.setattr(engine, "build_setup", passed)
+    monkeypatch.setattr(sweep_estimate, "estimate_sweep", passed)
+    monkeypatch.setattr(runner, "simulate", passed)
     check_bad_input(case, ws, cli)
 
 
