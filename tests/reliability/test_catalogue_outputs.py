@@ -129,6 +129,7 @@ CATALOGUE = [
     ("train-over-a-json-list", "replace only its own", train_over("list.json", b"[1, 2, 3]\n"), 2, ["--output", "list.json", "not a controller file"]),
     ("train-over-an-export", "replace only its own", train_over("x.json", b'{"format": "weakgrid-export/1"}\n'), 2, ["--output", "x.json", "not a controller file"]),
     ("train-default-output-taken", "replace only its own", lambda ws: (mine(ws, "case1-paper.controller.json"), ["train", "--preset", "case1-paper", "-q"])[1], 2, ["--output", "case1-paper.controller.json", "--force"]),
+    ("gamma-over-a-user-file", "replace only its own", lambda ws: ["gamma", "--preset", "case1-paper", "-o", ws.precious], 2, ["--output", "precious.json", "not a controller file", "--force"]),
     ("design-over-a-user-file", "replace only its own", lambda ws: ["design", ws.study, "-o", ws.precious], 2, ["--output", "precious.json", "not a controller file", "--force"]),
     ("design-derivation-taken", "replace only its own", lambda ws: (mine(ws, "c.derivation.json"), ["design", ws.study, "-o", ws.root / "c.controller.json"])[1], 2, ["--output", "c.derivation.json", "not a derivation file"]),
     # ---------------------------------------------------------------- export: a hand-edited or foreign file
