@@ -529,6 +529,8 @@ def _file_controllers(d, study, g, machine):
         from ..models import load_controller
 
         p = study.resolve(path)
+        if not p.is_file() and study.base_dir is None:
+            continue     # a study made in Python: the path is read when the controller is built
         if not p.is_file():
             raise ParameterError(f"controllers.{c}.path", path, f"no such file ({p}); give a "
                                  "controller file written by `weakgrid train` or `design`")

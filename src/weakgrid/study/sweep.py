@@ -92,7 +92,7 @@ def validate_sweep(d: dict, study) -> None:
             if not isinstance(vals, list) or not vals:
                 raise ParameterError(f"{where}.\"{path}\"", vals, "give a non-empty list")
             for v in vals:
-                _check_axis_value(d, where, path, v)
+                _check_axis_value(d, where, path, v, study)
     for where, t in (("sweep.t_end", sw.get("t_end")),
                      ("sweep.quick.t_end", (sw.get("quick") or {}).get("t_end"))):
         if t is not None and (isinstance(t, bool) or not isinstance(t, (int, float))
@@ -147,12 +147,12 @@ def _maps(sw, d):
                                      f"{sorted(axes)}")
 
 
-def _check_axis_value(d, where, path, value):
+def _check_axis_value(d, where, path, value, study=None):
     """A value of an axis must be valid for its field: the study with it is validated."""
     trial = {k: copy.deepcopy(v) for k, v in d.items() if k != "sweep"}
     try:
         set_path(trial, path, copy.deepcopy(value))
-        study_from_dict(trial)
+        study_from_dict(trial, getattr(study, "source", ""), getattr(study, "base_dir", None))
     except ParameterError as exc:
         fix = exc.fix if exc.field == path else str(exc)
         raise ParameterError(f"{where}.\"{path}\"", value,
