@@ -405,11 +405,11 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
             raise ParameterError(f"{w}.design_load", sc["design_load"], f"choose one of {loads} "
                                  "(the load the controllers are designed at)")
         sc["t_end"] = _num(sc, "t_end", w, positive=True)
+        step = "simulation.dt" if sim and "dt" in sim else "design.T"
         dt = (sim or {}).get("dt", ds["T"])
         if dt >= sc["t_end"]:
             raise ParameterError(f"{w}.t_end", sc["t_end"], f"the run is not longer than one "
-                                 f"integration step ({'simulation.dt' if sim and 'dt' in sim else 'design.T'}"
-                                 f" = {dt:g} s); give t_end > {dt:g} s")
+                                 f"integration step ({step} = {dt:g} s); give t_end > {dt:g} s")
         sc.setdefault("controllers", list(ct["compare"]))
         for c in sc["controllers"]:
             if c not in ct["compare"]:
