@@ -21,7 +21,7 @@ from pathlib import Path
 
 __all__ = ["write_text_atomic", "write_bytes_atomic", "write_json_atomic", "replace_atomic",
            "replace_many_atomic", "write_texts_atomic", "savefig_atomic", "safe_name",
-           "json_safe"]
+           "check_file_name", "json_safe"]
 
 
 def _umask() -> int:
@@ -230,3 +230,28 @@ def safe_name(name, default: str = "unnamed") -> str:
     s = _UNSAFE.sub("_", str(name)).strip(".")
     s = re.sub(r"\.{2,}", "_", s)
     return s[:120] or default
+
+
+_FILE_NAME = re.compile(r"[A-Za-z0-9_+-][A-Za-z0-9_.+-]{0,119}")
+
+
+def check_file_name(value, field: str) -> str:
+    """``value`` (a name read from a file: a study name, a scenario id, a figure id, a
+    controller or load-level name…) checked where it becomes part of an output file name.
+
+    Only letters, digits and ``_ . + -`` are allowed, not starting with a dot, without
+    ``..``, at most 120 characters: the name can never be a path separator, a parent folder
+    or an absolute path, so every output stays in the folder the user gave.
+
+    Raises
+    ------
+    weakgrid.game.errors.ParameterError
+        Naming ``field``, the value and the fix (a name made of the allowed characters).
+    """
+    if isinstance(value, str) and _FILE_NAME.fullmatch(value) and ".." not in value:
+        return value
+    from .game.errors import ParameterError
+
+    raise ParameterError(field, value, "it becomes part of an output file name: use only "
+                         "letters, digits and _ . + - (no path separator, no '..', not starting "
+                         f"with '.', at most 120 characters), e.g. {safe_name(value)!r}")

@@ -8,6 +8,8 @@
   runs, training checkpoints).
 * :func:`checksum` — of a record's own content, stored in the record and verified when it is
   read back, so that a damaged or hand-edited record is refused (and recomputed), not used.
+* :func:`stamp_c` / :func:`stamped_c_ok` — the same for generated C text (a last comment line
+  with the SHA-256 of the text above it): a hand-edited file is told from weakgrid's own.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from pathlib import Path
 from ._version import __version__
 
 __all__ = ["canonical_json", "code_fingerprint", "content_key", "checksum", "file_sha256",
-           "with_checksum", "checksum_ok"]
+           "with_checksum", "checksum_ok", "stamp_c", "stamped_c_ok"]
 
 
 def _canon(obj):
@@ -101,3 +103,24 @@ def checksum_ok(record: dict, files=()) -> bool:
         return False
     rec = _canon({k: v for k, v in record.items() if k != "checksum"})
     return checksum({"record": rec, "files": digests}) == want
+
+
+_STAMP = "/* weakgrid checksum sha256:{} */\n"
+
+
+def stamp_c(text: str) -> str:
+    """Generated C ``text`` with a last comment line holding the SHA-256 of the text above it
+    (:func:`stamped_c_ok`)."""
+    text = text if text.endswith("\n") else text + "\n"
+    return text + _STAMP.format(hashlib.sha256(text.encode()).hexdigest())
+
+
+def stamped_c_ok(data: bytes) -> bool:
+    """Whether ``data`` (a file's bytes) is C text stamped by :func:`stamp_c` and unchanged
+    since (a hand edit, or a file of another origin, gives False)."""
+    body, sep, last = data.rstrip(b"\n").rpartition(b"\n")
+    if not sep:
+        return False
+    body += b"\n"
+    want = _STAMP.format(hashlib.sha256(body).hexdigest()).encode()
+    return last + b"\n" == want and data == body + want

@@ -261,8 +261,10 @@ def test_cli_writes_the_validated_controller(closed_loop, tmp_path, capsys):
     from weakgrid import __version__
 
     prov = f"From {f.name} (weakgrid {__version__}; model kind upqc-design)."
+    from weakgrid.hashing import stamp_c
+
     for k, text in generate_digital_c(ctl, spec, "c2hji", prov).items():
-        assert (tmp_path / k).read_text() == text, k
+        assert (tmp_path / k).read_text() == stamp_c(text), k   # + its checksum line
     out = capsys.readouterr().out
     assert f"|u| <= {spec.Vmax:g} pu" in out and str(spec.bypass[0]) in out
     assert all(k in out for k in spec.state_map.values())

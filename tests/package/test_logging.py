@@ -24,7 +24,10 @@ def test_sweep_messages_are_log_records_not_prints(tmp_path, caplog, capsys):
 
 
 def test_removed_files_are_a_warning_record(tmp_path, caplog):
+    from weakgrid.manifest import Manifest
+
     (tmp_path / "old.json").write_text("{}")
+    Manifest(tmp_path).claim([tmp_path / "old.json"], force=True)   # a file weakgrid wrote
     with caplog.at_level(logging.WARNING, logger="weakgrid"):
         assert remove_stale(tmp_path, []) == ["old"]
     assert any(r.levelno == logging.WARNING and "old" in r.getMessage() for r in caplog.records)

@@ -3,7 +3,8 @@
 
 def check_bad_input(case, ws, cli):
     """Run one catalogue entry ``(name, category, build, code, needles)``: the exit code, one
-    or two lines naming every needle, no traceback, and no existing file touched."""
+    or two lines naming every needle, no traceback, no existing file touched and no file
+    written (anywhere: in the workspace or beside it)."""
     _name, _category, build, code, needles = case
     argv = build(ws)
     ws.snapshot()
@@ -15,3 +16,4 @@ def check_bad_input(case, ws, cli):
     for needle in needles:
         assert needle in err, f"{needle!r} missing from: {err}"
     ws.check_untouched()
+    ws.check_nothing_written()

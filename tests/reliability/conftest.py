@@ -59,12 +59,16 @@ class Workspace:
             p.write_text(STUDY.read_text())
         return p
 
-    def study_with(self, old: str, new: str) -> Path:
-        """A copy of the study with the first ``old`` replaced by ``new``."""
+    def study_with(self, old: str, new: str, *more: str) -> Path:
+        """A copy of the study with the first ``old`` replaced by ``new`` (and so on for
+        further pairs ``old2, new2, …`` in ``more``)."""
         text = STUDY.read_text()
-        assert old in text, f"{old!r} is not in the study"
+        pairs = [(old, new)] + list(zip(more[::2], more[1::2]))
+        for o, n in pairs:
+            assert o in text, f"{o!r} is not in the study"
+            text = text.replace(o, n, 1)
         p = self.root / "edited-study.toml"
-        p.write_text(text.replace(old, new, 1))
+        p.write_text(text)
         return p
 
     @staticmethod
@@ -87,6 +91,16 @@ class Workspace:
 
     def snapshot(self):
         self.before = {p: p.read_bytes() for p in self.root.rglob("*") if p.is_file()}
+        self.beside = sorted(p.name for p in self.root.parent.iterdir())
+
+    def check_nothing_written(self, inside=()):
+        """No new file under the workspace (but in the folders ``inside``) and none beside
+        it (a name read from a file that escaped the output folder would land there)."""
+        new = [p for p in self.root.rglob("*") if p.is_file() and p not in self.before
+               and not any(Path(d) in p.parents for d in inside)]
+        assert not new, f"files written: {new}"
+        assert sorted(p.name for p in self.root.parent.iterdir()) == self.beside, \
+            "a file or folder appeared beside the workspace (outside the output folder)"
 
     def check_untouched(self):
         after = {p for p in self.root.rglob("*") if p.is_file()}

@@ -19,7 +19,7 @@ def sub(old, new):
 
 def problem(old, new):
     return lambda ws: ["train", "--config", ws.problem_with(sub(old, new)), "-q",
-                       "-o", ws.precious]
+                       "-o", ws.root / "new.controller.json"]
 
 
 def ctl_edit(fn, cmd="export"):

@@ -18,6 +18,21 @@ AXIS = '"upqc.rating" = [0.1, 0.15, 0.3, 0.6, 1.0]'
 FAULT = "events = [{ kind = \"fault\", bus = 3, t_on = 0.2, t_off = 0.25, rf = 0.0, xf = 0.1 }]"
 
 
+NAME = 'name = "case1-weak-grid"'
+COMPARE = 'compare = ["hji", "nonlinear-29"'
+
+
+def _machine_sg(d):
+    """A controller record trained for a synchronous generator (another machine kind)."""
+    d["problem"]["model"]["machine"] = "sg"
+
+
+def _binary(ws):
+    p = ws.root / "binary-study.toml"
+    p.write_bytes(b"[study]\nname = \"x\xff\xfe\"\n")
+    return p
+
+
 def design(old, new):
     return lambda ws: ["design", ws.study_with(old, new), "--no-train"]
 
@@ -130,16 +145,80 @@ CATALOGUE = [
     ("simulate-study-unknown-controller", "study arguments", lambda ws: ["simulate", ws.study, "--controller", "mpc"], 2, ["--controller", "mpc", "hji"]),
     ("simulate-study-event-kind", "study file", simulate('kind = "fault", bus = 3', 'kind = "meteor", bus = 3'), 2, ["events.0.kind", "meteor"]),
     ("simulate-study-fault-bus-unknown", "study file", simulate("bus = 3, t_on", "bus = 33, t_on"), 2, ["bus", "33"]),
+    # ---------------------------------------------------------------- names read from a file that become paths
+    ("run-study-name-parent", "names from files", run(NAME, 'name = "../escaped"'), 2, ["study.name", "'../escaped'", "output file name", "'_escaped'"]),
+    ("run-study-name-absolute", "names from files", lambda ws: ["run", ws.study_with(NAME, f'name = "{ws.root.parent}/abs"'), "--workers", "0", "-o", ws.root / "r"], 2, ["study.name", "/abs'", "no path separator"]),
+    ("design-study-name-separator", "names from files", design(NAME, 'name = "a/b"'), 2, ["study.name", "'a/b'"]),
+    ("sweep-study-name-dotdot", "names from files", sweep(NAME, 'name = ".."'), 2, ["study.name", "'..'"]),
+    ("run-study-name-hidden", "names from files", run(NAME, 'name = ".hidden"'), 2, ["study.name", "'.hidden'", "not starting with '.'"]),
+    ("run-study-name-empty", "names from files", run(NAME, 'name = ""'), 2, ["study.name", "''"]),
+    ("run-study-name-backslash", "names from files", run(NAME, 'name = "a\\\\b"'), 2, ["study.name", "a\\\\b"]),
+    ("run-scenario-id-parent", "names from files", run('id = "c1-low-conv-redesign"', 'id = "../redesign"'), 2, ["scenarios.4.id", "'../redesign'"]),
+    ("sweep-scenario-id-separator", "names from files", sweep('id = "c1-low-red"', 'id = "low/red"'), 2, ["scenarios.3.id", "'low/red'"]),
+    ("simulate-scenario-id-absolute", "names from files", lambda ws: ["simulate", ws.study_with('id = "c1-low-red"', f'id = "{ws.root.parent}/sc"')], 2, ["scenarios.3.id", "/sc'"]),
+    ("run-controller-name-parent", "names from files", lambda ws: ["run", ws.study_with(COMPARE, 'compare = ["hji", "../lqr2", "nonlinear-29"', "[controllers.lqr]", '[controllers."../lqr2"]\nkind = "lqr"\n\n[controllers.lqr]'), "--workers", "0", "-o", ws.root / "r"], 2, ["controllers.compare", "'../lqr2'", "output file name"]),
+    ("run-figure-id-parent", "names from files", run('id = "fig07"', 'id = "../fig07"'), 2, ["figures.0.id", "'../fig07'"]),
+    ("run-figure-id-absolute", "names from files", lambda ws: ["run", ws.study_with('id = "fig08"', f'id = "{ws.root.parent}/fig"'), "--workers", "0", "-o", ws.root / "r"], 2, ["figures.1.id", "/fig'"]),
+    ("sweep-map-id-parent", "names from files", sweep('claim = "C1-cost"\ntitle', 'claim = "C1-cost"\nid = "../map"\ntitle'), 2, ["sweep.maps.0.id", "'../map'"]),
+    ("sweep-map-claim-as-name", "names from files", sweep('claim = "C1-power"\ntitle', 'claim = "C1/power"\ntitle'), 2, ["sweep.maps.1.claim", "'C1/power'"]),
+    ("design-load-level-parent", "names from files", design("[grid.loads.high]", '[grid.loads."../high"]'), 2, ["grid.loads.../high", "'../high'"]),
+    # ---------------------------------------------------------------- unknown keys and cross-references
+    ("run-figure-unknown-key", "cross-references", run('id = "fig07"', 'id = "fig07"\ncolour = "red"'), 2, ["figures.0.colour", "unknown field"]),
+    ("run-figure-run-unknown", "cross-references", run('[["c1-high-conv-hji", "HJI (optimal, (24))"], ["c1-high-conv-nonlinear-29"', '[["c1-high-conv-mpc", "HJI (optimal, (24))"], ["c1-high-conv-nonlinear-29"'), 2, ["figures.0.runs.0", "c1-high-conv-mpc", "no run of that id"]),
+    ("run-figure-panel-unknown", "cross-references", run('panels = ["sg_speed", "dc_voltage"]', 'panels = ["sg_sped", "dc_voltage"]'), 2, ["figures.0.panels", "sg_sped"]),
+    ("run-figure-run-not-pair", "cross-references", run('runs = [["c1-high-conv-hji", "HJI (optimal, (24))"], ["c1-high-conv-nonlinear-29", "nonlinear (29)"], ["c1-high-conv-pq"', 'runs = ["c1-high-conv-hji", ["c1-high-conv-nonlinear-29", "nonlinear (29)"], ["c1-high-conv-pq"'), 2, ["figures.0.runs.0", "c1-high-conv-hji", "[run id, legend label]"]),
+    ("run-figure-id-duplicate", "cross-references", run('id = "fig08"', 'id = "fig07"'), 2, ["figures.1.id", "fig07", "unique"]),
+    ("run-figure-id-missing", "cross-references", run('id = "fig07"\n', ''), 2, ["figures.0.id", "missing"]),
+    ("run-claim-unknown-key", "cross-references", run("reduction = 0.2\nsettling_tol = 0.25", "reduction = 0.2\nsettling_tol = 0.25\ntreshold = 3"), 2, ["claims.0.treshold", "unknown field"]),
+    ("run-claim-judge-parameter-missing", "cross-references", run('judge = "power_share"\nruns', 'judge = "power_share"\nrunz'), 2, ["claims.2.runz", "unknown field"]),
+    ("run-claim-judge-unknown", "cross-references", run('judge = "cost_less"', 'judge = "cost_more"'), 2, ["claims.0.judge", "cost_more"]),
+    ("sweep-map-unknown-key", "cross-references", sweep('claim = "C1-cost"\ntitle', 'claim = "C1-cost"\ncolour = "red"\ntitle'), 2, ["sweep.maps.0.colour", "unknown field"]),
+    ("sweep-map-kind-unknown", "cross-references", sweep('kind = "ratio"\nmetric = "control_cost"', 'kind = "pie"\nmetric = "control_cost"'), 2, ["sweep.maps.0.kind", "pie"]),
+    ("sweep-map-controller-unknown", "cross-references", sweep('a = "hji"\nb = "nonlinear-29"', 'a = "hji"\nb = "mpc"'), 2, ["sweep.maps.0.b", "mpc", "controllers.compare"]),
+    ("sweep-map-axis-not-swept", "cross-references", sweep('claim = "C1-cost"\ntitle', 'claim = "C1-cost"\nx = "upqc.x"\ntitle'), 2, ["sweep.maps.0.x", "upqc.x", "not a swept field"]),
+    ("sweep-map-id-duplicate", "cross-references", sweep('claim = "C1-power"\ntitle', 'claim = "C1-cost"\ntitle'), 2, ["sweep.maps.1.id", "C1-cost", "unique"]),
+    ("run-speed-of-unknown", "cross-references", run('speed_of = "SG"', 'speed_of = "G9"'), 2, ["report.speed_of", "G9", "['SG']"]),
+    ("run-quick-controller-unknown", "cross-references", run('quick = { t_end = 3.0, controllers = ["hji", "nonlinear-29", "pq"] }', 'quick = { t_end = 3.0, controllers = ["hji", "mpc"] }'), 2, ["scenarios.c1-high-conv.quick.controllers", "mpc"]),
+    ("run-controller-file-missing", "cross-references", lambda ws: ["run", ws.study_with("[controllers.lqr]", '[controllers.mine]\nkind = "file"\npath = "gone.controller.json"\n\n[controllers.lqr]', COMPARE, 'compare = ["mine", "hji", "nonlinear-29"'), "--workers", "0", "-o", ws.root / "r"], 2, ["controllers.mine.path", "gone.controller.json", "no such file"]),
+    # ---------------------------------------------------------------- physical plausibility
+    ("run-rating-beyond-line", "physical plausibility", run(RATING, "rating = 1e9"), 2, ["upqc.rating", "1000000000.0", "at most 1.0"]),
+    ("design-rating-above-1", "physical plausibility", design(RATING, "rating = 1.5"), 2, ["upqc.rating", "1.5", "series transformer"]),
+    ("sweep-axis-rating-above-1", "physical plausibility", sweep(AXIS, '"upqc.rating" = [0.1, 2.0]'), 2, ['sweep.axes."upqc.rating"', "2.0", "at most 1.0"]),
+    ("run-dt-longer-than-T", "physical plausibility", run("tol = 1e-8  ", "dt = 10.0\ntol = 1e-8  "), 2, ["simulation.dt", "10.0", "design.T"]),
+    ("run-t-end-within-one-step", "physical plausibility", run("t_end = 6.0\ncontrollers = [\"hji\", \"nonlinear-29\", \"lqr\"", "t_end = 5e-4\ncontrollers = [\"hji\", \"nonlinear-29\", \"lqr\""), 2, ["scenarios.c1-high-conv.t_end", "0.0005", "integration step"]),
+    ("run-t-off-and-duration", "physical plausibility", run(FAULT, FAULT.replace("t_off = 0.25", "t_off = 0.25, duration = 0.1")), 2, ["events.0.duration", "0.1", "not both"]),
+    ("run-faults-overlap", "physical plausibility", run(FAULT, FAULT[:-1] + ', { kind = "fault", bus = 3, t_on = 0.22, t_off = 0.3, xf = 0.2 }]'), 2, ["events.1.t_on", "0.22", "overlaps", "bus 3"]),
+    ("simulate-faults-overlap", "physical plausibility", simulate(FAULT, FAULT[:-1] + ', { kind = "fault", bus = 3, t_on = 0.1, duration = 0.2 }]'), 2, ["t_on", "overlaps", "bus 3"]),
+    ("run-trip-upqc-branch", "physical plausibility", run(FAULT, FAULT[:-1] + ', { kind = "line_trip", branch = "upqc", t = 1.0 }]'), 2, ["events.1.branch", "upqc", "UPQC's own"]),
+    ("run-trip-after-end", "physical plausibility", run(FAULT, FAULT[:-1] + ', { kind = "line_trip", branch = "line", t = 9.0 }]'), 2, ["events.1.t", "9.0", "t_end"]),
+    ("run-load-step-after-end", "physical plausibility", run(FAULT, FAULT[:-1] + ', { kind = "load_step", bus = 4, t = 7.0, dP = 5.0 }]'), 2, ["events.1.t", "7.0", "t_end"]),
+    ("simulate-load-step-1e6-MW", "physical plausibility", lambda ws: ["simulate", ws.study_with(FAULT, FAULT[:-1] + ', { kind = "load_step", bus = 4, t = 0.3, dP = 1e6 }]'), "--controller", "lqr", "--t-end", "0.5"], 2, ["events.1.dP", "1000000.0", "times the grid's size"]),
+    ("run-controller-file-other-machine", "physical plausibility", lambda ws: ["run", ws.study_with("[controllers.lqr]", f'[controllers.mine]\nkind = "file"\npath = "{ws.controller_with(_machine_sg)}"\n\n[controllers.lqr]', COMPARE, 'compare = ["mine", "hji", "nonlinear-29"'), "--workers", "0", "-o", ws.root / "r"], 2, ["controllers.mine.path", "trained for a SG", "'WF' is a GTI"]),
+    ("design-study-not-utf8", "study file", lambda ws: ["design", _binary(ws), "--no-train"], 2, ["binary-study.toml", "UTF-8"]),
+    ("run-study-not-utf8", "study file", lambda ws: ["run", _binary(ws), "--workers", "0", "-o", ws.root / "r"], 2, ["binary-study.toml", "UTF-8"]),
 ]
 
 
 def test_catalogue_size():
     assert len({c[0] for c in CATALOGUE}) == len(CATALOGUE)
-    assert {c[1] for c in CATALOGUE} == {"study file", "study arguments", "sweep"}
+    assert {c[1] for c in CATALOGUE} == {"study file", "study arguments", "sweep",
+                                         "names from files", "cross-references",
+                                         "physical plausibility"}
 
 
 @pytest.mark.parametrize("case", CATALOGUE, ids=[c[0] for c in CATALOGUE])
-def test_bad_input(case, ws, cli):
+def test_bad_input(case, ws, cli, monkeypatch):
+    import weakgrid.study.engine as engine
+
+    def passed(*a, **k):    # a `run` entry must be refused before any work: fail fast
+        raise AssertionError("the study passed validation and the engine started its work")
+
+    import weakgrid.study.runner as runner
+    import weakgrid.study.sweep_estimate as sweep_estimate
+
+    monkeypatch.setattr(engine, "build_setup", passed)
+    monkeypatch.setattr(sweep_estimate, "estimate_sweep", passed)
+    monkeypatch.setattr(runner, "simulate", passed)
     check_bad_input(case, ws, cli)
 
 

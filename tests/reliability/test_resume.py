@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from weakgrid.manifest import MANIFEST_NAME, Manifest
 from weakgrid.study.cache import inputs_key, load_run, remove_stale, save_run
 from weakgrid.study.runner import Run, RunRecord
 
@@ -46,10 +47,14 @@ def test_stale_runs_of_an_earlier_plan_are_removed_with_a_warning(tmp_path):
     for sid in ("keep", "old"):
         sc = Scenario(sid, C1, "high", "conventional", "pq", 0.2, 0.25, 1.0)
         save_run(_rec(sc), tmp_path, "k")
+    Manifest(tmp_path).claim(tmp_path.iterdir(), force=True)   # the files weakgrid wrote
+    (tmp_path / "mine.json").write_text("{}")          # the user's: never removed
     said = []
     assert remove_stale(tmp_path, ["keep"], said.append) == ["old"]
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.json", "keep.parquet"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        MANIFEST_NAME, "keep.json", "keep.parquet", "mine.json"]
     assert "stale" in said[0] and "old" in said[0]
+    assert remove_stale(tmp_path, ["keep"], said.append) == []
 
 
 def test_a_forged_or_edited_record_is_refused_with_a_warning(tmp_path, caplog):

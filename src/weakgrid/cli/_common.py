@@ -236,10 +236,72 @@ def bar_disable(args):
     return None if show_progress(args) else True
 
 
-def add_force_argument(p):
-    p.add_argument("--force", action="store_true",
-                   help="run even if the estimated memory/time exceeds the limits "
-                        "(4 GiB or half the available memory, 30 min; WEAKGRID_MAX_GIB)")
+def add_force_argument(p, overwrite: str | None = None, limits: bool = True):
+    """``--force``: run beyond the estimated limits (``limits``) and/or overwrite files
+    weakgrid did not write (``overwrite``: what is overwritten, for the help)."""
+    parts = (["run even if the estimated memory/time exceeds the limits (4 GiB or half the "
+              "available memory, 30 min; WEAKGRID_MAX_GIB)"] if limits else []) + \
+        ([f"overwrite {overwrite} that weakgrid did not write"] if overwrite else [])
+    p.add_argument("--force", action="store_true", help="; ".join(parts))
+
+
+def _json_format(path):
+    import json
+
+    try:
+        d = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return d.get("format") if isinstance(d, dict) else None
+
+
+def is_controller_file(path) -> bool:
+    """A controller file written by weakgrid (its format tag)."""
+    from ..game.controller import FILE_FORMAT
+
+    return _json_format(path) == FILE_FORMAT
+
+
+def is_export_json(path) -> bool:
+    """A ``--format json`` export written by weakgrid (its format tag)."""
+    from ..game.export_json import EXPORT_FORMAT
+
+    return _json_format(path) == EXPORT_FORMAT
+
+
+def is_generated_c(path) -> bool:
+    """C written by weakgrid and unchanged since (its checksum line)."""
+    from ..hashing import stamped_c_ok
+
+    try:
+        return stamped_c_ok(Path(path).read_bytes())
+    except OSError:
+        return False
+
+
+def is_weakgrid_fmu(path) -> bool:
+    """An FMU that weakgrid built (a zip whose modelDescription.xml names weakgrid as its
+    generation tool)."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as z:
+            return b'generationTool="weakgrid' in z.read("modelDescription.xml")
+    except (OSError, KeyError, zipfile.BadZipFile):
+        return False
+
+
+def guard_overwrite(path, is_own, what: str, force: bool) -> None:
+    """Refuse to replace an existing ``path`` that is not weakgrid's own output of the same
+    kind (``is_own(path) -> bool``) unless ``force``; names the file and the fix."""
+    from ..game.errors import ParameterError
+
+    p = Path(path)
+    if force or not p.exists() or is_own(p):
+        return
+    raise ParameterError("--output", str(p), f"exists and is not {what} written by weakgrid; "
+                         "it is left alone. Fix: give another file name, move it, or --force "
+                         "to overwrite it")
 
 
 def guard_training(problem, force: bool, log=print):

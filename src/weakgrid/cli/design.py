@@ -7,7 +7,8 @@ from pathlib import Path
 
 from ._checkpoint import TrainingCheckpoint, add_restart_argument, checkpoint_path, outer_bar
 from ._checkpoint import training_key
-from ._common import HelpFormatter, bar_disable, output_file
+from ._common import (HelpFormatter, add_force_argument, bar_disable, guard_overwrite,
+                      is_controller_file, output_file)
 from ._study import add_operating_point, add_study_argument, study_of
 
 NAME = "design"
@@ -28,8 +29,19 @@ def add_parser(sub):
                    help="controller file (default: <study>-<load>-<upqc>.controller.json)")
     p.add_argument("--no-train", action="store_true", help="derive and check only")
     add_restart_argument(p, "OUTPUT with the suffix .checkpoint.npz")
+    add_force_argument(p, overwrite="an OUTPUT file", limits=False)
     p.set_defaults(func=run)
     return p
+
+
+def _is_derivation(path) -> bool:
+    import json
+
+    try:
+        d = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(d, dict) and {"derivation", "mode_check", "study"} <= set(d)
 
 
 def run(args) -> int:
@@ -66,6 +78,10 @@ def run(args) -> int:
     if args.no_train:
         return 0
     out = args.output or Path(f"{st.name}-{setup.load}-{setup.upqc}.controller.json")
+    guard_overwrite(out, is_controller_file, "a controller file", args.force)
+    der_path = out.with_suffix("").with_suffix(".derivation.json") if \
+        out.name.endswith(".controller.json") else Path(str(out) + ".derivation.json")
+    guard_overwrite(der_path, _is_derivation, "a derivation file", args.force)
     # the training resumes from its checkpoint beside the output, as `weakgrid train` does
     problem = design_problem(st, d)
     settings = problem.settings
@@ -80,10 +96,7 @@ def run(args) -> int:
     finally:
         bar.close()
     ctl.save(out)
-    write_json_atomic(out.with_suffix("").with_suffix(".derivation.json") if
-                      out.name.endswith(".controller.json") else Path(str(out) +
-                                                                     ".derivation.json"),
-                      {"derivation": der.to_dict(), "mode_check": {
+    write_json_atomic(der_path, {"derivation": der.to_dict(), "mode_check": {
                           k: (str(v) if isinstance(v, complex) else v) for k, v in chk.items()},
                        "study": st.source})
     n = ctl.iterations["outer"]

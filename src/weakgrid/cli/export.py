@@ -9,7 +9,9 @@ from pathlib import Path
 from .. import __version__
 from ..fileio import write_json_atomic
 from ..fileio import write_texts_atomic
-from ._common import HelpFormatter, input_file, output_folder, positive_float
+from ._common import (HelpFormatter, add_force_argument, guard_overwrite, input_file,
+                      is_export_json, is_generated_c, is_weakgrid_fmu, output_folder,
+                      positive_float)
 
 NAME = "export"
 
@@ -57,8 +59,36 @@ def add_parser(sub):
     g.add_argument("--param", action="append", default=None, metavar="NAME=VALUE",
                    help="a measurement-mapping constant (GTI: phi_s0, tau, Vc0; SG: angle0, "
                         "ws), repeatable")
+    add_force_argument(p, overwrite="an output file", limits=False)
     p.set_defaults(func=run)
     return p
+
+
+_OWN = {".c": (is_generated_c, "C written by weakgrid and unchanged since"),
+        ".h": (is_generated_c, "a C header written by weakgrid and unchanged since"),
+        ".json": (is_export_json, "a JSON export"),
+        ".fmu": (is_weakgrid_fmu, "an FMU")}
+
+
+def _guard(paths, force):
+    """Refuse to replace a file that is not weakgrid's own export of the same kind (a
+    hand-edited .c included) unless --force."""
+    for p in paths:
+        own, what = _OWN[Path(p).suffix]
+        guard_overwrite(p, own, what, force)
+
+
+def _write_c(files: dict, force) -> list[Path]:
+    """Generated C files (path → text), each stamped with its checksum, together."""
+    from ..hashing import stamp_c
+
+    _guard(files, force)
+    return write_texts_atomic({p: stamp_c(t) for p, t in files.items()})
+
+
+def _digital_names(name) -> list[str]:
+    """The files ``--format c`` writes for ``name``."""
+    return [f"{name}.h", f"{name}.c", f"{name}_law.h", f"{name}_law.c"]
 
 
 def default_name(path: Path) -> str:
@@ -163,8 +193,9 @@ def run(args) -> int:
     kind = ctl.problem.get("model", {}).get("kind", ctl.system.kind)
     prov = f"From {path.name} (weakgrid {__version__}; model kind {kind})."
     if args.format == "c":
+        _guard([out / k for k in _digital_names(name)], args.force)
         _, files = _write_digital(ctl, args, name, prov)
-        write_texts_atomic({out / k: v for k, v in files.items()})
+        _write_c({out / k: v for k, v in files.items()}, args.force)
         print(f"weakgrid export: wrote {', '.join(str(out / k) for k in files)}")
         print(f"  int {name}_init({name}_state *s, const {name}_params *p);  "
               f"int {name}_step({name}_state *s, const double *meas, double *u_out);")
@@ -174,6 +205,7 @@ def run(args) -> int:
         from ..fmu import build_fmu
         from ..models.export_digital import fmu_block
 
+        _guard([out / f"{name}.fmu"], args.force)
         spec, files = _write_digital(ctl, args, name, prov)
         try:
             target = build_fmu(fmu_block(ctl, spec, name), files, out / f"{name}.fmu",
@@ -185,7 +217,7 @@ def run(args) -> int:
         return 0
     if args.format == "c-law":
         src, hdr = generate_c(ctl, name, prov)
-        write_texts_atomic({out / f"{name}.h": hdr, out / f"{name}.c": src})
+        _write_c({out / f"{name}.h": hdr, out / f"{name}.c": src}, args.force)
         print(f"weakgrid export: wrote {out / (name + '.c')} and {out / (name + '.h')}")
         print(f"  int {name}_saddle(const double x[{ctl.system.n_states}], "
               f"double u[{ctl.system.n_controls}], double w[{ctl.system.n_disturbances}]);"
@@ -195,6 +227,7 @@ def run(args) -> int:
     if args.format == "json":
         d = describe_controller(ctl, __version__, str(path))
         target = out / f"{name}.export.json"
+        _guard([target], args.force)
         write_json_atomic(target, d)
         print(f"weakgrid export: wrote {target}")
         return 0

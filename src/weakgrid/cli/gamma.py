@@ -9,7 +9,8 @@ from ..fileio import write_json_atomic
 from ..game.gamma_settings import SearchSettings
 from ._checkpoint import (Keeper, add_restart_argument, checkpoint_path, content_key,
                           load_kept, problem_inputs, say_kept)
-from ._common import (HelpFormatter, bar_disable, add_force_argument, add_problem_arguments, guard_training,
+from ._common import (HelpFormatter, add_force_argument, add_problem_arguments, bar_disable,
+                      guard_overwrite, guard_training, is_controller_file,
                       output_file, positive_float, positive_int, problem_of, provenance)
 
 NAME = "gamma"
@@ -48,7 +49,7 @@ def add_parser(sub):
     p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
     add_restart_argument(p, "OUTPUT, else REPORT, else NAME, with the suffix "
                             ".gamma.checkpoint.npz")
-    add_force_argument(p)
+    add_force_argument(p, overwrite="an OUTPUT file")
     p.set_defaults(func=run)
     return p
 
@@ -89,6 +90,8 @@ def run(args) -> int:
     guard_training(problem, args.force)
     # every decided trial is saved at once, the training of the running one at most every
     # CHECKPOINT_SECONDS and on an interruption; a re-run replays the decided trials
+    if args.output:
+        guard_overwrite(args.output, is_controller_file, "a controller file", args.force)
     ckpt = checkpoint_path(args.output or args.report or Path(f"{problem.name}.json"), NAME)
     key = content_key({"command": NAME, **problem_inputs(problem, solver),
                        "search": settings.to_dict()})

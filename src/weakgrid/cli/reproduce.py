@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import (HelpFormatter, add_cluster_arguments, check_cluster, output_folder,
-                      show_progress)
+from ._common import (HelpFormatter, add_cluster_arguments, add_force_argument, check_cluster,
+                      output_folder, show_progress)
 
 NAME = "reproduce"
 
@@ -24,6 +24,7 @@ def add_parser(sub):
     p.add_argument("--quick", action="store_true",
                    help="shorter runs and the essential subset of scenarios")
     add_cluster_arguments(p)
+    add_force_argument(p, overwrite="files in the output folder", limits=False)
     p.set_defaults(func=run)
     return p
 
@@ -34,7 +35,7 @@ def run(args) -> int:
 
     check_cluster(args)
     summary = reproduce(args.output, quick=args.quick, scheduler=args.scheduler,
-                        workers=args.workers, progress=show_progress(args))
+                        workers=args.workers, progress=show_progress(args), force=args.force)
     width = max((len(c["id"]) for c in summary["claims"]), default=0)
     print("\nclaims of the paper:")
     for c in summary["claims"]:

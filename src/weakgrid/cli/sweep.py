@@ -35,14 +35,14 @@ def add_parser(sub):
     p.add_argument("--signals", action="store_true",
                    help="keep every run's signals (Parquet, in the cache folder)")
     p.add_argument("--maps", action="store_true", help="also draw the sweep's maps (PNG)")
-    add_force_argument(p)
+    add_force_argument(p, overwrite="files in the output folder")
     p.set_defaults(func=run)
     return p
 
 
 def run(args) -> int:
     """Run ``weakgrid sweep`` with the parsed ``args``; return the exit status."""
-    from ..study.sweep import run_study_sweep
+    from ..study.sweep import claim_sweep_outputs, run_study_sweep
     from ..study.sweep_estimate import check_sweep, estimate_sweep
     from ..sweep import SweepInterrupted
 
@@ -51,6 +51,8 @@ def run(args) -> int:
         st.data["sweep"]["signals"] = True
     check_cluster(args)
     out = args.output or Path(f"{st.name}-sweep")
+    if "sweep" in st.data:      # a file of the user's in the way: refused before any work
+        claim_sweep_outputs(st, out, args.quick, args.maps, args.force, write=False)
     # before anything is written: what the runs still to do will cost (refused beyond limits)
     est = estimate_sweep(st, out / "cache", quick=args.quick, workers=args.workers,
                          scheduler=args.scheduler)
@@ -58,7 +60,8 @@ def run(args) -> int:
     check_sweep(est, st, quick=args.quick, force=args.force)
     try:
         table = run_study_sweep(st, out, quick=args.quick, scheduler=args.scheduler,
-                                workers=args.workers, progress=show_progress(args))
+                                workers=args.workers, progress=show_progress(args),
+                                force=args.force, maps=args.maps)
     except SweepInterrupted as exc:
         print(f"weakgrid sweep: {exc}")
         return 130

@@ -8,8 +8,9 @@ from pathlib import Path
 
 from ._checkpoint import (CHECKPOINT_SECONDS, TrainingCheckpoint, add_restart_argument,
                           checkpoint_path, outer_bar, training_key)
-from ._common import (HelpFormatter, bar_disable, add_force_argument, add_problem_arguments, guard_training,
-                      output_file, positive_float, problem_of)
+from ._common import (HelpFormatter, add_force_argument, add_problem_arguments, bar_disable,
+                      guard_overwrite, guard_training, is_controller_file, output_file,
+                      positive_float, problem_of)
 
 NAME = "train"
 
@@ -34,7 +35,7 @@ def add_parser(sub):
                    help="shape of --u-bound (default: the problem's, else disk)")
     p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
     add_restart_argument(p, "OUTPUT with the suffix .checkpoint.npz")
-    add_force_argument(p)
+    add_force_argument(p, overwrite="an OUTPUT file")
     p.set_defaults(func=run)
     return p
 
@@ -78,6 +79,7 @@ def run(args) -> int:
     print(f"  solver  δu = {settings.tol_u:g}, δw = {settings.tol_w:g}")
     guard_training(problem, args.force)
     out = args.output or Path(f"{problem.name}.controller.json")
+    guard_overwrite(out, is_controller_file, "a controller file", args.force)
     cp = TrainingCheckpoint(checkpoint_path(out), training_key(problem, settings),
                             args.restart, NAME)
     if not args.quiet:

@@ -42,7 +42,7 @@ from ..game import (
     paper_basis,
     solve_hji,
 )
-from ..fileio import safe_name
+from ..fileio import check_file_name, safe_name
 from ..game.bases import PolynomialBasis
 from ..game.errors import ShapeError
 from .design import UPQCDesignModel, gti_design_model, sg_design_model
@@ -152,11 +152,13 @@ def _model(d: dict):
     if kind == "gti":
         keys = {"C", "tau", "Vs", "B", "Vr_bar", "T", "chi", "Pin", "phi_s0"}
         _check_keys(d, keys | {"kind", "upqc"}, "model")
+        _required(d, ("C", "tau", "Vs", "B", "Vr_bar", "T"), "gti")
         kw = {k: _num(d, k, "model") for k in keys if k in d}
         return gti_design_model(upqc=d.get("upqc", "conventional"), **kw)
     if kind == "sg":
         keys = {"H", "E_prime", "B", "Vr_bar", "T", "f_nominal", "Pm", "delta0"}
         _check_keys(d, keys | {"kind"}, "model")
+        _required(d, ("H", "E_prime", "B", "Vr_bar", "T"), "sg")
         kw = {k: _num(d, k, "model") for k in keys if k in d}
         return sg_design_model(**kw)
     if kind == "linear":
@@ -164,6 +166,13 @@ def _model(d: dict):
         return LinearSystem(_array(d, "A", "model"), _array(d, "B", "model"),
                             _array(d, "E", "model"), d.get("state_names"))
     raise ParameterError("model.kind", kind, "use 'upqc-design', 'gti', 'sg' or 'linear'")
+
+
+def _required(d: dict, keys, kind):
+    for k in keys:
+        if k not in d:
+            raise ParameterError(f"model.{k}", None, f"missing; a model of kind '{kind}' needs "
+                                 f"{', '.join(keys)}")
 
 
 def _basis(d: dict, n: int) -> PolynomialBasis:
@@ -199,7 +208,12 @@ def _policy(d: dict, system):
         return lqr_policy(system, _weight(_array(d, "Q", "initial_policy", 0.01), system.n_states),
                           _weight(_array(d, "R", "initial_policy", 1.0), system.n_controls))
     if kind == "linear":
-        return LinearPolicy(_array(d, "K", "initial_policy"))
+        K = np.atleast_2d(_array(d, "K", "initial_policy"))
+        if K.shape != (system.n_controls, system.n_states):
+            raise ParameterError("initial_policy.K", K.tolist(), f"has shape {K.shape}; give "
+                                 f"{system.n_controls} × {system.n_states} (controls × states: "
+                                 "u = −K x)")
+        return LinearPolicy(K)
     raise ParameterError("initial_policy.kind", kind, "use 'nonlinear-29', 'lqr' or 'linear'")
 
 
@@ -338,7 +352,8 @@ def problem_from_dict(d: dict, source: str = "") -> TrainingProblem:
     s = {k: (_num(s, k, "solver") if k.startswith("tol") else _int(s, k, "solver")) for k in s}
     settings = SolverSettings(**s)
     # a name read from a file becomes part of output file names: keep it inside the folder
-    name = safe_name(d.get("preset", {}).get("name", Path(source).stem if source else "custom"),
-                     "custom")
+    pre = d.get("preset", {})
+    name = check_file_name(pre["name"], "preset.name") if isinstance(pre, dict) and "name" in pre \
+        else safe_name(Path(source).stem if source else "custom", "custom")
     return TrainingProblem(name, system, basis, cost, mesh, policy, settings,
                            d.get("published", {}), d, source)

@@ -155,9 +155,26 @@ def _pandapower_net(g, load):
     if fn is None or not callable(fn):
         raise ParameterError("grid.network", g["network"], "not a function of "
                              "pandapower.networks (e.g. case9, create_cigre_network_mv)")
+    kwargs = g.get("kwargs", {})
+    if not isinstance(kwargs, dict):
+        raise ParameterError("grid.kwargs", kwargs, f"give a table of keyword arguments of "
+                             f"pandapower.networks.{g['network']}")
+    import inspect
+
+    params = inspect.signature(fn).parameters
+    if not any(p.kind is p.VAR_KEYWORD for p in params.values()):
+        for k in kwargs:
+            if k not in params:
+                raise ParameterError(f"grid.kwargs.{k}", kwargs[k], f"not an argument of "
+                                     f"pandapower.networks.{g['network']}; its arguments: "
+                                     f"{list(params)}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        net = fn(**g.get("kwargs", {}))
+        try:
+            net = fn(**kwargs)
+        except (ValueError, TypeError, KeyError, NotImplementedError) as exc:
+            raise ParameterError("grid.kwargs", kwargs, f"pandapower.networks.{g['network']} "
+                                 f"refused them: {exc}") from None
         if "keep_buses" in g:
             keep = net.bus.name.astype(str).str.match(g["keep_buses"])
             pp.toolbox.drop_buses(net, net.bus.index[~keep], drop_elements=True)
@@ -327,7 +344,12 @@ def _andes_network(study, g, up):
     from ..sim.io.andes import from_andes
 
     addfile = _andes_file(study, g["dyr"]) if g.get("dyr") else None
-    ss = andes.load(_andes_file(study, g["file"]), addfile=addfile, setup=False,
+    main = _andes_file(study, g["file"])
+    if str(main).lower().endswith(".raw"):   # ANDES misreads layouts it does not know
+        from ..sim.io.psse.raw import raw_version
+
+        raw_version(main)
+    ss = andes.load(main, addfile=addfile, setup=False,
                     no_output=True, default_config=True)
     system, _ = from_andes(ss, include_events=False)
     bus_id = {str(k): int(v) for k, v in system.andes_bus_id.items()}

@@ -141,20 +141,26 @@ def load_run(folder, scenario, key: str, record_class):
                         aliases={k: v for k, v in aliases.items() if k != v})
 
 
-def remove_stale(folder, keep_ids, log=None, suffix=".json") -> list[str]:
-    """Remove the runs in ``folder`` whose id is not in ``keep_ids``; say so (``log``, default
-    this module's logger as a warning)."""
+def remove_stale(folder, keep_ids, log=None, suffix=".json", manifest=None) -> list[str]:
+    """Remove the runs in ``folder`` whose id is not in ``keep_ids`` — only files weakgrid
+    wrote (listed in ``manifest``, by default the manifest of ``folder``,
+    :class:`weakgrid.manifest.Manifest`); any other file is left alone. Say what was removed
+    (``log``, default this module's logger as a warning)."""
+    from ..manifest import Manifest
+
     log = log or logging.getLogger(__name__).warning
     folder = Path(folder)
     if not folder.is_dir():
         return []
+    manifest = manifest if manifest is not None else Manifest(folder)
     keep = set(keep_ids)
-    stale = sorted(p.name[:-len(suffix)] for p in folder.glob(f"*{suffix}")
-                   if p.name[:-len(suffix)] not in keep)
+    listed = manifest.listed_under(manifest.rel(folder))
+    stale = sorted({p.name[:-len(suffix)] for p in listed if p.name.endswith(suffix)
+                    and p.name[:-len(suffix)] not in keep and p.is_file()})
     for sid in stale:
-        for p in folder.glob(f"{sid}.*"):
-            p.unlink()
+        manifest.remove(p for p in folder.glob(f"{sid}.*"))
     if stale:
-        log(f"warning: removed {len(stale)} stale run(s) of an earlier reproduce in {folder} "
-            f"that this one does not make: {', '.join(stale[:6])}{' …' if len(stale) > 6 else ''}")
+        log(f"warning: removed {len(stale)} stale run(s) of an earlier run in {folder} "
+            f"that this one does not make: {', '.join(stale[:6])}{' …' if len(stale) > 6 else ''}"
+            " (only files weakgrid wrote; anything else there is left alone)")
     return stale

@@ -29,6 +29,7 @@ import numpy as np
 from .. import __version__
 from ..design import design_mode, machine_mode, mode_states, modes
 from ..fileio import write_json_atomic
+from ..manifest import Manifest
 from ..models import load_preset
 from .build import build_setup
 from .cache import inputs_key, load_run, remove_stale, save_run
@@ -150,20 +151,42 @@ def _run_task(study, run, trained):
     return run_scenario(study, run, trained)
 
 
+def planned_files(out: Path, plan, quick: bool, maps: bool) -> list[Path]:
+    """Every file :func:`run_studies` writes into ``out`` for ``plan`` (the sweep cache's
+    hash-named files aside)."""
+    files = [out / n for n in ("metrics.csv", "metrics.md", "report.html", "claims.json",
+                               "designs.json")]
+    for st, runs, keys in plan:
+        files += [out / "runs" / f"{r.id}{ext}" for r in runs
+                  for ext in (".json", ".parquet")]
+        files += [out / "controllers" / f"{st.name}-{ld}-{u}.controller.json" for ld, u in keys]
+        files += [out / "figures" / f"{f['id']}.{fmt}" for f in figure_specs(st, quick)
+                  for fmt in ("png", "svg")]
+        if maps and st.data.get("sweep"):
+            files += [out / "maps" / f"map-{st.name}-{m.get('id', m['claim'])}.png"
+                      for m in st.data["sweep"].get("maps", [])]
+    if maps and any(st.data.get("sweep") for st, _, _ in plan):
+        files.append(out / f"sweep{'-quick' if quick else ''}.parquet")
+    return files
+
+
 def run_studies(studies, output, quick=False, log=None, title=None, progress=True,
-                scheduler=None, workers=None, maps=True) -> dict:
+                scheduler=None, workers=None, maps=True, force=False) -> dict:
     """Run every (scenario, controller) of ``studies`` and write everything to ``output``.
 
     The runs (and the sweeps of the studies that have a ``[sweep]`` table, drawn as maps
     when ``maps``) go to one Dask cluster: a local one with ``workers`` processes (default
     one per core), or the one at ``scheduler``; ``workers = 0`` runs everything serially here.
 
+    weakgrid writes only into ``output`` and deletes there only files it wrote (its manifest,
+    :class:`weakgrid.manifest.Manifest`): a file of another origin with the name of an output
+    stops the run before any work (unless ``force``: overwritten); other files are left alone.
+
     Returns a summary dict (claims, metrics, figures, report, designs, maps).
     """
     log = log or logging.getLogger(__name__).info
     out = Path(output)
     runs_dir = out / "runs"
-    runs_dir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     plan = []   # (study, [Run], training keys)
     for st in studies:
@@ -181,11 +204,18 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                 f"{st.name}\"" + (f" and {n_maps} map{'s' if n_maps != 1 else ''}"
                                    if n_maps else "") + f", {_sweep_file(quick)}")
     total = sum(len(r) + len(k) for _, r, k in plan)
-    # a used folder: runs this plan does not make are stale; finished runs with the same
-    # inputs are kept and not redone (an interrupted run continues where it stopped)
-    remove_stale(runs_dir, [r.id for _, runs, _ in plan for r in runs], log)
+    # the files this plan writes are weakgrid's (listed before they are written); a file of
+    # the user's in the way stops here, before any work
+    manifest = Manifest(out)
+    manifest.claim(planned_files(out, plan, quick, maps), force=force)
+    runs_dir.mkdir(parents=True, exist_ok=True)
+    # a used folder: runs this plan does not make are stale (only those weakgrid wrote);
+    # finished runs with the same inputs are kept and not redone (an interrupted run
+    # continues where it stopped)
+    remove_stale(runs_dir, [r.id for _, runs, _ in plan for r in runs], log, manifest=manifest)
     remove_stale(out / "controllers", [f"{st.name}-{ld}-{u}" for st, _, keys in plan
-                                       for ld, u in keys], log, suffix=".controller.json")
+                                       for ld, u in keys], log, suffix=".controller.json",
+                 manifest=manifest)
     n_kept = 0
     bar = _progress(total, progress)
     designs, notes, metrics, records, claims_spec, fig_specs = [], {}, [], {}, [], []

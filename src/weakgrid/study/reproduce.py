@@ -20,10 +20,11 @@ def paper_studies():
 
 
 def reproduce(output="reproduce-output", quick=False, log=None, scheduler=None,
-              workers=None, progress=True) -> dict:
+              workers=None, progress=True, force=False) -> dict:
     """Run the paper's case studies (and their sweeps, as maps) and write everything to
     ``output``; simulations run on a Dask cluster (see :func:`run_studies`; ``progress``:
-    its progress bar on stderr)."""
+    its progress bar on stderr; ``force``: overwrite files there that weakgrid did not
+    write)."""
     return run_studies(paper_studies(), output, quick=quick, log=log,
                        title="reproduction of Nazaripouya & Mehraeen (2015)",
-                       scheduler=scheduler, workers=workers, progress=progress)
+                       scheduler=scheduler, workers=workers, progress=progress, force=force)

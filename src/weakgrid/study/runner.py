@@ -197,8 +197,29 @@ def make_events(setup, run: Run):
             out.append(LineTrip(_branch_row(setup, e["branch"], f"{w}.branch"), e["t"],
                                 close=bool(e.get("close", False))))
         else:
+            _plausible_step(setup, e, w)
             out.append(LoadStep(setup.bus(e["bus"], f"{w}.bus"), e["t"], e["dP"], e["dQ"]))
     return out
+
+
+STEP_LIMIT = 10.0   # a load step beyond this many times the grid's size is refused
+
+
+def _plausible_step(setup, e, w):
+    """A load step no operating point of the grid could carry is refused with its size beside
+    the grid's (the Newton iteration would fail with nothing to say)."""
+    from ..sim.network import PD, PG, QD
+
+    net = setup.system.network
+    size = max(float(net.Sb), float(np.abs(net.bus[:, PD] + 1j * net.bus[:, QD]).sum()),
+               float(np.abs(net.gen[:, PG]).sum()))
+    step = abs(complex(e["dP"], e["dQ"]))
+    if step > STEP_LIMIT * size:
+        raise ParameterError(f"{w}.dP", e["dP"], f"a load step of {step:.4g} MVA is "
+                             f"{step / size:.3g} times the grid's size ({size:.4g} MVA: the "
+                             "largest of its base, total load and total generation); no "
+                             "operating point carries it. Give dP, dQ in MW, Mvar, at most "
+                             f"{STEP_LIMIT:g} × {size:.4g}")
 
 
 def sim_settings(study, dt_factor: float = 1.0) -> tuple[float, float | None]:

@@ -40,6 +40,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..dotted import get_path as _get, set_path as _set
+from ..fileio import check_file_name, safe_name
 from ..game.errors import ParameterError
 
 __all__ = ["Study", "load_study", "apply_overrides", "study_from_dict", "get_path", "set_path", "shipped_studies",
@@ -129,6 +130,10 @@ def _read(p) -> dict:
             return tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError("study", str(p), f"is not valid TOML ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise ParameterError("study", str(p), f"is not UTF-8 text (byte "
+                             f"{exc.object[exc.start:exc.start + 1]!r} at position {exc.start}): "
+                             "save the study file as UTF-8 TOML") from None
 
 
 def load_study(src, overrides=()) -> "Study":
@@ -334,7 +339,9 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
     _keys(d, TOP, "study file")
     st = d.setdefault("study", {})
     _keys(st, {"name", "title", "reproduce", "notes", "description"}, "study")
-    st.setdefault("name", Path(source).stem if source else "study")
+    if "name" in st:
+        check_file_name(st["name"], "study.name")
+    st.setdefault("name", safe_name(Path(source).stem if source else "study", "study"))
     st.setdefault("title", "")
     st.setdefault("reproduce", False)
     st.setdefault("notes", [])
@@ -362,6 +369,8 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         _need(g, "file", "grid", str)
     if "f_hz" in g:
         _num(g, "f_hz", "grid", positive=True)
+    for level in _load_levels(g):
+        check_file_name(level, f"grid.loads.{level}")
     dyn = d.setdefault("dynamics", {})
     _keys(dyn, {"generator", "gti"}, "dynamics")
     names = []
@@ -394,6 +403,11 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
     up.setdefault("name", "UPQC")
     up["structure"] = _choice(up, "structure", "upqc", STRUCTURES, "conventional")
     up["rating"] = _num(up, "rating", "upqc", 0.2, positive=True)
+    if up["rating"] > MAX_RATING:
+        raise ParameterError("upqc.rating", up["rating"], f"a series voltage above {MAX_RATING:g} "
+                             "pu (the line's nominal voltage) is more than the series "
+                             "transformer and the line can carry; give the UPQC's largest "
+                             "series-voltage magnitude in pu, at most 1.0 (typically 0.1-0.5)")
     if ("branch" in up) == ("insert" in up):
         raise ParameterError("upqc.branch", up.get("branch"), "give either upqc.branch (an "
                              "existing series branch, from = shunt bus) or upqc.insert (a new "
@@ -427,6 +441,10 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                                  "\"bus*.v\"] (omit it to record every signal)")
         if "dt" in sim:
             _num(sim, "dt", "simulation", positive=True)
+            if sim["dt"] > ds["T"]:
+                raise ParameterError("simulation.dt", sim["dt"], f"the integration step must not "
+                                     f"be longer than the controller's sampling period design.T "
+                                     f"({ds['T']:g} s); give dt ≤ T (omit it for dt = T)")
         if "tol" in sim:
             _num(sim, "tol", "simulation", positive=True)
             if not 1e-13 <= sim["tol"] <= 1e-4:
@@ -440,6 +458,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
     if not isinstance(ct["compare"], list) or not ct["compare"]:
         raise ParameterError("controllers.compare", ct["compare"], "give a list of controllers")
     for c in ct["compare"]:
+        check_file_name(c, "controllers.compare")
         kind = ct.get(c, {}).get("kind", c) if isinstance(ct.get(c), dict) else c
         if kind not in CONTROLLER_KINDS:
             raise ParameterError("controllers.compare", c, f"unknown controller; choose from "
@@ -452,7 +471,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         w = f"scenarios.{i}"
         _keys(sc, {"id", "load", "upqc", "t_end", "controllers", "events", "bypass", "quick",
                    "description", "design_load"}, w)
-        sid = _need(sc, "id", w, str)
+        sid = check_file_name(_need(sc, "id", w, str), f"{w}.id")
         if sid in seen:
             raise ParameterError(f"{w}.id", sid, "scenario ids must be unique")
         seen.add(sid)
@@ -465,6 +484,11 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
             raise ParameterError(f"{w}.design_load", sc["design_load"], f"choose one of {loads} "
                                  "(the load the controllers are designed at)")
         sc["t_end"] = _num(sc, "t_end", w, positive=True)
+        step = "simulation.dt" if sim and "dt" in sim else "design.T"
+        dt = (sim or {}).get("dt", ds["T"])
+        if dt >= sc["t_end"]:
+            raise ParameterError(f"{w}.t_end", sc["t_end"], f"the run is not longer than one "
+                                 f"integration step ({step} = {dt:g} s); give t_end > {dt:g} s")
         sc.setdefault("controllers", list(ct["compare"]))
         for c in sc["controllers"]:
             if c not in ct["compare"]:
@@ -473,6 +497,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         evs = sc.setdefault("events", [])
         for j, ev in enumerate(evs):
             _event(ev, f"{w}.events.{j}", sc["t_end"])
+        _events_together(evs, w, up)
         # bypass: default = the fault windows, computed when used (so that it follows the
         # faults when a field is changed later), see Study.scenarios
         for j, b in enumerate(sc.get("bypass", [])):
@@ -482,22 +507,141 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         q = sc.get("quick")
         if q:
             _keys(q, {"t_end", "controllers"}, f"{w}.quick")
+            if "t_end" in q:
+                _num(q, "t_end", f"{w}.quick", positive=True)
+            for c in q.get("controllers", []):
+                if c not in sc["controllers"]:
+                    raise ParameterError(f"{w}.quick.controllers", c, f"not among the "
+                                         f"scenario's controllers {sc['controllers']}")
     rp = d.setdefault("report", {})
     _keys(rp, {"speed_of", "notes"}, "report")
     rp.setdefault("notes", [])
-    d.setdefault("figures", [])
-    d.setdefault("claims", [])
-    for i, c in enumerate(d["claims"]):
-        from .claims import RULES
-
-        _choice(c, "judge", f"claims.{i}", sorted(RULES))
-        for k in ("id", "paper", "rule"):
-            _need(c, k, f"claims.{i}", str)
+    gens = [gen["name"] for gen in dyn["generator"]]
+    if rp.get("speed_of") and g["kind"] not in ("andes", "psse") and rp["speed_of"] not in gens:
+        raise ParameterError("report.speed_of", rp["speed_of"], f"no synchronous machine of "
+                             f"that name in [[dynamics.generator]]; choose one of {gens} or "
+                             "\"\" for no speed panel")
     st = Study(d, source, base_dir)
+    _figures(d, st)
+    _claims(d)
+    _file_controllers(d, st, g, m["name"])
     from .sweep import validate_sweep
 
     validate_sweep(d, st)
     return st
+
+
+MAX_RATING = 1.0   # pu: the largest series-voltage rating a UPQC can have (the line's voltage)
+FIGURE_KEYS = {"id", "title", "label", "panels", "runs"}
+
+
+def _load_levels(g) -> list:
+    loads = g.get("loads") or {}
+    if g["kind"] != "inline":
+        loads = loads.get("levels") or {} if isinstance(loads, dict) else {}
+    return list(loads) if isinstance(loads, dict) else []
+
+
+def _figures(d, study):
+    """``[[figures]]``: known keys, a file-name id, known panels and runs of this study."""
+    from .figures import PANELS
+
+    figs = d.setdefault("figures", [])
+    if not isinstance(figs, list):
+        raise ParameterError("figures", figs, "give [[figures]] tables")
+    runs = {f"{sc['id']}-{c}" for sc in d["scenarios"] for c in sc["controllers"]}
+    seen = set()
+    for i, f in enumerate(figs):
+        w = f"figures.{i}"
+        _keys(f, FIGURE_KEYS, w)
+        fid = check_file_name(_need(f, "id", w, str), f"{w}.id")
+        if fid in seen:
+            raise ParameterError(f"{w}.id", fid, "figure ids must be unique (each is a file "
+                                 "name)")
+        seen.add(fid)
+        _need(f, "title", w, str)
+        for k in _need(f, "panels", w, list):
+            if k not in PANELS:
+                raise ParameterError(f"{w}.panels", k, f"no such panel; choose from "
+                                     f"{sorted(PANELS)}")
+        for j, r in enumerate(_need(f, "runs", w, list)):
+            if not (isinstance(r, list) and len(r) == 2 and all(isinstance(x, str) for x in r)):
+                raise ParameterError(f"{w}.runs.{j}", r, "give [run id, legend label]")
+            if r[0] not in runs:
+                raise ParameterError(f"{w}.runs.{j}", r[0], f"no run of that id in this study "
+                                     f"(run id = scenario id-controller); runs: {sorted(runs)}")
+
+
+def _claims(d):
+    """``[[claims]]``: a known judge with exactly the parameters it takes."""
+    import inspect
+
+    from .claims import RULES
+
+    claims = d.setdefault("claims", [])
+    if not isinstance(claims, list):
+        raise ParameterError("claims", claims, "give [[claims]] tables")
+    for i, c in enumerate(claims):
+        w = f"claims.{i}"
+        if not isinstance(c, dict):
+            raise ParameterError(w, c, "must be a table [[claims]]")
+        judge = _choice(c, "judge", w, sorted(RULES))
+        for k in ("id", "paper", "rule"):
+            _need(c, k, w, str)
+        params = inspect.signature(RULES[judge]).parameters
+        _keys(c, {"id", "case", "paper", "rule", "judge"} | (set(params) - {"m"}), w)
+        for k, p in params.items():
+            if k != "m" and p.default is inspect.Parameter.empty and k not in c:
+                raise ParameterError(f"{w}.{k}", None, f"missing; the judge '{judge}' needs it")
+
+
+def _file_controllers(d, study, g, machine):
+    """Controllers of kind ``file``: the file exists and was trained for this kind of machine."""
+    ct = d["controllers"]
+    kinds = {gen["name"]: "sg" for gen in d["dynamics"]["generator"]}
+    kinds.update({gt["name"]: "gti" for gt in d["dynamics"]["gti"]})
+    for c in ct["compare"]:
+        o = ct.get(c)
+        if not (isinstance(o, dict) and o.get("kind") == "file"):
+            continue
+        path = _need(o, "path", f"controllers.{c}", str)
+        from ..models import load_controller
+
+        p = study.resolve(path)
+        if not p.is_file() and study.base_dir is None:
+            continue     # a study made in Python: the path is read when the controller is built
+        if not p.is_file():
+            raise ParameterError(f"controllers.{c}.path", path, f"no such file ({p}); give a "
+                                 "controller file written by `weakgrid train` or `design`")
+        ctl = load_controller(p)
+        theirs = getattr(ctl.system, "machine", None)
+        ours = kinds.get(machine)
+        if theirs and ours and theirs != ours:
+            raise ParameterError(f"controllers.{c}.path", path, f"the controller was trained for "
+                                 f"a {theirs.upper()} but machine.name = '{machine}' is a "
+                                 f"{ours.upper()}; train one for this study (`weakgrid design`)")
+
+
+def _events_together(evs, w, up):
+    """Events of one scenario: no two faults at one bus at the same time, no trip of the
+    UPQC's own branch."""
+    faults = sorted((ev["t_on"], ev["t_off"], j, ev["bus"]) for j, ev in enumerate(evs)
+                    if ev["kind"] == "fault")
+    for a, (t0, t1, j, bus) in enumerate(faults):
+        for u0, u1, k, bus2 in faults[a + 1:]:
+            if bus2 == bus and u0 < t1:
+                raise ParameterError(f"{w}.events.{max(j, k)}.t_on", u0, f"overlaps the fault "
+                                     f"events.{min(j, k)} at bus {bus} ({t0:g}-{t1:g} s); give "
+                                     "one fault, or let the second start after the first "
+                                     "is cleared")
+    own = {v for v in (up.get("branch"), (up.get("insert") or {}).get("name"), up.get("name"))
+           if isinstance(v, (str, int)) and not isinstance(v, bool)}
+    for j, ev in enumerate(evs):
+        if ev["kind"] == "line_trip" and (ev["branch"] == up.get("branch") or (
+                isinstance(ev["branch"], (str, int)) and ev["branch"] in own)):
+            raise ParameterError(f"{w}.events.{j}.branch", ev["branch"], "is the UPQC's own "
+                                 "series branch: tripping it disconnects the UPQC; trip "
+                                 "another branch")
 
 
 def _event(ev, w, t_end):
@@ -506,6 +650,9 @@ def _event(ev, w, t_end):
         _keys(ev, {"kind", "bus", "t_on", "t_off", "duration", "rf", "xf"}, w)
         _need(ev, "bus", w, (int, str))
         t_on = _num(ev, "t_on", w, nonneg=True)
+        if "duration" in ev and "t_off" in ev:
+            raise ParameterError(f"{w}.duration", ev["duration"], f"t_off ({ev['t_off']!r}) is "
+                                 "given too; give t_off or duration, not both")
         if "duration" in ev:      # t_off from the duration (the duration is not kept)
             ev["t_off"] = t_on + _num(ev, "duration", w, positive=True)
             del ev["duration"]
@@ -521,10 +668,16 @@ def _event(ev, w, t_end):
         _keys(ev, {"kind", "branch", "t", "close"}, w)
         _need(ev, "branch", w, (int, str, dict))
         _num(ev, "t", w, nonneg=True)
+        if ev["t"] >= t_end:
+            raise ParameterError(f"{w}.t", ev["t"], f"after the run's end (t_end = {t_end}); "
+                                 "give t < t_end")
     else:
         _keys(ev, {"kind", "bus", "t", "dP", "dQ"}, w)
         _need(ev, "bus", w, (int, str))
         _num(ev, "t", w, nonneg=True)
+        if ev["t"] >= t_end:
+            raise ParameterError(f"{w}.t", ev["t"], f"after the run's end (t_end = {t_end}); "
+                                 "give t < t_end")
         ev["dP"] = _num(ev, "dP", w, 0.0)
         ev["dQ"] = _num(ev, "dQ", w, 0.0)
 

@@ -38,7 +38,7 @@ from ..sweep import Point, canonical_json, expand, run_sweep
 from .studyfile import get_path, set_path, study_from_dict
 
 __all__ = ["SWEEP_KEYS", "validate_sweep", "sweep_points", "describe_sweep", "run_point",
-           "run_study_sweep"]
+           "run_study_sweep", "claim_sweep_outputs"]
 
 SWEEP_KEYS = {"axes", "mode", "scenarios", "controllers", "t_end", "design_load", "signals",
               "quick", "maps", "dt_check"}
@@ -91,7 +91,7 @@ def validate_sweep(d: dict, study) -> None:
             if not isinstance(vals, list) or not vals:
                 raise ParameterError(f"{where}.\"{path}\"", vals, "give a non-empty list")
             for v in vals:
-                _check_axis_value(d, where, path, v, axes)
+                _check_axis_value(d, where, path, v, axes, study)
     for where, t in (("sweep.t_end", sw.get("t_end")),
                      ("sweep.quick.t_end", (sw.get("quick") or {}).get("t_end"))):
         if t is not None and (isinstance(t, bool) or not isinstance(t, (int, float))
@@ -109,13 +109,55 @@ def validate_sweep(d: dict, study) -> None:
                                          f"{ends[head]} already: sweep the fault's t_off or its "
                                          "duration, not both")
                 ends[head] = path
+    _maps(sw, d)
     for path, vals in (sw.get("dt_check") or {}).items():
         if path not in sw.get("axes", {}) or not isinstance(vals, list):
             raise ParameterError(f"sweep.dt_check.\"{path}\"", vals, "give a list of values of "
                                  "a swept field (a path of [sweep.axes])")
 
 
-def _check_axis_value(d, where, path, value, axes=None):
+MAP_KEYS = {"claim", "id", "title", "kind", "metric", "metrics", "a", "b", "holds_below",
+            "holds_within", "label", "x", "y", "facet"}
+
+
+def _maps(sw, d):
+    """``[[sweep.maps]]``: known keys, kind, controllers of the study, a file-name id, axes
+    among the swept fields."""
+    from ..fileio import check_file_name
+    from .sweep_maps import MAP_KINDS
+
+    maps = sw.get("maps", [])
+    if not isinstance(maps, list):
+        raise ParameterError("sweep.maps", maps, "give [[sweep.maps]] tables")
+    axes = set(sw.get("axes") or {}) | set((sw.get("quick") or {}).get("axes") or {})
+    compare = d["controllers"]["compare"]
+    seen = set()
+    for i, m in enumerate(maps):
+        w = f"sweep.maps.{i}"
+        if not isinstance(m, dict):
+            raise ParameterError(w, m, "must be a table [[sweep.maps]]")
+        extra = sorted(set(m) - MAP_KEYS)
+        if extra:
+            raise ParameterError(f"{w}.{extra[0]}", m[extra[0]], f"unknown field; allowed: "
+                                 f"{sorted(MAP_KEYS)}")
+        if not isinstance(m.get("claim"), str):
+            raise ParameterError(f"{w}.claim", m.get("claim"), "give the claim's id (text)")
+        mid = check_file_name(m.get("id", m["claim"]), f"{w}.id" if "id" in m else f"{w}.claim")
+        if mid in seen:
+            raise ParameterError(f"{w}.id", mid, "map ids must be unique (each is a file name)")
+        seen.add(mid)
+        if m.get("kind") not in MAP_KINDS:
+            raise ParameterError(f"{w}.kind", m.get("kind"), f"choose one of {list(MAP_KINDS)}")
+        for k in ("a", "b"):
+            if k in m and m[k] not in compare:
+                raise ParameterError(f"{w}.{k}", m[k], f"not in controllers.compare {compare}")
+        for k in ("x", "y", "facet"):
+            if k in m and m[k] not in axes:
+                raise ParameterError(f"{w}.{k}", m[k], f"not a swept field; choose one of "
+                                     f"{sorted(axes)}")
+
+
+def _check_axis_value(d, where, path, value, axes=None, study=None):
     """A value of an axis must be valid for its field: the study with it is validated (a
     fault's t_on with the first value of its swept duration, if swept: the end follows it)."""
     trial = {k: copy.deepcopy(v) for k, v in d.items() if k != "sweep"}
@@ -125,7 +167,7 @@ def _check_axis_value(d, where, path, value, axes=None):
         if last == "t_on" and with_end in (axes or {}):
             set_path(trial, with_end, copy.deepcopy(axes[with_end][0]))
         set_path(trial, path, copy.deepcopy(value))
-        study_from_dict(trial)
+        study_from_dict(trial, getattr(study, "source", ""), getattr(study, "base_dir", None))
     except ParameterError as exc:
         fix = exc.fix if exc.field == path else str(exc)
         raise ParameterError(f"{where}.\"{path}\"", value,
@@ -278,19 +320,39 @@ def run_point(inputs: dict):
     return m
 
 
+def claim_sweep_outputs(study, output, quick=False, maps=False, force=False,
+                        write=True) -> Path:
+    """List the files a sweep writes into ``output`` (its table; the maps' files with
+    ``maps``) in the folder's manifest before anything is written; a file of another origin
+    in the way is refused unless ``force`` (:class:`weakgrid.manifest.Manifest`; ``write =
+    False``: only the check, nothing written). Returns the table's path."""
+    from ..manifest import Manifest
+
+    out = Path(output)
+    table_path = out / f"{study.name}-sweep{'-quick' if quick else ''}.parquet"
+    files = [table_path] + ([out / "maps" / f"map-{study.name}-{m.get('id', m['claim'])}.png"
+                             for m in study.data["sweep"].get("maps", [])] if maps else [])
+    m = Manifest(out)
+    (m.claim if write else m.check)(files, force=force)
+    return table_path
+
+
 def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
-                    progress=True, log=None, cache_dir=None) -> pd.DataFrame:
+                    progress=True, log=None, cache_dir=None, force=False,
+                    maps=False) -> pd.DataFrame:
     """Run the study's sweep; write ``<output>/<study>-sweep.parquet``; return the table.
 
     The cache (``<output>/cache`` unless given) keeps every finished run: an interrupted
-    sweep resumes, a repeated one runs nothing.
+    sweep resumes, a repeated one runs nothing. The table (and the maps' files, ``maps``)
+    are listed in the folder's manifest before they are written; a file of another origin
+    in the way stops the sweep before any run unless ``force``
+    (:class:`weakgrid.manifest.Manifest`).
     """
     from .sweep_estimate import run_cost
 
     out = Path(output)
-    out.mkdir(parents=True, exist_ok=True)
+    table_path = claim_sweep_outputs(study, out, quick, maps, force)
     pts = sweep_points(study, quick)
     return run_sweep(pts, run_point, cache_dir=cache_dir or out / "cache", scheduler=scheduler,
                      workers=workers, progress=progress, log=log, cost=run_cost,
-                     table_path=out / f"{study.name}-sweep{'-quick' if quick else ''}.parquet",
-                     desc=f"sweep {study.name}")
+                     table_path=table_path, desc=f"sweep {study.name}")

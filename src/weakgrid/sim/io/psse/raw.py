@@ -185,6 +185,39 @@ def _section_of(comment: str):
     return None
 
 
+_ID_RECORD = "case identification (IC, SBASE, REV, XFRRAT, NXFRAT, BASFRQ)"
+
+
+def _version(rd, f0, ln0, rec) -> int:
+    """``REV`` of the case identification record, one of :data:`VERSIONS`."""
+    rev_f = f0[2] if len(f0) > 2 else None
+    if rev_f is None or rev_f.text is None:
+        raise DataError(rd.where(ln0, rec), "REV", None,
+                        "the case identification gives no PSS/E version; weakgrid reads versions "
+                        "29 to 35: save the case from PSS/E with one of them (rawd_2 ... vernum)")
+    rev = rd.num(f0, 2, "REV", ln0, rec)
+    if rev != int(rev) or int(rev) not in VERSIONS:
+        raise DataError(rd.where(ln0, rec), "REV", rev_f.text,
+                        f"the file claims PSS/E version {rev_f.text}; weakgrid reads PSS/E .raw "
+                        "versions 29 to 35; convert the case (e.g. save it from PSS/E as "
+                        "version 33)")
+    return int(rev)
+
+
+def raw_version(path) -> int:
+    """The PSS/E version (``REV``) a ``.raw`` file claims, checked to be one of 29-35 (as
+    :func:`read_raw` checks it) without reading the rest: for readers of other libraries
+    that would misread a layout they do not know."""
+    path = Path(path)
+    rd = _Reader(path)
+    with open(path, encoding="latin-1") as fh:
+        for k, s in enumerate(fh):
+            if not s.lstrip().startswith("@!"):
+                f0, _ = split_line(s.rstrip("\n"))
+                return _version(rd, f0, k + 1, _ID_RECORD)
+    raise DataError(rd.where(1, "case identification"), "IC", None, "the file is empty")
+
+
 def read_raw(path) -> RawCase:
     """Read a PSS/E ``.raw`` file (versions 29-35).
 
@@ -214,21 +247,11 @@ def read_raw(path) -> RawCase:
         raise DataError(rd.where(1, "case identification"), "IC", None, "the file is empty")
     ln0, s0 = numbered[0]
     f0, _ = split_line(s0)
-    rec = "case identification (IC, SBASE, REV, XFRRAT, NXFRAT, BASFRQ)"
+    rec = _ID_RECORD
     sbase = rd.num(f0, 1, "SBASE", ln0, rec, default=100.0)
     if not sbase > 0:
         raise DataError(rd.where(ln0, rec), "SBASE", sbase, "the system base must be > 0 MVA")
-    rev_f = f0[2] if len(f0) > 2 else None
-    if rev_f is None or rev_f.text is None:
-        raise DataError(rd.where(ln0, rec), "REV", None,
-                        "the case identification gives no PSS/E version; weakgrid reads versions "
-                        "29 to 35: save the case from PSS/E with one of them (rawd_2 ... vernum)")
-    rev = rd.num(f0, 2, "REV", ln0, rec)
-    if rev != int(rev) or int(rev) not in VERSIONS:
-        raise DataError(rd.where(ln0, rec), "REV", rev_f.text,
-                        "weakgrid reads PSS/E .raw versions 29 to 35; convert the case "
-                        "(e.g. save it from PSS/E as version 33)")
-    version = int(rev)
+    version = _version(rd, f0, ln0, rec)
     basfrq = rd.num(f0, 5, "BASFRQ", ln0, rec, default=60.0)
     if not basfrq > 0:
         basfrq = 60.0
