@@ -80,9 +80,9 @@ def test_run_validates_the_value_set(capsys, tmp_path):
 
 
 def test_set_reaches_optional_fields_and_array_elements_by_id():
-    st = load_study("case1-weak-grid", [("simulation.dt", 0.002),
+    st = load_study("case1-weak-grid", [("simulation.dt", 0.0004),
                                         ("scenarios.c1-low-red.t_end", 7.5)])
-    assert st.get("simulation.dt") == 0.002
+    assert st.get("simulation.dt") == 0.0004
     assert st.get("scenarios.c1-low-red.t_end") == 7.5
     assert load_study("case1-weak-grid").get("scenarios.c1-low-red.t_end") != 7.5
     with pytest.raises(ParameterError, match="report"):
