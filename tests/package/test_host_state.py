@@ -1,5 +1,6 @@
 """weakgrid leaves its host alone: importing it, drawing its figures and building a grid
-change neither matplotlib's backend nor its rcParams nor any logger that is not weakgrid's.
+change neither matplotlib's backend nor its rcParams nor any logger that is not weakgrid's
+(nor the warnings filters, nor NumPy's error and print options).
 
 Each check runs in a fresh interpreter whose matplotlib backend is ``svg`` (not Agg), so
 that a switch to Agg (what ``weakgrid.study.figures`` did at import) is seen.
@@ -30,7 +31,10 @@ def state():
     levels = {n: lg.level for n, lg in logging.Logger.manager.loggerDict.items()
               if isinstance(lg, logging.Logger) and not n.startswith("weakgrid")}
     levels["<root>"] = logging.getLogger().level
-    return {"backend": matplotlib.get_backend(), "rc": rc, "levels": levels}
+    import warnings
+    other = {"warnings.filters": repr(warnings.filters), "numpy.geterr": repr(numpy.geterr()),
+             "numpy.printoptions": repr(numpy.get_printoptions())}
+    return {"backend": matplotlib.get_backend(), "rc": rc, "levels": levels, "other": other}
 
 before = state()
 """
@@ -41,7 +45,9 @@ out = {"backend": [before["backend"], after["backend"]],
        "rc": sorted(k for k in before["rc"] if before["rc"][k] != after["rc"].get(k)),
        # a logger that did not exist before (or was a placeholder) counts as NOTSET
        "levels": sorted(n for n in set(before["levels"]) | set(after["levels"])
-                        if before["levels"].get(n, 0) != after["levels"].get(n, 0))}
+                        if before["levels"].get(n, 0) != after["levels"].get(n, 0)),
+       # process-wide settings of the standard library and NumPy
+       "other": sorted(k for k in before["other"] if before["other"][k] != after["other"][k])}
 print("STATE" + json.dumps(out))
 """
 
@@ -64,6 +70,7 @@ def _assert_untouched(out):
     assert out["backend"] == ["svg", "svg"], f"backend switched: {out['backend']}"
     assert out["rc"] == [], f"rcParams changed: {out['rc']}"
     assert out["levels"] == [], f"logger levels changed: {out['levels']}"
+    assert out["other"] == [], f"process-wide settings changed: {out['other']}"
 
 
 #: the optional extras' top-level modules: a module that needs one may fail to import without it
