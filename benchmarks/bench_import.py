@@ -13,6 +13,7 @@ import statistics
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 CASES = {
     "python -c 'import numpy' (peer)": [sys.executable, "-c", "import numpy"],
@@ -21,6 +22,10 @@ CASES = {
                         "sys.argv = ['weakgrid', '--help']; sys.exit(main())"],
     "python -c 'import weakgrid.sim'": [sys.executable, "-c", "import weakgrid.sim"],
 }
+#: the installed console script itself, where this interpreter has one (an install, not PYTHONPATH)
+_SCRIPT = Path(sys.executable).with_name("weakgrid")
+if _SCRIPT.is_file():
+    CASES["weakgrid --help (console script)"] = [str(_SCRIPT), "--help"]
 
 
 def wall(cmd) -> float:

@@ -45,7 +45,7 @@ ANDES with its tolerance tightened to 1e-8: a deviation that shrinks with the st
 tools' step (discretization) error, not a model difference.
 
 Run:  PYTHONPATH=src python benchmarks/bench_scale.py [--repeat 3] [--cases kundur_full,case118]
-      [--solver auto|dense|sparse] [--lu klu|superlu] [--tools weakgrid,andes]
+      [--solver auto|dense|sparse] [--lu auto|klu|superlu] [--tools weakgrid,andes]
 """
 
 from __future__ import annotations
@@ -211,7 +211,7 @@ def main():
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--solver", default="auto", choices=["auto", "dense", "sparse"])
-    ap.add_argument("--lu", default="klu", choices=["klu", "superlu"])
+    ap.add_argument("--lu", default="auto", choices=["auto", "klu", "superlu"])
     ap.add_argument("--tools", default="weakgrid,andes")
     ap.add_argument("--child")
     ap.add_argument("--out")
@@ -233,7 +233,10 @@ def main():
         print(json.dumps(info))
         return
     tools = a.tools.split(",")
-    print(f"10 s, step 1/120 s, fault 1.0-1.05 s; median of {a.repeat}; weakgrid solver={a.solver} lu={a.lu}")
+    from weakgrid.sim.linsolve import sparse_lu
+
+    print(f"10 s, step 1/120 s, fault 1.0-1.05 s; median of {a.repeat}; weakgrid solver={a.solver} "
+          f"lu={a.lu} ({sparse_lu(a.lu)} where sparse)")
     hdr = ("| case | DAE size (weakgrid / ANDES) | weakgrid | ANDES | weakgrid / ANDES | speed-up |"
            " max speed deviation [pu] | standard models [pu] | peak memory weakgrid / ANDES [MB] |")
     print(hdr)

@@ -4,6 +4,8 @@ Oracles: the dense path (same trajectories to 1e-10), the dense first-fit colour
 the dense Ybus, and the power-flow equilibrium of a freshly initialized system.
 """
 
+import sys
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -14,7 +16,7 @@ from sim_cases import build_gti_upqc_sg, two_machine_case
 from weakgrid.sim.errors import DataError
 from weakgrid.sim.events import Fault, LineTrip
 from weakgrid.sim.integrate import Simulator
-from weakgrid.sim.linsolve import DenseSolver, SparseSolver, make_solver
+from weakgrid.sim.linsolve import DenseSolver, SparseSolver, make_solver, sparse_lu
 from weakgrid.sim.system import System, colour_columns
 
 
@@ -71,8 +73,14 @@ def test_sparse_jacobian_equals_dense(gus):
     np.testing.assert_allclose(gus.jacobian_sparse(0.0, z).toarray(), gus.jacobian(0.0, z), rtol=0, atol=1e-12)
 
 
+def _lu_available(lu):
+    if lu == "klu":
+        pytest.importorskip("kvxopt", reason="KLU needs the extra weakgrid[klu]")
+
+
 @pytest.mark.parametrize("lu", ["klu", "superlu"])
 def test_sparse_factorizations_solve_like_dense(gus, lu):
+    _lu_available(lu)
     z = gus.z0
     d, s = DenseSolver(gus), SparseSolver(gus, lu=lu)
     vals = gus.device_jacobian_values(0.0, z)
@@ -85,6 +93,25 @@ def test_sparse_factorizations_solve_like_dense(gus, lu):
                                    rtol=1e-9, atol=1e-11)
         np.testing.assert_allclose(s.factor_algebraic().solve(b[gus.nx:]), d.factor_algebraic().solve(b[gus.nx:]),
                                    rtol=1e-9, atol=1e-11)
+
+
+def test_sparse_lu_without_kvxopt(gus, monkeypatch):
+    """Without kvxopt (the base install) "auto" is SuperLU and an explicit "klu" is an error
+    naming the extra (it used to switch to SuperLU silently, so a benchmark's "--lu klu" could
+    time SuperLU)."""
+    monkeypatch.setitem(sys.modules, "kvxopt", None)      # import kvxopt -> ImportError
+    assert sparse_lu() == "superlu"
+    assert SparseSolver(gus).lu == "superlu"
+    with pytest.raises(DataError, match=r"weakgrid\[klu\]"):
+        SparseSolver(gus, lu="klu")
+    with pytest.raises(DataError, match="'lu'"):
+        sparse_lu("umfpack")
+
+
+def test_sparse_lu_auto_is_klu_with_kvxopt(gus):
+    pytest.importorskip("kvxopt", reason="KLU needs the extra weakgrid[klu]")
+    assert sparse_lu("auto") == "klu" and SparseSolver(gus).lu == "klu"
+    assert SparseSolver(gus, lu="superlu").lu == "superlu"
 
 
 def test_make_solver_choice_and_bad_kind(gus):
@@ -218,6 +245,7 @@ def test_sparse_pattern_is_complete_and_colouring_exact(which, gus):
 def test_singular_matrix_gives_nan_not_a_traceback(gus, lu):
     """A singular matrix (no device derivatives, network switched to all zeros) is reported as
     NaN solutions, which the integrator handles as a failed iteration."""
+    _lu_available(lu)
     nx = gus.nx
     saved = gus.Yr_coo
     try:

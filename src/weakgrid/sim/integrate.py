@@ -83,9 +83,11 @@ class Simulator:
         Record every n-th step (breakpoints are always recorded).
     linear_solver : {"auto", "dense", "sparse"}
         Linear algebra backend (:mod:`weakgrid.sim.linsolve`): ``"auto"`` is dense
-        for small systems and sparse (KLU) for large ones.
-    sparse_lu : {"klu", "superlu"}
-        Sparse LU library of the sparse backend.
+        for small systems and sparse for large ones.
+    sparse_lu : {"auto", "klu", "superlu"}
+        Sparse LU library of the sparse backend: ``"auto"`` is KLU when ``kvxopt`` (the
+        extra ``weakgrid[klu]``) is installed, else SciPy's SuperLU
+        (:func:`weakgrid.sim.linsolve.sparse_lu`).
     record : None, "all", "machines" or list of str
         What :meth:`run` records (:meth:`Results.recorder`): ``None`` records
         everything for small systems and the machine speeds and angles for large
@@ -93,7 +95,7 @@ class Simulator:
     """
 
     def __init__(self, system, dt=1 / 120, tol=None, max_iter=8, max_angle_spread=180.0,
-                 save_every=1, min_step=None, linear_solver="auto", sparse_lu="klu", record=None):
+                 save_every=1, min_step=None, linear_solver="auto", sparse_lu="auto", record=None):
         if not system.is_setup:
             system.setup()
         if not dt > 0:

@@ -17,12 +17,14 @@ Two backends implement :class:`LinearSolver`:
 :class:`SparseSolver`
     The full pattern (device pattern ∪ network pattern with every branch ∪ the
     diagonal) is fixed once, so matrices are assembled in O(nnz) with one
-    ``bincount`` into CSC arrays. The LU is **KLU** (SuiteSparse, through
-    ``kvxopt``, which ANDES also uses): the symbolic analysis (BTF + AMD
-    ordering) is done once per matrix kind and reused by every numeric
-    refactorization. ``lu="superlu"`` uses SciPy's SuperLU instead, with the
-    COLAMD column ordering of the first factorization reused (SciPy's SuperLU
-    has no separate symbolic step).
+    ``bincount`` into CSC arrays. The LU is SciPy's **SuperLU** (``lu="superlu"``),
+    with the COLAMD column ordering of the first factorization reused (SciPy's
+    SuperLU has no separate symbolic step), or **KLU** (``lu="klu"``: SuiteSparse
+    through ``kvxopt``, which ANDES also uses; the extra ``weakgrid[klu]``,
+    GPL-3.0-or-later): the symbolic analysis (BTF + AMD ordering) is done once per
+    matrix kind and reused by every numeric refactorization. ``lu="auto"`` (the
+    default) takes KLU when ``kvxopt`` is installed and SuperLU otherwise
+    (``benchmarks/bench_lu.py`` measures the difference).
 
 :func:`make_solver` chooses: ``"auto"`` takes dense up to
 :data:`DENSE_MAX_VARS` variables and sparse above (the crossover measured by
@@ -223,19 +225,14 @@ class _SuperLUFactor:
 
 
 class SparseSolver(LinearSolver):
-    """Sparse matrices on a pattern fixed at construction, KLU (default) or SuperLU."""
+    """Sparse matrices on a pattern fixed at construction, KLU or SuperLU (:func:`sparse_lu`)."""
 
     name = "sparse"
 
-    def __init__(self, system, lu="klu"):
+    def __init__(self, system, lu="auto"):
         super().__init__(system)
-        if lu not in ("klu", "superlu"):
-            raise DataError("linear solver", "lu", lu, "use 'klu' or 'superlu'")
-        if lu == "klu":
-            try:
-                import kvxopt  # noqa: F401
-            except ImportError:
-                lu = "superlu"
+        lu = sparse_lu(lu)
+        #: the sparse LU library in use, ``"klu"`` or ``"superlu"``
         self.lu = lu
         N, nx = self.N, self.nx
         s = system
@@ -280,15 +277,43 @@ class SparseSolver(LinearSolver):
         return self._alg_lu.factor(self.alg_pat.data(vals))
 
 
-def make_solver(system, kind: str = "auto", lu: str = "klu") -> LinearSolver:
+def sparse_lu(lu: str = "auto") -> str:
+    """The sparse LU library for ``lu``: ``"klu"`` or ``"superlu"``.
+
+    ``"auto"`` is KLU when ``kvxopt`` is installed (the extra ``weakgrid[klu]``, or with
+    ANDES), else SciPy's SuperLU. An explicit ``"klu"`` without ``kvxopt`` is an error
+    naming the extra, not a silent switch to SuperLU.
+
+    Raises
+    ------
+    DataError
+        ``lu`` is not one of ``"auto"``, ``"klu"``, ``"superlu"``, or ``"klu"`` without
+        ``kvxopt``.
+    """
+    if lu not in ("auto", "klu", "superlu"):
+        raise DataError("linear solver", "lu", lu, "use 'auto', 'klu' or 'superlu'")
+    if lu == "superlu":
+        return lu
+    try:
+        import kvxopt  # noqa: F401
+    except ImportError:
+        if lu == "klu":
+            raise DataError("linear solver", "lu", lu,
+                            "KLU needs kvxopt: pip install 'weakgrid[klu]' (GPL-3.0-or-later), "
+                            "or use 'superlu' or 'auto'") from None
+        return "superlu"
+    return "klu"
+
+
+def make_solver(system, kind: str = "auto", lu: str = "auto") -> LinearSolver:
     """The linear solver for ``system``.
 
     Parameters
     ----------
     kind : {"auto", "dense", "sparse"}
         ``"auto"``: dense up to :data:`DENSE_MAX_VARS` DAE variables, sparse above.
-    lu : {"klu", "superlu"}
-        Sparse LU library (sparse backend only).
+    lu : {"auto", "klu", "superlu"}
+        Sparse LU library (sparse backend only; :func:`sparse_lu`).
     """
     if kind == "auto":
         kind = "dense" if system.N <= DENSE_MAX_VARS else "sparse"
