@@ -95,16 +95,29 @@ class Setup:
 
 
 def _bus_ref(ref, bus_id, network, where):
-    if isinstance(ref, str):
-        if ref not in bus_id:
-            raise ParameterError(where, ref, f"no bus of that name; e.g. {list(bus_id)[:8]}")
+    """Simulator bus number of a study's bus reference: a bus number of the source (PSS/E,
+    MATPOWER, ANDES idx, pandapower index) or a name of the source (``bus_id``: name → number).
+    An unknown reference raises :class:`ParameterError` listing some of the grid's buses."""
+    if isinstance(ref, str) and ref in bus_id:
         return int(bus_id[ref])
     if isinstance(ref, (int, np.integer)) and not isinstance(ref, bool):
-        if ref in bus_id:                      # pandapower index → simulator bus
+        if ref in bus_id:                      # pandapower index (the simulator bus number)
             return int(bus_id[ref])
-        if int(ref) in set(int(b) for b in network.bus_ids):
+        if int(ref) in network._pos:
             return int(ref)
-    raise ParameterError(where, ref, "give a bus number or name of this grid")
+    raise ParameterError(where, ref, f"no such bus in this grid; {bus_choices(bus_id, network)}")
+
+
+def bus_choices(bus_id, network, n=8) -> str:
+    """A few of a grid's bus numbers and names, for an error message."""
+    nums = [int(b) for b in network.bus_ids]
+    names = [k for k in bus_id if isinstance(k, str) and k != str(bus_id[k])]
+    text = f"bus numbers: {nums[:n]}{' …' if len(nums) > n else ''}"
+    if names:
+        text += f"; names: {names[:n]}{' …' if len(names) > n else ''}"
+    elif any(isinstance(k, str) for k in bus_id):
+        text += " (also as strings, e.g. \"" + str(nums[0]) + "\")"
+    return text
 
 
 # ----------------------------------------------------------------------------- grids
@@ -213,12 +226,6 @@ def _pandapower_net(g, load):
     return net, bus_of, bref
 
 
-def _pp_bus_ids(net) -> dict:
-    """pandapower bus index → simulator (ppc) bus number, after the conversion."""
-    lk = net._pd2ppc_lookups["bus"]        # set by pandapower's to_ppc (used only here)
-    return {int(i): int(lk[i]) for i in net.bus.index}
-
-
 # ----------------------------------------------------------------------------- setup
 def _network(study, load):
     """``(Network, bus_id name→number, branch names, upqc row, System or None)`` at ``load``."""
@@ -247,7 +254,7 @@ def _network(study, load):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             network = Network.from_pandapower(net)
-        ids = _pp_bus_ids(net)
+        ids = network.pandapower_bus     # pandapower index -> simulator bus (the same index)
         bus_id = {n: ids[i] for n, i in bus_of.items()}
         bus_id.update({i: ids[i] for i in net.bus.index})
         if ends is None:
@@ -335,6 +342,7 @@ def _andes_network(study, g, up):
         net = system.network
         case, k_up, _, _ = insert_upqc_matpower(net.case, names[ref], ins["side"],
                                                 ins.get("r", 0.0), ins["x"])
+        case.update(branch_names=list(net.branch_names), bus_names=net.bus_names)
         system.network = Network(case, f_hz=net.f_hz)
         names[up["name"]] = k_up
         return system.network, bus_id, names, k_up, system
@@ -389,10 +397,25 @@ def _psse_network(study, g, up):
         case, k_up, _, _ = insert_upqc_matpower(net.case, k_ref, ins["side"], ins.get("r", 0.0), ins["x"])
         case.update(series_capacitors=sorted(net.series_capacitors),
                     negative_resistance=sorted(net.negative_resistance))
+        case.update(branch_names=list(net.branch_names), bus_names=net.bus_names)
         system.network = Network(case, f_hz=net.f_hz)
         names[up["name"]] = k_up
         return system.network, bus_id, names, k_up, system
     return net, bus_id, names, k_ref, system
+
+
+def _source_names(network, bus_id, br_names):
+    """One set of identifiers for the study file, the printouts and the results: the source's
+    bus names and branch names of ``network`` join the study's (``bus_id``, ``br_names``,
+    completed in place), and the study's branch names label the network's rows."""
+    for num, name in network.bus_names.items():
+        bus_id.setdefault(name, int(num))
+    for k, name in enumerate(network.branch_names):
+        if name is not None:
+            br_names.setdefault(name, k)
+    for name, k in br_names.items():
+        if network.branch_names[k] is None:
+            network.branch_names[k] = name
 
 
 def build_setup(study, load: str | None = None, upqc: str | None = None,
@@ -407,6 +430,7 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
         raise ParameterError("variant", variant, f"choose one of {VARIANTS}")
     with quiet_loggers("pandapower", "andes"):   # their parsers' notes; restored after
         network, bus_id, br_names, k_up, system = _network(study, load)
+    _source_names(network, bus_id, br_names)
     if d["upqc"].get("side", "from") == "to":     # the branch's to-bus is the shunt bus r
         row = network.branch[k_up]
         row[F_BUS], row[T_BUS] = row[T_BUS], row[F_BUS]
