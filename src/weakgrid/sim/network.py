@@ -81,7 +81,7 @@ class Network:
         case key ``bus_names``.
     branch_names : list
         Each branch row's identifier in its source (PSS/E ``"I-J-CKT"``, an ANDES ``Line`` idx,
-        pandapower ``"line 3"``, a study's branch name), or None; optional case key
+        pandapower ``"line_3"``, a study's branch name), or None; optional case key
         ``branch_names``. :meth:`branch_label` prints them.
     """
 
@@ -423,9 +423,9 @@ class Network:
         ``pandapower_bus`` maps every pandapower bus index to its number, ``bus_names`` each
         number to the pandapower bus name (where it has one), ``branch_names`` each branch row
         to its element and ``gen_names`` each gen row to its ``ext_grid`` or ``gen``: the
-        element's name where it is unique and non-empty, else ``"<table> <index>"`` (``"line
-        3"``, ``"trafo 0"``, ``"gen 1"``); ``gen_source`` holds ``(table, index, name)`` per gen
-        row.
+        element's name where it is unique and non-empty, else ``"<table>_<index>"``
+        (``"line_3"``, ``"trafo_0"``, ``"gen_1"``); ``gen_source`` holds ``(table, index, name)``
+        per gen row.
         """
         from pandapower.converter.pypower import to_ppc
 
@@ -488,18 +488,18 @@ class Network:
 
 def _element_names(elements) -> list:
     """pandapower elements ``(table, index, name)`` (or None) as identifiers: the element's
-    name where it is a non-empty string that no other element has, else ``"<table> <index>"``."""
+    name where it is a non-empty string that no other element has, else ``"<table>_<index>"``."""
     text = _text
     count = {}
     for e in elements:
         if e is not None and text(e[2]):
             count[text(e[2])] = count.get(text(e[2]), 0) + 1
     out = [None if e is None else (text(e[2]) if text(e[2]) and count[text(e[2])] == 1
-                                   else f"{e[0]} {e[1]}") for e in elements]
+                                   else f"{e[0]}_{e[1]}") for e in elements]
     taken = set()
-    for k, n in enumerate(out):           # a name equal to another's "<table> <index>"
+    for k, n in enumerate(out):           # a name equal to another's "<table>_<index>"
         if n is not None and n in taken:
-            out[k] = f"{elements[k][0]} {elements[k][1]}"
+            out[k] = f"{elements[k][0]}_{elements[k][1]}"
         taken.add(out[k])
     return out
 
