@@ -15,7 +15,8 @@ Grid kinds (``[grid] kind``):
 * ``matpower`` — ``file`` (a ``.m``/``.mat`` case); ``loads.levels`` scale PD, QD.
 * ``andes`` — ``file`` (any case ANDES parses: PSS/E ``.raw``, ``.xlsx``, ``.json``; ``andes:``
   prefix for ANDES's stock cases) and ``dyr`` (PSS/E dynamic data): machines and controls come
-  from the file (named ``GENROU_<idx>`` …), the UPQC is an existing ``Line`` (``upqc.branch`` =
+  from the file (named ``<MODEL>_<idx>``: ``GENROU_4``, kundur's ``GENROU_1``; buses keep their
+  integer idx), the UPQC is an existing ``Line`` (``upqc.branch`` =
   its idx; ``upqc.side = "to"`` when its bus2 is the shunt bus) or inserted into one
   (``upqc.insert = {branch = idx, side, r, x}``, pu on the system base).
 * ``psse`` — ``raw`` (PSS/E ``.raw``, versions 29-35) and ``dyr`` (optional), paths relative to
@@ -25,7 +26,12 @@ Grid kinds (``[grid] kind``):
   branch (``upqc.branch = "I-J-CKT"``, e.g. ``"101-102-1"``, or ``{from, to}``) or inserted into
   one (``upqc.insert = {branch = "I-J-CKT", side, r, x}``, pu on the system base).
 
-Buses are referred to by external number (inline/matpower), or by pandapower name or index.
+Buses are referred to by the source's number (inline/matpower/PSS/E, an ANDES idx), by name
+(PSS/E ``.raw``, ANDES ``Bus.name``, pandapower, inline), or by pandapower index — which is the
+simulator's bus number of a pandapower grid, so results (``bus<number>.v``), events and the
+design printout use one numbering. Branches (events, ``upqc.branch``) by the source's names
+(PSS/E ``"I-J-CKT"``, ANDES ``Line`` idx, a pandapower element's name or ``"line_3"``, an inline
+branch's name), ``{from, to}`` buses, or a 0-based row.
 The UPQC is either an existing series branch (``upqc.branch``: a branch name, a row, or
 ``{from, to}``; from = the shunt bus r) or inserted into a branch (``upqc.insert``, see
 :mod:`weakgrid.design.upqc_insert`).
@@ -90,7 +96,8 @@ class Setup:
     state_map: object = None
 
     def bus(self, ref, where="bus") -> int:
-        """External bus number of a bus reference (number, or name)."""
+        """Simulator bus number of a bus reference (the source's number or name; a pandapower
+        index); :class:`ParameterError` listing some of the grid's buses if unknown."""
         return _bus_ref(ref, self.bus_id, self.system.network, where)
 
 
