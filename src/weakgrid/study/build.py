@@ -417,6 +417,9 @@ def _source_names(network, bus_id, br_names):
     completed in place), and the study's branch names label the network's rows."""
     for num, name in network.bus_names.items():
         bus_id.setdefault(name, int(num))
+    for name, num in bus_id.items():     # the study's own bus names (inline grids)
+        if isinstance(name, str) and name != str(num):
+            network.bus_names.setdefault(int(num), name)
     for k, name in enumerate(network.branch_names):
         if name is not None:
             br_names.setdefault(name, k)

@@ -439,9 +439,10 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
         if b1 != b2:
             raise DataError(f"ANDES Line {line.idx.v[k]}", "b1", b1, "asymmetric line charging (b1 != b2) unsupported")
         tap = _raw(line, "tap")[k]
-        L[kk, :] = [num[line.bus1.v[k]], num[line.bus2.v[k]], _raw(line, "r")[k] * zc, _raw(line, "x")[k] * zc, (b + b1 + b2) / zc,
-                   0, 0, 0, 0 if tap == 1 else tap, np.degrees(_raw(line, "phi")[k]),
-                   1 if _raw(line, "u")[k] > 0 else 0, -360, 360]
+        L[kk, :] = [num[line.bus1.v[k]], num[line.bus2.v[k]], _raw(line, "r")[k] * zc,
+                    _raw(line, "x")[k] * zc, (b + b1 + b2) / zc,
+                    0, 0, 0, 0 if tap == 1 else tap, np.degrees(_raw(line, "phi")[k]),
+                    1 if _raw(line, "u")[k] > 0 else 0, -360, 360]
     L = L[:len(lrow)]
     bus_name = dict(zip(bus.idx.v, bus.name.v)) if "name" in bus.params else {}
     case = {"baseMVA": Sb, "bus": B, "gen": np.array(G), "branch": L,
@@ -462,7 +463,7 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
         if key not in names_of:
             taken = set(names_of.values())
             name = device_name(mname, ix)
-            if name in taken:        # e.g. a GENROU "GENROU_1" and a GENROU 1: keep both apart
+            if name in taken:        # a kept idx ("GENROU_1") meets a GENROU 1: prefix it
                 name = f"{mname}_{str(ix).strip()}"
             if name in taken:
                 raise DataError(f"ANDES {mname} {ix}", "idx", ix,
