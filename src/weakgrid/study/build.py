@@ -186,7 +186,8 @@ def _pandapower_net(g, load):
                                          f"{list(bus_of)[:8]}")
                 return bus_of[ref]
             if ref not in net.bus.index:
-                raise ParameterError(where, ref, "no bus with that pandapower index")
+                raise ParameterError(where, ref, "no bus with that pandapower index; e.g. "
+                                     f"{list(net.bus.index[:8])}, or a name {list(bus_of)[:8]}")
             return int(ref)
 
         ld = g.get("loads", {})
