@@ -162,10 +162,25 @@ def test_pandapower_bus_index_and_element_names():
     assert "GENCLS_Hydro.omega" in res.names and "bus30.v" in res.names
 
 
-def test_pandapower_fused_and_generated_names():
+def test_pandapower_fused_buses_take_the_smallest_index():
+    import pandapower as pp
+
+    from weakgrid.sim.network import Network
+
+    net = _pandapower_net()
+    pp.create_bus(net, 110.0, index=40, name="Mine B")
+    pp.create_switch(net, 30, 40, et="b", closed=True)      # fused with bus 30 by the conversion
+    nw = Network.from_pandapower(net)
+    assert nw.pandapower_bus[40] == nw.pandapower_bus[30] == 30
+    assert [int(b) for b in nw.bus_ids] == [10, 20, 30]
+
+
+def test_pandapower_generated_names_are_unique():
     from weakgrid.sim.network import _element_names
 
     # duplicate or empty names fall back to "<table>_<index>", so every id stays unique
     got = _element_names([("gen", 0, "A"), ("gen", 1, "A"), ("gen", 2, None), None,
-                          ("ext_grid", 0, "gen_2")])
-    assert got == ["gen_0", "gen_1", "gen_2", None, "ext_grid_0"]
+                          ("ext_grid", 0, "gen_2"), ("ext_grid", 1, "Hydro")])
+    assert got == ["gen_0", "gen_1", "gen_2", None, "ext_grid_0", "Hydro"]
+    got = _element_names([("ext_grid", 0, "gen_1"), ("gen", 1, None)])   # named first
+    assert got == ["ext_grid_0", "gen_1"]

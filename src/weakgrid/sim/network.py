@@ -488,19 +488,18 @@ class Network:
 
 def _element_names(elements) -> list:
     """pandapower elements ``(table, index, name)`` (or None) as identifiers: the element's
-    name where it is a non-empty string that no other element has, else ``"<table>_<index>"``."""
-    text = _text
+    name where it is a non-empty string that no other element has (and that is not another
+    element's ``"<table>_<index>"``), else ``"<table>_<index>"``; unique by construction."""
+    own = [None if e is None else f"{e[0]}_{e[1]}" for e in elements]
+    reserved = {o for o in own if o is not None}
     count = {}
     for e in elements:
-        if e is not None and text(e[2]):
-            count[text(e[2])] = count.get(text(e[2]), 0) + 1
-    out = [None if e is None else (text(e[2]) if text(e[2]) and count[text(e[2])] == 1
-                                   else f"{e[0]}_{e[1]}") for e in elements]
-    taken = set()
-    for k, n in enumerate(out):           # a name equal to another's "<table>_<index>"
-        if n is not None and n in taken:
-            out[k] = f"{elements[k][0]}_{elements[k][1]}"
-        taken.add(out[k])
+        if e is not None and _text(e[2]):
+            count[_text(e[2])] = count.get(_text(e[2]), 0) + 1
+    out = []
+    for e, o in zip(elements, own):
+        t = None if e is None else _text(e[2])
+        out.append(t if t and count[t] == 1 and (t not in reserved or t == o) else o)
     return out
 
 
