@@ -6,7 +6,7 @@ import pytest
 andes = pytest.importorskip("andes")
 
 from weakgrid.sim.errors import DataError  # noqa: E402
-from weakgrid.sim.io.andes import _supported, from_andes  # noqa: E402
+from weakgrid.sim.io.andes import _supported, device_name, from_andes  # noqa: E402
 from weakgrid.sim.peer.andes_case import load_case  # noqa: E402
 
 pytestmark = pytest.mark.andes
@@ -119,8 +119,9 @@ def test_ieeevc_links_to_the_machine_of_its_exciter():
         avr_syn.update(zip(ss.models[name].idx.v, ss.models[name].syn.v))
     system, _ = from_andes(ss, conventions="andes")
     vc = system.components["IEEEVC"]
-    assert vc.names == [f"IEEEVC_{i}" for i in ss.IEEEVC.idx.v]
-    assert [lk["machine"] for lk in vc.links] == [f"GENROU_{avr_syn[a]}" for a in ss.IEEEVC.avr.v]
+    assert vc.names == [device_name("IEEEVC", i) for i in ss.IEEEVC.idx.v]
+    assert [lk["machine"] for lk in vc.links] == [device_name("GENROU", avr_syn[a])
+                                                  for a in ss.IEEEVC.avr.v]
     assert [v["on_Sb"] for v in vc._values] == [1.0, 1.0]
     system.setup()
     F, _ = system.residual(0.0, system.z0)

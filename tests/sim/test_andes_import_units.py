@@ -18,7 +18,7 @@ def test_shunt_rated_at_another_voltage():
     ss.add("Shunt", {"bus": bus, "Sn": 100.0, "Vn": 220.0, "b": 1.0, "g": 0.2})
     system, _ = from_andes(ss)
     net = system.network
-    i = system.andes_bus_id[bus] - 1
+    i = net.index_of(system.andes_bus_id[bus])
     assert net.bus[i, 5] == pytest.approx(100 * (230 / 220) ** 2, rel=1e-12)   # BS [Mvar]
     assert net.bus[i, 4] == pytest.approx(20 * (230 / 220) ** 2, rel=1e-12)    # GS [MW]
     ss.setup()                                   # ANDES's own conversion to the system base

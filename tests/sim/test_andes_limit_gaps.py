@@ -59,7 +59,7 @@ def test_ieeet1_limit_gap_is_andes_integrating_beyond_the_limit(tmp_path):
     steps = np.diff(t[t > 1.05])
     assert np.min(steps[steps > 1e-3]) < 0.9 * H                # and its "fixed" step shrank
 
-    res, name = w["res"], "IEEET1_IEEET1_3"
+    res, name = w["res"], "IEEET1_3"
     VR, EFD = res[f"{name}.VR"], res[f"{name}.Efd"]
     assert np.max(VR) == pytest.approx(3.0, abs=1e-9)
     exciter = w["system"].components["IEEET1"].EX           # TE dEfd/dt = VR - VFE(Efd)

@@ -112,12 +112,12 @@ def _case_b(limits):
 
 
 # (limited signal in weakgrid results, bound) checked in the limit cases
-LIMITS_A = [("ESST3A_ESST3A_1.VR", "hi", 2.5), ("EXST1_EXST1_2.vi", "hi", 0.02),
+LIMITS_A = [("ESST3A_1.VR", "hi", 2.5), ("EXST1_2.vi", "hi", 0.02),
 
-            ("IEEEG1_IEEEG1_1.vs", "lo", -0.02), ("IEESGO_IEESGO_2.P", "lo", None),
-            ("TG2_TG2_3.pout", "lo", None), ("TGOV1N_TGOV1N_4.LAG", "lo", None)]
-LIMITS_B = [("EXAC1_EXAC1_1.VR", "hi", 3.0),
-            ("IEEEG1_IEEEG1_3.GV", "lo", None), ("ST2CUT_ST2CUT_EXAC1_1.vss", "both", 0.03)]
+            ("IEEEG1_1.vs", "lo", -0.02), ("IEESGO_2.P", "lo", None),
+            ("TG2_3.pout", "lo", None), ("TGOV1N_4.LAG", "lo", None)]
+LIMITS_B = [("EXAC1_1.VR", "hi", 3.0),
+            ("IEEEG1_3.GV", "lo", None), ("ST2CUT_EXAC1_1.vss", "both", 0.03)]
 
 CASES = {
     "a_nominal": (_case_a, False, (8, 1.0, 1.05)),

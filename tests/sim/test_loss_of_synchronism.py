@@ -49,10 +49,10 @@ def test_phase_shifted_machines_more_than_180_deg_apart_are_in_synchronism():
     assert np.degrees(d[0] - d[2]) > 180.0               # the case is what it is meant to be
     a, b = _run(0.0, 1.1), _run(PHI, 1.1)
     assert a.ok and b.ok, b.failure
-    for n, phi in (("G0", PHI), ("G1", 0.0), ("G2", -PHI)):
+    for n, phi in (("GENCLS_1_1", PHI), ("GENCLS_2_1", 0.0), ("GENCLS_3_1", -PHI)):
         np.testing.assert_allclose(b[f"{n}.delta"] - np.radians(phi), a[f"{n}.delta"], atol=1e-8)
         np.testing.assert_allclose(b[f"{n}.omega"], a[f"{n}.omega"], atol=1e-10)
-    assert np.ptp(a["G0.delta"]) > 0.1                   # the fault swings the machines
+    assert np.ptp(a["GENCLS_1_1.delta"]) > 0.1                   # the fault swings the machines
 
 
 def test_a_pole_slip_is_found_at_the_same_instant_with_and_without_the_shift():

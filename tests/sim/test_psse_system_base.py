@@ -46,7 +46,7 @@ def test_psse_branches_are_on_the_system_base():
     # N44_BC.raw, branch 3000-3115 '1': R = 0.075, X = 0.9, B = 0.5 pu on SBASE = 1000 MVA
     # and the bus base (420 kV on both ends), i.e. exactly these values in the network
     row = [k for k in range(net.nl)
-           if {net.bus_ids[int(net.branch[k, F_BUS]) - 1], net.bus_ids[int(net.branch[k, T_BUS]) - 1]}
+           if {int(net.branch[k, F_BUS]), int(net.branch[k, T_BUS])}
            == {system.andes_bus_id[3000], system.andes_bus_id[3115]}]
     assert len(row) == 1
     np.testing.assert_allclose(net.branch[row[0], [BR_R, BR_X, BR_B]], [0.075, 0.9, 0.5], rtol=1e-12)
@@ -62,7 +62,7 @@ def test_nordic44_power_flow_matches_andes():
     ss.PFlow.run()
     assert ss.PFlow.converged
     Va = np.asarray(ss.Bus.v.v) * np.exp(1j * np.asarray(ss.Bus.a.v))
-    order = [system.andes_bus_id[b] - 1 for b in ss.Bus.idx.v]
+    order = [system.network.index_of(system.andes_bus_id[b]) for b in ss.Bus.idx.v]
     np.testing.assert_allclose(pf.V[order], Va, atol=1e-6, rtol=0)
 
 

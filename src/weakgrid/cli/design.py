@@ -56,7 +56,8 @@ def run(args) -> int:
     der = setup.derivation
     d = der.model
     print(f"study {st.name} ({st.source}): {setup.load} load, {setup.upqc} UPQC "
-          f"'{setup.upqc_name}' in branch {setup.upqc_branch} (shunt bus r = {setup.shunt_bus})")
+          f"'{setup.upqc_name}' in branch {setup.system.network.branch_label(setup.upqc_branch)} "
+          f"(shunt bus r = {setup.system.network.bus_label(setup.shunt_bus)})")
     print(f"controlled machine: {der.machine.upper()} '{der.name}'; line power through the "
           f"UPQC {setup.line_power_mw:.4g} MW")
     print("\ndesign model (10), derived:")

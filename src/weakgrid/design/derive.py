@@ -158,6 +158,16 @@ def derive_design(system, machine: str, upqc, T: float, structure: str = "conven
     return _derive_sg(system, comp, i, k_up, r_id, Vr, T, structure, lossless_sg)
 
 
+def _buses(net, ids) -> str:
+    """Bus numbers with their source names (:meth:`Network.bus_label`)."""
+    return "[" + ", ".join(net.bus_label(b) for b in ids) + "]"
+
+
+def _labels(net, rows) -> str:
+    """Branch rows as their source names (:meth:`Network.branch_label`)."""
+    return "[" + ", ".join(net.branch_label(k) for k in rows) + "]"
+
+
 def _derive_gti(system, gti, i, k_up, r_id, Vr, T, structure):
     net = system.network
     p = gti.p
@@ -187,11 +197,12 @@ def _derive_gti(system, gti, i, k_up, r_id, Vr, T, structure):
     d.add("B_gti", Bg, "pu", f"{src} parameter B (coupling susceptance)")
     d.add("Vs", Vs, "pu", "|Es| = |V + jI/B_gti| at the power-flow operating point")
     d.add("B", B, "pu", f"|Y12| of the two-port Es → V' = Vr + Vu (Kron reduction over buses "
-          f"{tp.buses}, branches {tp.branches} and the UPQC branch {k_up})")
+          f"{_buses(net, tp.buses)}, branches {_labels(net, tp.branches)} and the UPQC branch "
+          f"{net.branch_label(k_up)})")
     d.add("eps", eps, "rad", "loss angle ∠Y12 − π/2 of that two-port (0 if lossless)")
     d.add("T", T, "s", "study design.T (sampling period)")
     d.add("a", a, "rad/s²/pu", "τ'·Vs·B/C")
-    d.add("Vr_bar", float(abs(Vr)), "pu", f"|V| of the UPQC shunt bus {r_id} (power flow)")
+    d.add("Vr_bar", float(abs(Vr)), "pu", f"|V| of the UPQC shunt bus {net.bus_label(r_id)} (power flow)")
     d.add("phi_s0", phi0, "rad", f"∠Es − ∠Vr (power flow, GTI '{name}' phi0)")
     Y11 = tp.Y11
     d.details = {"Vs": Vs, "B_eff": B, "loss_angle_eps": eps, "G11": float(Y11.real),
@@ -235,14 +246,16 @@ def _derive_sg(system, gm, i, k_up, r_id, Vr, T, structure, lossless):
     d.add("ra", ra, "pu", f"{src} stator resistance (system base; reported, not in B)")
     d.add("x'd", xd1, "pu", f"{src} transient reactance (system base)")
     d.add("E'", float(abs(E)), "pu", "|V + I·(ra + j·x'd)| at the power-flow operating point")
-    d.add("Xu", Xu, "pu", f"UPQC series branch {k_up} reactance")
-    d.add("Ru", Ru, "pu", f"UPQC series branch {k_up} resistance (reported, not in B)")
+    d.add("Xu", Xu, "pu", f"UPQC series branch {net.branch_label(k_up)} reactance")
+    d.add("Ru", Ru, "pu", f"UPQC series branch {net.branch_label(k_up)} resistance "
+          "(reported, not in B)")
     d.add("B", B, "pu", "1/(x'd + Xu)" if direct else
-          f"|Y12| of E' → V' (Kron reduction over buses {tp.buses}, branches {tp.branches}"
+          f"|Y12| of E' → V' (Kron reduction over buses {_buses(net, tp.buses)}, branches "
+          f"{_labels(net, tp.branches)}"
           + (", reactances only)" if lossless else ")"))
     d.add("T", T, "s", "study design.T (sampling period)")
     d.add("a", model.a, "rad/s²/pu", "ωs·E'·B/(2H)")
-    d.add("Vr_bar", Vr_bar, "pu", f"|V| of the UPQC shunt bus {r_id} (power flow)")
+    d.add("Vr_bar", Vr_bar, "pu", f"|V| of the UPQC shunt bus {net.bus_label(r_id)} (power flow)")
     d.add("phi_s0", phi_s0, "rad", "∠E' − ∠Vr (power flow)")
     d.details = {"E_prime": float(abs(E)), "B": B, "H_system_base_s": H,
                  "M_design": 2 * H / (2 * math.pi * f_hz), "x_d1_system": xd1, "Xu_system": Xu,

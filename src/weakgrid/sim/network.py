@@ -81,6 +81,13 @@ class Network:
         External bus numbers; ``index_of(bus_id)`` maps them to 0-based positions.
     negative_resistance : set of int
         Branch rows with ``BR_R < 0`` (declared or not).
+    bus_names : dict
+        Bus number -> the source's bus name, where it has one (PSS/E, pandapower); optional
+        case key ``bus_names``.
+    branch_names : list
+        Each branch row's identifier in its source (PSS/E ``"I-J-CKT"``, an ANDES ``Line`` idx,
+        pandapower ``"line_3"``, a study's branch name), or None; optional case key
+        ``branch_names``. :meth:`branch_label` prints them.
     """
 
     def __init__(self, case: dict, f_hz: float = 60.0):
@@ -170,6 +177,9 @@ class Network:
         self.nl = branch.shape[0]
         self.base_kv = kv.copy()
         self.pf: PowerFlowResult | None = None
+        self.bus_names = {int(k): str(v) for k, v in dict(case.get("bus_names") or {}).items()}
+        names = list(case.get("branch_names") or [])
+        self.branch_names = (names + [None] * self.nl)[:self.nl]
 
     # ------------------------------------------------------------------ lookup
     def index_of(self, bus_id, element: str = "element", field: str = "bus") -> int:
@@ -180,6 +190,20 @@ class Network:
             raise DataError(element, field, bus_id,
                             "no such bus; known buses are "
                             f"{sorted(int(b) for b in self._pos)}") from None
+
+    def bus_label(self, bus_id) -> str:
+        """A bus as a user knows it: its number, and its source name where it differs,
+        e.g. ``'5 ("6")'`` (pandapower index 5, named "6"), ``'101 ("BUS 1")'``, ``'7'``."""
+        name = self.bus_names.get(int(bus_id))
+        return f'{int(bus_id)} ("{name}")' if name and name != str(int(bus_id)) else str(int(bus_id))
+
+    def branch_label(self, k) -> str:
+        """A branch row as a user knows it: its source name and end buses, e.g.
+        ``'"101-102-1" (101-102)'``, or ``'row 3 (5-7)'`` without a name."""
+        k = int(k)
+        ends = f"{int(self.branch[k, F_BUS])}-{int(self.branch[k, T_BUS])}"
+        name = self.branch_names[k] if 0 <= k < len(self.branch_names) else None
+        return f'"{name}" ({ends})' if name is not None else f"row {k} ({ends})"
 
     # ------------------------------------------------------------- admittances
     def branch_admittances(self):
@@ -407,12 +431,101 @@ class Network:
 
     @classmethod
     def from_pandapower(cls, net) -> "Network":
-        """Build a :class:`Network` from a pandapower network (via ``pandapower.converter.to_ppc``)."""
+        """Build a :class:`Network` from a pandapower network (via ``pandapower.converter.to_ppc``).
+
+        Buses keep their pandapower index as their number (bus ``5`` is ``net.bus.loc[5]``;
+        buses that pandapower's conversion fuses through closed bus-bus switches take the
+        smallest index among them); buses the conversion adds (e.g. the star point of a
+        three-winding transformer) are numbered above the largest index. The result's
+        ``pandapower_bus`` maps every pandapower bus index to its number, ``bus_names`` each
+        number to the pandapower bus name (where it has one), ``branch_names`` each branch row
+        to its element and ``gen_names`` each gen row to its ``ext_grid`` or ``gen``: the
+        element's name where it is unique and non-empty, else ``"<table>_<index>"``
+        (``"line_3"``, ``"trafo_0"``, ``"gen_1"``); ``gen_source`` holds ``(table, index, name)``
+        per gen row.
+        """
         from pandapower.converter.pypower import to_ppc
 
         ppc = to_ppc(net, init="flat", calculate_voltage_angles=True, trafo_model="pi")
-        bus = np.asarray(ppc["bus"])[:, :13].copy()
-        gen = np.asarray(ppc["gen"])[:, :21].copy()
+        bus = np.asarray(ppc["bus"])[:, :13].real.copy()
+        gen = np.asarray(ppc["gen"])[:, :21].real.copy()
         branch = np.asarray(ppc["branch"])[:, :13].real.copy()
-        return cls({"baseMVA": ppc["baseMVA"], "bus": bus.real, "gen": gen.real, "branch": branch},
-                   f_hz=float(net.f_hz))
+        lookups = net._pd2ppc_lookups            # written by to_ppc: pandapower -> ppc positions
+        pos_of = lookups["bus"]
+        pos = bus[:, BUS_I].astype(int)          # ppc numbers its buses by position
+        number = {}
+        for i in sorted(int(i) for i in net.bus.index):
+            p = int(pos_of[i]) if i < len(pos_of) else -1
+            if p >= 0 and p not in number:
+                number[p] = i
+        top = max([int(i) for i in net.bus.index] + [-1])
+        for p in pos:                            # buses the conversion added
+            if int(p) not in number:
+                top += 1
+                number[int(p)] = top
+        renum = np.vectorize(lambda p: number[int(p)], otypes=[float])
+        bus[:, BUS_I] = renum(bus[:, BUS_I])
+        if gen.size:
+            gen[:, GEN_BUS] = renum(gen[:, GEN_BUS])
+        if branch.size:
+            branch[:, F_BUS] = renum(branch[:, F_BUS])
+            branch[:, T_BUS] = renum(branch[:, T_BUS])
+        pandapower_bus = {int(i): number[int(pos_of[i])] for i in net.bus.index
+                          if i < len(pos_of) and int(pos_of[i]) >= 0}
+        bus_names = {}
+        for i, name in net.bus["name"].items():
+            text = _text(name)
+            if text and int(i) in pandapower_bus:
+                bus_names.setdefault(pandapower_bus[int(i)], text)
+        branch_names = [None] * branch.shape[0]
+        for table, (a, b) in (lookups.get("branch") or {}).items():
+            tab = getattr(net, table, None)
+            if tab is not None and b - a == len(tab):    # the table's rows, in order
+                for k, i in enumerate(tab.index):
+                    branch_names[a + k] = (table, int(i), tab.at[i, "name"] if "name" in tab
+                                           else None)
+        branch_names = _element_names(branch_names)
+        out = cls({"baseMVA": ppc["baseMVA"], "bus": bus, "gen": gen, "branch": branch,
+                   "bus_names": bus_names, "branch_names": branch_names}, f_hz=float(net.f_hz))
+        out.pandapower_bus = pandapower_bus
+        out.gen_source = [None] * gen.shape[0]
+        for table in ("ext_grid", "gen"):
+            rows = lookups.get(table)
+            tab = getattr(net, table)
+            if rows is None or tab is None or not len(tab):
+                continue
+            rows = np.asarray(rows).ravel()
+            for k, (i, row) in enumerate(tab.iterrows()):
+                if k < len(rows) and 0 <= int(rows[k]) < len(out.gen_source):
+                    name = row.get("name")
+                    out.gen_source[int(rows[k])] = (table, int(i), _text(name))
+        out.gen_names = _element_names(out.gen_source)
+        return out
+
+
+def _element_names(elements) -> list:
+    """pandapower elements ``(table, index, name)`` (or None) as identifiers: the element's
+    name where it is a non-empty string that no other element has (and that is not another
+    element's ``"<table>_<index>"``), else ``"<table>_<index>"``; unique by construction."""
+    own = [None if e is None else f"{e[0]}_{e[1]}" for e in elements]
+    reserved = {o for o in own if o is not None}
+    count = {}
+    for e in elements:
+        if e is not None and _text(e[2]):
+            count[_text(e[2])] = count.get(_text(e[2]), 0) + 1
+    out = []
+    for e, o in zip(elements, own):
+        t = None if e is None else _text(e[2])
+        out.append(t if t and count[t] == 1 and (t not in reserved or t == o) else o)
+    return out
+
+
+def _text(name):
+    """A pandapower element name as text (numbers too, e.g. case9's buses 1..9), or None when
+    missing (None, NaN, blank)."""
+    if name is None or (isinstance(name, float) and name != name):
+        return None
+    if isinstance(name, float) and name.is_integer():
+        name = int(name)
+    text = str(name).strip()
+    return text or None

@@ -24,7 +24,7 @@ from .system import System
 
 PMAX = 8
 
-__all__ = ["classical_parameters", "classical_system", "matpower_case"]
+__all__ = ["classical_parameters", "classical_system", "machine_id", "matpower_case"]
 
 
 def _is_pandapower(case) -> bool:
@@ -39,13 +39,16 @@ def matpower_case(case) -> dict:
     case : dict, Network, pandapower network or str
         A MATPOWER case dict, a :class:`Network`, a pandapower network, or the
         name of a function of :mod:`pandapower.networks` returning one (e.g.
-        ``"case118"``). pandapower networks are converted with
-        ``pandapower.converter.to_ppc`` and their buses renumbered from 1
-        (MATPOWER convention; bus ``k`` is the k-th bus of the ppc).
+        ``"case118"``). pandapower networks are converted by
+        :meth:`Network.from_pandapower`: a bus keeps its pandapower index as its number, and
+        the dict carries the elements' identifiers (``gen_names``, ``bus_names``,
+        ``branch_names``: the element's name when unique and non-empty, else
+        ``"<table>_<index>"``).
 
     Returns
     -------
-    dict with ``baseMVA``, ``bus``, ``gen``, ``branch``.
+    dict with ``baseMVA``, ``bus``, ``gen``, ``branch`` (and, from pandapower, ``gen_names``,
+    ``bus_names``, ``branch_names``).
     """
     if isinstance(case, dict) and not _is_pandapower(case):   # a pandapower net is a dict too
         return case
@@ -62,13 +65,30 @@ def matpower_case(case) -> dict:
         net = Network.from_pandapower(case)
         c = {k: np.array(v, dtype=float) for k, v in net.case.items() if k != "baseMVA"}
         c["baseMVA"] = net.Sb
-        for col, tab in ((0, "bus"), (0, "gen"), (0, "branch"), (1, "branch")):
-            c[tab][:, col] += 1
+        c.update(gen_names=list(net.gen_names), bus_names=dict(net.bus_names),
+                 branch_names=list(net.branch_names))
         mb = c["gen"][:, 6]
         c["gen"][:, 6] = np.where(np.isfinite(mb) & (mb > 1), mb, c["baseMVA"])
         return c
     raise DataError("case", "type", type(case).__name__,
                     "give a MATPOWER dict, a Network, a pandapower network or a pandapower.networks name")
+
+
+def machine_id(case, g) -> str:
+    """Source identifier of generator row ``g`` of a MATPOWER case dict.
+
+    From pandapower (``case["gen_names"]``): the ``ext_grid`` / ``gen`` element's name when it
+    is unique and non-empty, else ``"<table>_<index>"``. MATPOWER (no generator ids):
+    ``"<bus>_<k>"``, the bus number and the generator's place among those of its bus in the gen
+    table (1 for the first; PSS/E's default machine id), e.g. ``"30_1"``.
+    """
+    names = case.get("gen_names") if isinstance(case, dict) else None
+    if names and g < len(names) and names[g]:
+        return str(names[g])
+    gen = np.atleast_2d(np.asarray(case["gen"], dtype=float))
+    bus = int(gen[g, 0])
+    k = int(np.sum(gen[:g + 1, 0].astype(int) == bus))
+    return f"{bus}_{k}"
 
 
 def classical_parameters(case, H=4.0, xd1=0.3, D=0.0, ra=0.0, Sn=None, Sn_min=10.0) -> list[dict]:
@@ -93,8 +113,8 @@ def classical_parameters(case, H=4.0, xd1=0.3, D=0.0, ra=0.0, Sn=None, Sn_min=10
 
     Returns
     -------
-    list of dict with keys ``gen`` (0-based gen row), ``bus`` (bus number) and the
-    ``GENCLS`` parameters ``Sn, M, D, ra, xd1``.
+    list of dict with keys ``gen`` (0-based gen row), ``bus`` (bus number), ``name`` (the
+    machine's name, :func:`machine_id`) and the ``GENCLS`` parameters ``Sn, M, D, ra, xd1``.
     """
     for nm, v in (("H", H), ("xd1", xd1)):
         if not (np.isfinite(v) and v > 0):
@@ -114,7 +134,8 @@ def classical_parameters(case, H=4.0, xd1=0.3, D=0.0, ra=0.0, Sn=None, Sn_min=10
             sn = float(Sn)
             if not sn > 0:
                 raise DataError("classical template", "Sn", Sn, "must be > 0 MVA")
-        out.append(dict(gen=g, bus=int(gen[g, 0]), Sn=float(sn), M=2.0 * H, D=float(D),
+        out.append(dict(gen=g, bus=int(gen[g, 0]), name=f"GENCLS_{machine_id(case, g)}",
+                        Sn=float(sn), M=2.0 * H, D=float(D),
                         ra=float(ra), xd1=float(xd1)))
     return out
 
@@ -137,7 +158,9 @@ def classical_system(case, H=4.0, xd1=0.3, D=0.0, ra=0.0, Sn=None, Sn_min=10.0,
     Returns
     -------
     System
-        Machines are named ``G<k>`` with ``k`` the 0-based gen row.
+        Machines are named ``GENCLS_<id>`` with the generator's source identifier
+        (:func:`machine_id`: ``GENCLS_30_1`` for the first generator of MATPOWER bus 30,
+        ``GENCLS_gen_1`` / ``GENCLS_<name>`` for a pandapower element).
 
     Examples
     --------
@@ -150,7 +173,7 @@ def classical_system(case, H=4.0, xd1=0.3, D=0.0, ra=0.0, Sn=None, Sn_min=10.0,
     mpc = matpower_case(case)
     s = System(Network(mpc, f_hz=f_hz))
     for p in classical_parameters(mpc, H=H, xd1=xd1, D=D, ra=ra, Sn=Sn, Sn_min=Sn_min):
-        s.add_machine("GENCLS", f"G{p['gen']}", p["gen"], Sn=p["Sn"], M=p["M"], D=p["D"],
+        s.add_machine("GENCLS", p["name"], p["gen"], Sn=p["Sn"], M=p["M"], D=p["D"],
                       ra=p["ra"], xd1=p["xd1"], fn=f_hz)
     if setup:
         s.setup()

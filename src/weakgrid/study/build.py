@@ -15,7 +15,8 @@ Grid kinds (``[grid] kind``):
 * ``matpower`` — ``file`` (a ``.m``/``.mat`` case); ``loads.levels`` scale PD, QD.
 * ``andes`` — ``file`` (any case ANDES parses: PSS/E ``.raw``, ``.xlsx``, ``.json``; ``andes:``
   prefix for ANDES's stock cases) and ``dyr`` (PSS/E dynamic data): machines and controls come
-  from the file (named ``GENROU_<idx>`` …), the UPQC is an existing ``Line`` (``upqc.branch`` =
+  from the file (named ``<MODEL>_<idx>``: ``GENROU_4``, kundur's ``GENROU_1``; buses keep their
+  integer idx), the UPQC is an existing ``Line`` (``upqc.branch`` =
   its idx; ``upqc.side = "to"`` when its bus2 is the shunt bus) or inserted into one
   (``upqc.insert = {branch = idx, side, r, x}``, pu on the system base).
 * ``psse`` — ``raw`` (PSS/E ``.raw``, versions 29-35) and ``dyr`` (optional), paths relative to
@@ -25,7 +26,12 @@ Grid kinds (``[grid] kind``):
   branch (``upqc.branch = "I-J-CKT"``, e.g. ``"101-102-1"``, or ``{from, to}``) or inserted into
   one (``upqc.insert = {branch = "I-J-CKT", side, r, x}``, pu on the system base).
 
-Buses are referred to by external number (inline/matpower), or by pandapower name or index.
+Buses are referred to by the source's number (inline/matpower/PSS/E, an ANDES idx), by name
+(PSS/E ``.raw``, ANDES ``Bus.name``, pandapower, inline), or by pandapower index — which is the
+simulator's bus number of a pandapower grid, so results (``bus<number>.v``), events and the
+design printout use one numbering. Branches (events, ``upqc.branch``) by the source's names
+(PSS/E ``"I-J-CKT"``, ANDES ``Line`` idx, a pandapower element's name or ``"line_3"``, an inline
+branch's name), ``{from, to}`` buses, or a 0-based row.
 The UPQC is either an existing series branch (``upqc.branch``: a branch name, a row, or
 ``{from, to}``; from = the shunt bus r) or inserted into a branch (``upqc.insert``, see
 :mod:`weakgrid.design.upqc_insert`).
@@ -96,21 +102,35 @@ class Setup:
     state_map: object = None
 
     def bus(self, ref, where="bus") -> int:
-        """External bus number of a bus reference (number, or name)."""
+        """Simulator bus number of a bus reference (the source's number or name; a pandapower
+        index); :class:`ParameterError` listing some of the grid's buses if unknown."""
         return _bus_ref(ref, self.bus_id, self.system.network, where)
 
 
 def _bus_ref(ref, bus_id, network, where):
-    if isinstance(ref, str):
-        if ref not in bus_id:
-            raise ParameterError(where, ref, f"no bus of that name; e.g. {list(bus_id)[:8]}")
+    """Simulator bus number of a study's bus reference: a bus number of the source (PSS/E,
+    MATPOWER, ANDES idx, pandapower index) or a name of the source (``bus_id``: name → number).
+    An unknown reference raises :class:`ParameterError` listing some of the grid's buses."""
+    if isinstance(ref, str) and ref in bus_id:
         return int(bus_id[ref])
     if isinstance(ref, (int, np.integer)) and not isinstance(ref, bool):
-        if ref in bus_id:                      # pandapower index → simulator bus
+        if ref in bus_id:                      # pandapower index (the simulator bus number)
             return int(bus_id[ref])
-        if int(ref) in set(int(b) for b in network.bus_ids):
+        if int(ref) in network._pos:
             return int(ref)
-    raise ParameterError(where, ref, "give a bus number or name of this grid")
+    raise ParameterError(where, ref, f"no such bus in this grid; {bus_choices(bus_id, network)}")
+
+
+def bus_choices(bus_id, network, n=8) -> str:
+    """A few of a grid's bus numbers and names, for an error message."""
+    nums = [int(b) for b in network.bus_ids]
+    names = [k for k in bus_id if isinstance(k, str) and k != str(bus_id[k])]
+    text = f"bus numbers: {nums[:n]}{' …' if len(nums) > n else ''}"
+    if names:
+        text += f"; names: {names[:n]}{' …' if len(names) > n else ''}"
+    elif any(isinstance(k, str) for k in bus_id):
+        text += " (also as strings, e.g. \"" + str(nums[0]) + "\")"
+    return text
 
 
 # ----------------------------------------------------------------------------- grids
@@ -189,7 +209,8 @@ def _pandapower_net(g, load):
                                          f"{list(bus_of)[:8]}")
                 return bus_of[ref]
             if ref not in net.bus.index:
-                raise ParameterError(where, ref, "no bus with that pandapower index")
+                raise ParameterError(where, ref, "no bus with that pandapower index; e.g. "
+                                     f"{list(net.bus.index[:8])}, or a name {list(bus_of)[:8]}")
             return int(ref)
 
         ld = g.get("loads", {})
@@ -236,12 +257,6 @@ def _pandapower_net(g, load):
     return net, bus_of, bref
 
 
-def _pp_bus_ids(net) -> dict:
-    """pandapower bus index → simulator (ppc) bus number, after the conversion."""
-    lk = net._pd2ppc_lookups["bus"]        # set by pandapower's to_ppc (used only here)
-    return {int(i): int(lk[i]) for i in net.bus.index}
-
-
 # ----------------------------------------------------------------------------- setup
 def _network(study, load):
     """``(Network, bus_id name→number, branch names, upqc row, System or None)`` at ``load``."""
@@ -270,7 +285,7 @@ def _network(study, load):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             network = Network.from_pandapower(net)
-        ids = _pp_bus_ids(net)
+        ids = network.pandapower_bus     # pandapower index -> simulator bus (the same index)
         bus_id = {n: ids[i] for n, i in bus_of.items()}
         bus_id.update({i: ids[i] for i in net.bus.index})
         if ends is None:
@@ -363,6 +378,7 @@ def _andes_network(study, g, up):
         net = system.network
         case, k_up, _, _ = insert_upqc_matpower(net.case, names[ref], ins["side"],
                                                 ins.get("r", 0.0), ins["x"])
+        case.update(branch_names=list(net.branch_names), bus_names=net.bus_names)
         system.network = Network(case, f_hz=net.f_hz)
         names[up["name"]] = k_up
         return system.network, bus_id, names, k_up, system
@@ -417,6 +433,7 @@ def _psse_network(study, g, up):
         case, k_up, _, _ = insert_upqc_matpower(net.case, k_ref, ins["side"], ins.get("r", 0.0), ins["x"])
         case.update(series_capacitors=sorted(net.series_capacitors),
                     negative_resistance=sorted(net.negative_resistance), gen_split=net.gen_split)
+        case.update(branch_names=list(net.branch_names), bus_names=net.bus_names)
         system.network = Network(case, f_hz=net.f_hz)
         names[up["name"]] = k_up
         return system.network, bus_id, names, k_up, system
@@ -488,6 +505,23 @@ def _remove_stabilizers(system, machine):
                   "'none' equals 'pss-only'")
 
 
+def _source_names(network, bus_id, br_names):
+    """One set of identifiers for the study file, the printouts and the results: the source's
+    bus names and branch names of ``network`` join the study's (``bus_id``, ``br_names``,
+    completed in place), and the study's branch names label the network's rows."""
+    for num, name in network.bus_names.items():
+        bus_id.setdefault(name, int(num))
+    for name, num in bus_id.items():     # the study's own bus names (inline grids)
+        if isinstance(name, str) and name != str(num):
+            network.bus_names.setdefault(int(num), name)
+    for k, name in enumerate(network.branch_names):
+        if name is not None:
+            br_names.setdefault(name, k)
+    for name, k in br_names.items():
+        if network.branch_names[k] is None:
+            network.branch_names[k] = name
+
+
 def build_setup(study, load: str | None = None, upqc: str | None = None,
                 variant: str = "upqc") -> Setup:
     """Build and set up the study's grid at ``load`` with the UPQC in structure ``upqc``;
@@ -502,6 +536,7 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
         raise ParameterError("variant", variant, f"choose one of {VARIANTS}")
     with quiet_loggers("pandapower", "andes"):   # their parsers' notes; restored after
         network, bus_id, br_names, k_up, system = _network(study, load)
+    _source_names(network, bus_id, br_names)
     if d["upqc"].get("side", "from") == "to":     # the branch's to-bus is the shunt bus r
         row = network.branch[k_up]
         row[F_BUS], row[T_BUS] = row[T_BUS], row[F_BUS]

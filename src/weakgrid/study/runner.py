@@ -169,11 +169,15 @@ def enable_windows(bypass, t_end):
 
 
 def _branch_row(setup, ref, where):
+    """Branch row of a study's branch reference: a source name (PSS/E ``"I-J-CKT"``, ANDES Line
+    idx, pandapower element name or ``"line_3"``, a study's branch name), ``{from, to}`` buses,
+    or a 0-based row of the network's branch table."""
     net = setup.system.network
     if isinstance(ref, str):
         if ref not in setup.branch_names:
-            raise ParameterError(where, ref, f"no branch of that name; choose one of "
-                                 f"{list(setup.branch_names)} or give a 0-based row")
+            names = list(setup.branch_names)
+            raise ParameterError(where, ref, f"no branch of that name; e.g. {names[:8]}"
+                                 f"{' …' if len(names) > 8 else ''}, or {{from = BUS, to = BUS}}")
         return setup.branch_names[ref]
     if isinstance(ref, dict):
         f, t = setup.bus(ref.get("from"), f"{where}.from"), setup.bus(ref.get("to"), f"{where}.to")
@@ -182,7 +186,10 @@ def _branch_row(setup, ref, where):
         if len(rows) != 1:
             raise ParameterError(where, ref, f"found {len(rows)} branches between these buses")
         return rows[0]
-    return int(ref)
+    if isinstance(ref, (int, np.integer)) and not isinstance(ref, bool) and 0 <= ref < net.nl:
+        return int(ref)
+    raise ParameterError(where, ref, f"give a branch name (e.g. {list(setup.branch_names)[:8]}), "
+                         f"{{from = BUS, to = BUS}} or a row 0..{net.nl - 1}")
 
 
 def make_events(setup, run: Run):

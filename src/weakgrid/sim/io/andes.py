@@ -61,6 +61,8 @@ loaded ``andes.System``.
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from ..errors import DataError
@@ -101,6 +103,46 @@ ANDES_CONVENTIONS = {
     "WTTQA1": {"speed_err": 0.0, "Pe_filt": 0.0, "wg_reset": 1.0, "adjust_lim": 1.0},
 }
 CONVENTIONS = ("standard", "andes")
+
+
+def device_name(model: str, idx) -> str:
+    """weakgrid's name of ANDES device ``idx`` of ``model``: ``"<model>_<idx>"``.
+
+    ANDES's own generated idx already carry the model (``GENROU_4``, ``Line_13``): they are kept
+    as they are, not prefixed twice (``GENROU_4``, not ``GENROU_GENROU_4``); a numeric or other
+    idx gets the model in front (kundur's GENROU ``1`` → ``GENROU_1``, REGCA1 ``RE1`` →
+    ``REGCA1_RE1``), so that a name says its model and the idx a user gave.
+    """
+    s = str(idx).strip()
+    return s if s.startswith(f"{model}_") else f"{model}_{s}"
+
+
+def bus_numbers(idx) -> tuple[dict, bool]:
+    """weakgrid bus number of each ANDES bus idx: the idx itself when every idx is an integer
+    (PSS/E numbers, ANDES's stock cases), else 1..n in the case's bus order.
+
+    Returns
+    -------
+    numbers : dict
+        ANDES bus idx -> weakgrid bus number.
+    kept : bool
+        True when the numbers are the idx themselves.
+    """
+    def as_int(v):
+        if isinstance(v, (bool, np.bool_)):
+            return None
+        if isinstance(v, (int, np.integer)):
+            return int(v)
+        if isinstance(v, (float, np.floating)) and float(v).is_integer():
+            return int(v)
+        if isinstance(v, str) and re.fullmatch(r"[+-]?\d+", v.strip()):
+            return int(v)
+        return None
+
+    nums = [as_int(v) for v in idx]
+    if all(n is not None for n in nums) and len(set(nums)) == len(nums):
+        return dict(zip(idx, nums)), True
+    return {b: k + 1 for k, b in enumerate(idx)}, False
 
 
 def _col(m, name):
@@ -237,8 +279,9 @@ def _check_islands(case, bus_names):
     B, L = case["bus"], case["branch"]
     nb = B.shape[0]
     on = L[:, 10] > 0
-    f = L[on, 0].astype(int) - 1
-    t = L[on, 1].astype(int) - 1
+    at = {int(b): i for i, b in enumerate(B[:, 0])}
+    f = np.array([at[int(b)] for b in L[on, 0]], dtype=int)
+    t = np.array([at[int(b)] for b in L[on, 1]], dtype=int)
     A = coo_matrix((np.ones(len(f)), (f, t)), shape=(nb, nb))
     ncomp, lab = connected_components(A, directed=False)
     bad = []
@@ -307,9 +350,13 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
     nb = int(on_bus.sum())
     bidx = [b for b, u in zip(bus.idx.v, on_bus) if u]
     pos = {b: i for i, b in enumerate(bidx)}
+    num, kept = bus_numbers(bidx)   # ANDES bus idx -> weakgrid bus number (the idx if integer)
+    if not kept:
+        notes.append("Bus idx are not all integers: buses numbered 1..n in the case's order "
+                     "(system.andes_bus_id maps each idx to its number)")
     Vn_bus = _raw(bus, "Vn")[on_bus]
     B = np.zeros((nb, 13))
-    B[:, 0] = np.arange(1, nb + 1)
+    B[:, 0] = [num[b] for b in bidx]
     B[:, 1] = 1
     B[:, 6] = 1
     B[:, 7] = _raw(bus, "v0")[on_bus]
@@ -362,7 +409,7 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
                 if mname == "Slack":
                     B[i, 8] = np.degrees(_raw(m, "a0")[k])
             row = np.zeros(21)
-            row[0] = i + 1
+            row[0] = num[m.bus.v[k]]
             row[1] = _raw(m, "p0")[k] * Sb
             row[2] = _raw(m, "q0")[k] * Sb
             row[3], row[4] = 9999.0, -9999.0
@@ -393,11 +440,16 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
         if b1 != b2:
             raise DataError(f"ANDES Line {line.idx.v[k]}", "b1", b1, "asymmetric line charging (b1 != b2) unsupported")
         tap = _raw(line, "tap")[k]
-        L[kk, :] = [i + 1, j + 1, _raw(line, "r")[k] * zc, _raw(line, "x")[k] * zc, (b + b1 + b2) / zc,
-                   0, 0, 0, 0 if tap == 1 else tap, np.degrees(_raw(line, "phi")[k]),
-                   1 if _raw(line, "u")[k] > 0 else 0, -360, 360]
+        L[kk, :] = [num[line.bus1.v[k]], num[line.bus2.v[k]], _raw(line, "r")[k] * zc,
+                    _raw(line, "x")[k] * zc, (b + b1 + b2) / zc,
+                    0, 0, 0, 0 if tap == 1 else tap, np.degrees(_raw(line, "phi")[k]),
+                    1 if _raw(line, "u")[k] > 0 else 0, -360, 360]
     L = L[:len(lrow)]
-    case = {"baseMVA": Sb, "bus": B, "gen": np.array(G), "branch": L}
+    bus_name = dict(zip(bus.idx.v, bus.name.v)) if "name" in bus.params else {}
+    case = {"baseMVA": Sb, "bus": B, "gen": np.array(G), "branch": L,
+            "branch_names": [str(ix) for ix in lrow],      # Line idx, in row order
+            "bus_names": {num[b]: str(bus_name[b]) for b in bidx
+                          if bus_name.get(b) not in (None, "") and str(bus_name[b]) != str(b)}}
     _check_islands(case, bidx)
     fn = 60.0
     if "GENROU" in ss.models and ss.GENROU.n:
@@ -405,6 +457,20 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
     elif "GENCLS" in ss.models and ss.GENCLS.n:
         fn = float(_raw(ss.GENCLS, "fn")[0])
     system = System(_network(case, fn))
+    names_of = {}     # (ANDES model, idx) -> weakgrid name, unique over the whole system
+
+    def name_of(mname, ix):
+        key = (mname, ix)
+        if key not in names_of:
+            taken = set(names_of.values())
+            name = device_name(mname, ix)
+            if name in taken:        # a kept idx ("GENROU_1") meets a GENROU 1: prefix it
+                name = f"{mname}_{str(ix).strip()}"
+            if name in taken:
+                raise DataError(f"ANDES {mname} {ix}", "idx", ix,
+                                f"two devices would both be named '{name}'; give them distinct idx")
+            names_of[key] = name
+        return names_of[key]
     # machines
     syn_name = {}
     for mname, cls in reg.items():
@@ -418,7 +484,7 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
             if gen_row[m.gen.v[k]] is None or G[gen_row[m.gen.v[k]]][7] <= 0:
                 notes.append(f"{mname} {m.idx.v[k]}: its static generator {m.gen.v[k]} is out of service, skipped")
                 continue
-            name = f"{mname}_{m.idx.v[k]}"
+            name = name_of(mname, m.idx.v[k])
             system.add_machine(mname, name, gen_row[m.gen.v[k]], **_params(cls, m, k))
             syn_name[m.idx.v[k]] = name
     # machine controls: exciters and governors link to `syn`, stabilizers and compensators to `avr`
@@ -439,7 +505,7 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
                 if syn is None:
                     notes.append(f"{dev}: its machine is out of service, skipped")
                     continue
-                name = f"{mname}_{m.idx.v[k]}"
+                name = name_of(mname, m.idx.v[k])
                 params = _params(cls, m, k)
                 extra = {}
                 if mname == "ST2CUT":
@@ -472,7 +538,7 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
             if link is None or ("gen" in link and link["gen"] is None):
                 notes.append(f"{dev}: the device it controls is out of service, skipped")
                 continue
-            name = f"{mname}_{m.idx.v[k]}"
+            name = name_of(mname, m.idx.v[k])
             values = _params(cls, m, k)
             if hasattr(cls, "andes_params"):
                 values = cls.andes_params(m, k, ss, values)
@@ -493,7 +559,7 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
     # as ANDES: their power-flow equations stay in the time domain (weakgrid.sim.sources)
     for mname, ix, b in bare:
         src = "InfiniteBus" if mname == "Slack" else "PVSource"
-        system._component(src, "device").add_source(f"{mname}_{ix}", gen_row[ix])
+        system._component(src, "device").add_source(name_of(mname, ix), gen_row[ix])
         what = ("an ideal voltage source (infinite bus: fixed voltage and angle, infinite "
                 "inertia, unlimited current)" if mname == "Slack" else
                 "a constant-P, constant-|V| source (no inertia, unlimited reactive power)")
@@ -526,9 +592,10 @@ def from_andes(ss, include_events: bool = True, conventions: str = "standard", s
                 if _raw(fl, "u")[k] <= 0 or on_off_bus(fl, k, "bus"):
                     continue
                 tc = float(_raw(fl, "tc")[k])
-                events.append(Fault(pos[fl.bus.v[k]] + 1, float(_raw(fl, "tf")[k]), tc if tc > 0 else None,
+                events.append(Fault(num[fl.bus.v[k]], float(_raw(fl, "tf")[k]), tc if tc > 0 else None,
                                     rf=float(_raw(fl, "rf")[k]), xf=float(_raw(fl, "xf")[k])))
-    system.andes_bus_id = {b: pos[b] + 1 for b in bidx}
+    system.andes_bus_id = {b: num[b] for b in bidx}
+    system.andes_device = dict(names_of)   # (ANDES model, idx) -> weakgrid name
     system.andes_line_row = dict(lrow)
     for mname, n in sorted(applied.items()):
         flags = ", ".join(f"{f} = {v:g}" for f, v in ANDES_CONVENTIONS[mname].items())

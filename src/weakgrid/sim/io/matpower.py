@@ -1,8 +1,10 @@
 """MATPOWER case files (``.m`` version 2, or ``.mat``) → the MATPOWER case dict.
 
 Parsing is done by ``matpowercaseframes`` (``.m``) and ``scipy.io.loadmat``
-(``.mat``); bus numbers stay MATPOWER's (1-based, as written in the file), which
-is what :class:`~weakgrid.sim.network.Network` takes.
+(``.mat``); bus numbers stay MATPOWER's (as written in the file), which is what
+:class:`~weakgrid.sim.network.Network` takes, and an ``mpc.bus_name`` becomes the case's
+``bus_names`` (bus number -> name). Generators have no ids in MATPOWER: weakgrid names them by
+bus number and their place at the bus (:func:`weakgrid.sim.templates.machine_id`).
 """
 
 from __future__ import annotations
@@ -28,7 +30,8 @@ def load_matpower(path, variable: str = "mpc") -> dict:
 
     Returns
     -------
-    dict with ``baseMVA``, ``bus``, ``gen``, ``branch`` (numpy arrays, MATPOWER columns).
+    dict with ``baseMVA``, ``bus``, ``gen``, ``branch`` (numpy arrays, MATPOWER columns) and,
+    when the file has ``mpc.bus_name``, ``bus_names``.
     """
     path = Path(path)
     if not path.exists():
@@ -46,6 +49,11 @@ def load_matpower(path, variable: str = "mpc") -> dict:
             if not hasattr(cf, key):
                 raise DataError("MATPOWER case", key, "missing", f"the file has no mpc.{key}")
             case[key] = np.asarray(getattr(cf, key).values, dtype=float)
+        names = getattr(cf, "bus_name", None)      # optional mpc.bus_name, in bus order
+        if names is not None and len(names) == len(case["bus"]):
+            case["bus_names"] = {int(b): str(n).strip()
+                                 for b, n in zip(case["bus"][:, 0], np.ravel(np.asarray(names)))
+                                 if str(n).strip()}
         return case
     if path.suffix == ".mat":
         from scipy.io import loadmat

@@ -2,7 +2,8 @@
 
 Generalizes :mod:`weakgrid.sim.peer.andes_runs` (stock cases by name, one machine
 model) to any case file: machines of every model are matched by name
-(``"<model>_<idx>"``, the names :func:`weakgrid.sim.io.andes.from_andes` gives),
+(:func:`weakgrid.sim.io.andes.device_name`, the names :func:`weakgrid.sim.io.andes.from_andes`
+gives),
 the case's own timed events can be replaced by one three-phase fault, PSS/E branch
 data get their true base in ANDES's copy too
 (:func:`weakgrid.sim.io.andes.fix_psse_branch_base`), and the ANDES system can be
@@ -16,6 +17,7 @@ import time
 
 import numpy as np
 
+from ..io.andes import device_name
 from .andes_runs import interp_to
 
 MACHINES = ("GENROU", "GENCLS")
@@ -78,11 +80,12 @@ def auto_fault_bus(ss):
 
 
 def machine_names(ss):
-    """Names ``"<model>_<idx>"`` of the in-service machines of an ANDES system."""
+    """weakgrid's names (:func:`weakgrid.sim.io.andes.device_name`) of the in-service machines
+    of an ANDES system."""
     out = []
     for m in MACHINES:
         mdl = ss.models[m]
-        out += [f"{m}_{ix}" for k, ix in enumerate(mdl.idx.v) if mdl.u.v[k] > 0]
+        out += [device_name(m, ix) for k, ix in enumerate(mdl.idx.v) if mdl.u.v[k] > 0]
     return out
 
 
@@ -180,7 +183,7 @@ def run_andes_ss(ss, tf, h, tol=1e-8, hold_step=False, configure=None):
             if mdl.u.v[k] > 0:
                 om.append(mdl.omega.a[k])
                 de.append(mdl.delta.a[k])
-                names.append(f"{m}_{ix}")
+                names.append(device_name(m, ix))
     out = {"t": np.asarray(ts.t), "omega": np.asarray(ts.x[:, om]), "delta": np.asarray(ts.x[:, de]),
            "names": names, "wall": wall, "ok": bool(ss.exit_code == 0), "ss": ss}
     if not out["ok"]:

@@ -10,6 +10,8 @@ import time
 
 import numpy as np
 
+from ..io.andes import device_name
+
 
 def load_andes(case: str, fault=None, disable_toggles=False, add=(), edit=(), addfile=None):
     """Load an ANDES stock case with ``andes.load(..., setup=False)``; optionally add a fault.
@@ -76,7 +78,8 @@ def run_andes(case, tf=10.0, h=1 / 120, fault=None, disable_toggles=False, tol=1
     gen = ss.GENROU if ss.GENROU.n else ss.GENCLS
     ts = ss.dae.ts
     return {"t": np.asarray(ts.t), "omega": np.asarray(ts.x[:, gen.omega.a]),
-            "delta": np.asarray(ts.x[:, gen.delta.a]), "wall": wall, "names": list(gen.idx.v),
+            "delta": np.asarray(ts.x[:, gen.delta.a]), "wall": wall,
+            "names": [device_name(gen.class_name, ix) for ix in gen.idx.v],
             "ok": bool(ss.exit_code == 0)}
 
 

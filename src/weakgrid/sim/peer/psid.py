@@ -153,11 +153,9 @@ class Names:
             hits = [n for n in names if pat.match(n)]
         else:   # ANDES route: ANDES's names carry no PSS/E id; match by bus
             hits = []
-            for n in names:
-                model, _, idx = n.partition("_")
+            for (model, idx), n in self.sys.andes_device.items():
                 mdl = self.ss.models.get(model)
-                ids = [str(v) for v in mdl.idx.v] if mdl is not None else []
-                if idx in ids and int(mdl.bus.v[ids.index(idx)]) == int(bus):
+                if n in names and int(mdl.bus.v[mdl.idx.v.index(idx)]) == int(bus):
                     hits.append(n)
         if len(hits) != 1:
             raise DataError(f"machine ({bus}, '{gid}')", "name", hits,

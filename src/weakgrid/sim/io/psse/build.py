@@ -390,5 +390,14 @@ class _Builder:
         s.psse_branch_row = dict(maps.branch_row)
         s.psse_transformer_rows = dict(maps.transformer_rows)
         s.psse_star_bus = dict(maps.star_bus)
+        net = s.network      # the PSS/E identifiers on the network too (printouts, studies)
+        net.bus_names.update({int(b): str(n).strip() for b, n in maps.bus_name.items()
+                              if str(n).strip()})
+        for (i, j, c), row in maps.branch_row.items():
+            net.branch_names[int(row)] = f"{i}-{j}-{c}"
+        for (i, j, k, c), rows in maps.transformer_rows.items():
+            for w, row in enumerate(rows, start=1):
+                net.branch_names[int(row)] = (f"{i}-{j}-{c}" if k == 0 else
+                                              f"{i}-{j}-{k}-{c} winding {w}")
         s.conventions = "standard"
         s.conventions_applied = {}
