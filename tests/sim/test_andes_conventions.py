@@ -66,7 +66,9 @@ def test_conventions_set_the_flags_and_say_so():
         anc.setup()
     c_std, c_anc = std.components["IEEEX1"], anc.components["IEEEX1"]
     assert np.all(c_std.p["VR_Vt"] == 1) and np.all(c_anc.p["VR_Vt"] == 0)
-    assert std.conventions_applied == {} and anc.conventions_applied == {"IEEEX1": 10}
+    # ieee39's IEEEST have A3 = A4 = 0: ANDES then drops the filter's numerator (F2_bypass)
+    assert std.conventions_applied == {} and \
+        anc.conventions_applied == {"IEEEX1": 10, "IEEEST": 10}
     assert any("IEEEX1 (10): ANDES 2.0 conventions, VR_Vt = 0" in n for n in anc.import_notes)
     # regulator limits: VRMAX*Vt0 (standard) and VRMAX itself (ANDES)
     i_std = np.isin(std.lim_idx, c_std.idx("VR"))
