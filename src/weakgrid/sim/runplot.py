@@ -1,4 +1,5 @@
-"""Plots of run files (``weakgrid plot``): chosen signals against time, one panel per unit."""
+"""Plots of run files (``weakgrid plot``): chosen signals against time, one panel per quantity
+(its kind and unit: speeds and voltages in pu are not drawn on one axis)."""
 
 from __future__ import annotations
 
@@ -36,20 +37,22 @@ def plot_run(path, signals, output=None, *, si: bool = False, dpi: int = 110) ->
     output = path.with_suffix(".png") if output is None else Path(output)
     # both rows of a breakpoint: a jump is drawn as the vertical step it is
     df = read_run(path, list(signals), si=si, pre_event=True)
-    units = df.attrs["units"]
+    units, kinds = df.attrs["units"], df.attrs.get("kinds", {})
     cols = [c for c in df.columns if c not in ("t", "pre_event")]
-    groups: dict[str, list[str]] = {}
-    for c in cols:
-        groups.setdefault(units.get(c, ""), []).append(c)
+    groups: dict[tuple[str, str], list[str]] = {}
+    for c in cols:     # one panel per quantity: its kind (speed, voltage, ...) and unit
+        groups.setdefault((kinds.get(c, ""), units.get(c, "")), []).append(c)
     n = len(groups)
-    fig, axes = new_figure(n, 1, figsize=(7.0, 2.4 * n + 0.8), sharex=True, squeeze=False)
+    fig, axes = new_figure(n, 1, figsize=(9.0, 2.4 * n + 0.8), sharex=True, squeeze=False)
     t = df["t"].to_numpy()
-    for ax, (unit, names) in zip(axes[:, 0], groups.items()):
+    for ax, ((kind, unit), names) in zip(axes[:, 0], groups.items()):
         for c in names:
             ax.plot(t, df[c].to_numpy(), lw=1.1, label=c)
-        ax.set_ylabel(unit)
+        ax.set_ylabel(f"{kind} [{unit}]" if kind and kind != "pu" else unit)
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8, loc="best", ncol=1 + len(names) // 8)
+        # beside the axes: a legend inside would hide the curves
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0,
+                  ncol=1 + len(names) // 12)
     axes[-1, 0].set_xlabel("time [s]")
     meta = df.attrs.get("meta", {})
     title = " · ".join(str(meta[k]) for k in ("study", "scenario", "controller") if meta.get(k))
