@@ -193,20 +193,42 @@ def _branch_row(setup, ref, where):
 
 
 def make_events(setup, run: Run):
-    """Simulator events of a run's scenario."""
+    """Simulator events of a run's scenario.
+
+    Checked once the grid's identifiers are resolved (the study file's own check compares the
+    references as written): no trip of the UPQC's own series branch however it is addressed
+    (name, row or its buses), no two faults overlapping in time at one bus (``3`` and ``"3"``
+    are one bus)."""
     out = []
     for j, e in enumerate(run.events):
         w = f"scenarios.{run.scenario}.events.{j}"
         if e["kind"] == "fault":
-            out.append(Fault(bus=setup.bus(e["bus"], f"{w}.bus"), t_on=e["t_on"],
-                             t_off=e["t_off"], rf=float(e["rf"]), xf=float(e["xf"])))
+            f = Fault(bus=setup.bus(e["bus"], f"{w}.bus"), t_on=e["t_on"], t_off=e["t_off"],
+                      rf=float(e["rf"]), xf=float(e["xf"]))
+            for k, g in enumerate(out):
+                if isinstance(g, Fault) and g.bus == f.bus and f.t_on < _end(g) and \
+                        g.t_on < _end(f):
+                    raise ParameterError(f"{w}.t_on", e["t_on"], f"overlaps the fault at the "
+                                         f"same bus ({e['bus']}, {g.t_on:g}-{g.t_off:g} s) of "
+                                         f"another event of this scenario; give one fault, or "
+                                         "let the second start after the first is cleared")
+            out.append(f)
         elif e["kind"] == "line_trip":
-            out.append(LineTrip(_branch_row(setup, e["branch"], f"{w}.branch"), e["t"],
-                                close=bool(e.get("close", False))))
+            row = _branch_row(setup, e["branch"], f"{w}.branch")
+            if row == getattr(setup, "upqc_branch", None) and setup.upqc_name:
+                raise ParameterError(f"{w}.branch", e["branch"], "is the UPQC's own series "
+                                     "branch: tripping it disconnects the UPQC; trip another "
+                                     "branch")
+            out.append(LineTrip(row, e["t"], close=bool(e.get("close", False))))
         else:
             _plausible_step(setup, e, w)
             out.append(LoadStep(setup.bus(e["bus"], f"{w}.bus"), e["t"], e["dP"], e["dQ"]))
     return out
+
+
+def _end(fault) -> float:
+    """Clearing time of ``fault`` [s] (a permanent fault never clears)."""
+    return float("inf") if fault.t_off is None else float(fault.t_off)
 
 
 STEP_LIMIT = 10.0   # a load step beyond this many times the grid's size is refused
