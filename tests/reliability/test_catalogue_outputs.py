@@ -130,6 +130,9 @@ CATALOGUE = [
     ("train-over-an-export", "replace only its own", train_over("x.json", b'{"format": "weakgrid-export/1"}\n'), 2, ["--output", "x.json", "not a controller file"]),
     ("train-default-output-taken", "replace only its own", lambda ws: (mine(ws, "case1-paper.controller.json"), ["train", "--preset", "case1-paper", "-q"])[1], 2, ["--output", "case1-paper.controller.json", "--force"]),
     ("gamma-over-a-user-file", "replace only its own", lambda ws: ["gamma", "--preset", "case1-paper", "-o", ws.precious], 2, ["--output", "precious.json", "not a controller file", "--force"]),
+    ("gamma-report-over-a-user-file", "replace only its own", lambda ws: ["gamma", "--preset", "case1-paper", "--report", ws.precious], 2, ["--report", "precious.json", "not a gamma report", "--force"]),
+    ("gamma-report-over-a-controller", "replace only its own", lambda ws: ["gamma", "--preset", "case1-paper", "--report", ws.controller], 2, ["--report", "ctl.json", "not a gamma report"]),
+    ("gamma-report-over-another-commands-record", "replace only its own", lambda ws: (mine(ws, "r.json", b'{"command": "verify", "weakgrid_version": "0.1"}\n'), ["gamma", "--preset", "case1-paper", "--report", ws.root / "r.json"])[1], 2, ["--report", "r.json", "not a gamma report"]),
     ("design-over-a-user-file", "replace only its own", lambda ws: ["design", ws.study, "-o", ws.precious], 2, ["--output", "precious.json", "not a controller file", "--force"]),
     ("design-derivation-taken", "replace only its own", lambda ws: (mine(ws, "c.derivation.json"), ["design", ws.study, "-o", ws.root / "c.controller.json"])[1], 2, ["--output", "c.derivation.json", "not a derivation file"]),
     # ---------------------------------------------------------------- export: a hand-edited or foreign file
@@ -287,3 +290,73 @@ def test_a_manifest_lists_before_the_write_and_never_leaves_the_folder(tmp_path)
         with pytest.raises(ParameterError, match="outside the output folder"):
             m.claim([outside])
     assert m.remove([tmp_path / "o" / "a.json"]) == []                # nothing to delete
+
+
+# ------------------------------------------------- a listed file swapped: content, not name
+def test_a_manifest_records_each_files_content_once_written(tmp_path, caplog):
+    import logging
+
+    from weakgrid.game.errors import ParameterError
+    from weakgrid.hashing import file_sha256
+
+    out = tmp_path / "o"
+    a, b = out / "a.json", out / "b.json"
+    m = Manifest(out)
+    m.claim([a, b])
+    a.write_text("weakgrid's a")
+    b.write_text("weakgrid's b")
+    m.record([a, b])
+    files = json.loads((out / MANIFEST_NAME).read_text())["files"]
+    assert files == {"a.json": file_sha256(a), "b.json": file_sha256(b)}
+    a.write_bytes(MINE)                                   # the user's file swapped in
+    m = Manifest(out)
+    assert not m.owns(a) and m.owns(b)
+    with pytest.raises(ParameterError, match="content changed since weakgrid wrote it"):
+        m.claim([a])
+    m.claim([a], force=True)                              # --force: weakgrid's again
+    with caplog.at_level(logging.WARNING, logger="weakgrid"):
+        b.write_bytes(MINE)
+        assert Manifest(out).remove([a, b]) == [a]        # a (claimed again) goes, b stays
+    assert b.read_bytes() == MINE
+    assert any("b.json" in r.getMessage() and "changed" in r.getMessage()
+               for r in caplog.records)
+    assert "b.json" not in json.loads((out / MANIFEST_NAME).read_text())["files"]
+
+
+def test_a_users_file_swapped_in_for_a_listed_one_is_left_alone(ws, cli, monkeypatch):
+    """After a reproduce, the user puts their own files where weakgrid's were (a report, a
+    stale run's record): the next run refuses the first (named, untouched) and its clean-up
+    of a smaller plan leaves the second alone and says so."""
+    out = ws.root / "out"
+    code, _, err = _reproduce(cli, out, 2, monkeypatch)
+    assert code == 0, err
+    report, stale = out / "report.html", out / "runs" / "s1-pq.json"
+    assert report.is_file() and stale.is_file()
+    report.write_bytes(MINE)
+    ws.snapshot()
+    code, _, err = _reproduce(cli, out, 2, monkeypatch)
+    assert code == 2 and "report.html" in err and "content changed" in err, err
+    ws.check_untouched()
+    report.unlink()
+    stale.write_bytes(MINE)
+    code, text, err = _reproduce(cli, out, 1, monkeypatch)   # s1 is stale now
+    assert code == 0, err
+    assert stale.read_bytes() == MINE and "s1-pq.json" in text + err
+    assert not (out / "runs" / "s1-pq.parquet").exists()   # weakgrid's: removed
+    assert Manifest(out).owns(report) and report.read_bytes() != MINE
+
+
+def test_gamma_report_replaces_its_own_report(tmp_path):
+    """What ``gamma --report`` takes as its own: a JSON record of the gamma command."""
+    from weakgrid.cli._common import is_command_record
+
+    own = is_command_record("gamma")
+    f = tmp_path / "r.json"
+    f.write_text(json.dumps({"command": "gamma", "weakgrid_version": "1.0", "gamma_star": 3.0}))
+    assert own(f)
+    for other in ({"command": "verify", "weakgrid_version": "1.0"}, {"command": "gamma"},
+                  [1, 2]):
+        f.write_text(json.dumps(other))
+        assert not own(f)
+    f.write_bytes(b"\xff not json")
+    assert not own(f)

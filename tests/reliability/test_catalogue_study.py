@@ -270,3 +270,33 @@ def test_a_missing_output_folder_is_created(ws, cli):
     assert plot.read_text().lstrip().startswith(("<?xml", "<svg"))
     assert sorted(p.name for p in (ws.root / "new").rglob("*")) == ["modes.svg", "sub"]
     ws.check_untouched()
+
+
+# ------------------------------------------------- events checked on the grid while planning
+# Events that only the built grid can judge (a load step beside the grid's size, the UPQC's
+# own branch given by its buses, a bus the grid does not have, faults overlapping at one bus
+# named two ways) stop `run` while it plans, before any training: the engine's training,
+# simulation and sweep estimate are patched to fail, and nothing may be written.
+_STEP = FAULT[:-1] + ', { kind = "load_step", bus = 4, t = 0.3, dP = 1e6 }]'
+_LOW_RED = 'protocol: the high-load controllers applied at low load\nupqc = "reduced"\nt_end = 6.0\ncontrollers = ["hji", "nonlinear-29"]\n'
+PLANNING = [
+    ("run-load-step-1e6-MW", "physical plausibility", run(FAULT, _STEP), 2, ["scenarios.c1-high-conv.events.1.dP", "1000000.0", "times the grid's size"]),
+    ("run-load-step-1e6-MW-last-scenario", "physical plausibility", run(_LOW_RED + FAULT, _LOW_RED + _STEP), 2, ["scenarios.c1-low-red.events.1.dP", "1000000.0", "times the grid's size"]),
+    ("run-trip-upqc-branch-by-buses", "physical plausibility", run(FAULT, FAULT[:-1] + ', { kind = "line_trip", branch = { from = 2, to = 3 }, t = 1.0 }]'), 2, ["events.1.branch", "'from': 2", "UPQC's own"]),
+    ("run-fault-unknown-bus", "physical plausibility", run(FAULT, FAULT.replace("bus = 3", "bus = 99")), 2, ["events.0.bus", "99"]),
+    ("run-faults-overlap-bus-named-two-ways", "physical plausibility", run(FAULT, FAULT[:-1] + ', { kind = "fault", bus = "UPQC shunt bus r", t_on = 0.22, t_off = 0.3, xf = 0.2 }]'), 2, ["events.1.t_on", "0.22", "overlaps"]),
+]
+
+
+@pytest.mark.parametrize("case", PLANNING, ids=[c[0] for c in PLANNING])
+def test_bad_event_stops_run_before_training(case, ws, cli, monkeypatch):
+    import weakgrid.study.engine as engine
+    import weakgrid.study.runner as runner
+
+    def passed(*a, **k):
+        raise AssertionError("a bad event passed planning and the engine started its work")
+
+    monkeypatch.setattr(engine, "train_hji", passed)
+    monkeypatch.setattr(engine, "estimate_sweep", passed)
+    monkeypatch.setattr(runner, "simulate", passed)
+    check_bad_input(case, ws, cli)

@@ -262,6 +262,21 @@ def is_controller_file(path) -> bool:
     return _json_format(path) == FILE_FORMAT
 
 
+def is_command_record(command: str):
+    """``is_own`` of :func:`guard_overwrite` for a JSON record of ``command`` written by
+    weakgrid (:func:`provenance`: its command and weakgrid_version fields)."""
+    import json
+
+    def own(path) -> bool:
+        try:
+            d = json.loads(Path(path).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return False
+        return isinstance(d, dict) and d.get("command") == command and \
+            isinstance(d.get("weakgrid_version"), str)
+    return own
+
+
 def is_export_json(path) -> bool:
     """A ``--format json`` export written by weakgrid (its format tag)."""
     from ..game.export_json import EXPORT_FORMAT
@@ -291,15 +306,16 @@ def is_weakgrid_fmu(path) -> bool:
         return False
 
 
-def guard_overwrite(path, is_own, what: str, force: bool) -> None:
-    """Refuse to replace an existing ``path`` that is not weakgrid's own output of the same
-    kind (``is_own(path) -> bool``) unless ``force``; names the file and the fix."""
+def guard_overwrite(path, is_own, what: str, force: bool, option: str = "--output") -> None:
+    """Refuse to replace an existing ``path`` (given as ``option``) that is not weakgrid's
+    own output of the same kind (``is_own(path) -> bool``) unless ``force``; names the file
+    and the fix."""
     from ..game.errors import ParameterError
 
     p = Path(path)
     if force or not p.exists() or is_own(p):
         return
-    raise ParameterError("--output", str(p), f"exists and is not {what} written by weakgrid; "
+    raise ParameterError(option, str(p), f"exists and is not {what} written by weakgrid; "
                          "it is left alone. Fix: give another file name, move it, or --force "
                          "to overwrite it")
 

@@ -10,7 +10,7 @@ from ..game.gamma_settings import SearchSettings
 from ._checkpoint import (Keeper, add_restart_argument, checkpoint_path, content_key,
                           load_kept, problem_inputs, say_kept)
 from ._common import (HelpFormatter, add_force_argument, add_problem_arguments, bar_disable,
-                      guard_overwrite, guard_training, is_controller_file,
+                      guard_overwrite, guard_training, is_command_record, is_controller_file,
                       output_file, positive_float, positive_int, problem_of, provenance)
 
 NAME = "gamma"
@@ -49,7 +49,7 @@ def add_parser(sub):
     p.add_argument("--quiet", "-q", action="store_true", help="print only the summary")
     add_restart_argument(p, "OUTPUT, else REPORT, else NAME, with the suffix "
                             ".gamma.checkpoint.npz")
-    add_force_argument(p, overwrite="an OUTPUT file")
+    add_force_argument(p, overwrite="an OUTPUT or REPORT file")
     p.set_defaults(func=run)
     return p
 
@@ -92,6 +92,9 @@ def run(args) -> int:
     # CHECKPOINT_SECONDS and on an interruption; a re-run replays the decided trials
     if args.output:
         guard_overwrite(args.output, is_controller_file, "a controller file", args.force)
+    if args.report:
+        guard_overwrite(args.report, is_command_record(NAME), "a gamma report", args.force,
+                        option="--report")
     ckpt = checkpoint_path(args.output or args.report or Path(f"{problem.name}.json"), NAME)
     key = content_key({"command": NAME, **problem_inputs(problem, solver),
                        "search": settings.to_dict()})

@@ -75,6 +75,9 @@ def run(args) -> int:
         from ..study.sweep_maps import draw_maps, map_summaries
 
         maps = draw_maps(st, table, out / "maps", quick=args.quick)
+        from ..manifest import Manifest
+
+        Manifest(out).record(m["path"] for m in maps if m.get("path"))   # their content
         for s in map_summaries(maps):
             print(f"  {s['claim']}: at the shipped setting {s['at_setting']}; {s['region']}")
     return 0

@@ -522,6 +522,48 @@ def _source_names(network, bus_id, br_names):
             network.branch_names[k] = name
 
 
+def _plausible_rating(up: dict, load: str, v_r: float, i_line: float, Sb: float) -> None:
+    """Check the UPQC rating against what the converter and the line can carry.
+
+    The largest series power is ``|Vu|max · |I_line|``. Beyond the converter's rating
+    (``upqc.insert.sn_mva``, when given) it is refused. Beyond the line's apparent power
+    ``|V_r| · |I_line|`` at the shunt bus r (a series voltage above the bus voltage) it is
+    said loudly, once, as a warning: the shipped studies' sweeps reach rating 1.0 pu, above
+    case 1's sagging shunt-bus voltage (0.83 pu at high load), on purpose.
+
+    Parameters
+    ----------
+    up : dict
+        The study's ``[upqc]`` table (``rating`` in pu of the bus voltage).
+    load : str
+        The load level (in messages).
+    v_r, i_line : float
+        ``|V_r|`` and ``|I_line|`` at the operating point [pu on ``Sb``].
+    Sb : float
+        System power base [MVA].
+    """
+    rating = float(up["rating"])
+    per_pu = i_line * Sb                                  # MVA of series power per pu of |Vu|
+    p_series = rating * per_pu
+    sn = (up.get("insert") or {}).get("sn_mva")
+    if sn is not None and p_series > float(sn) * (1 + 1e-9):
+        raise ParameterError(
+            "upqc.rating", rating, f"its largest series power |Vu|max · |I_line| = "
+            f"{p_series:.4g} MVA at load '{load}' ({100 * p_series / float(sn):.0f} % of the "
+            f"converter's rating upqc.insert.sn_mva = {float(sn):g} MVA) is beyond what the "
+            f"converter carries. Give a rating at most {float(sn) / per_pu:.3g} pu, or a "
+            "larger upqc.insert.sn_mva")
+    s_line = v_r * per_pu
+    if p_series > s_line * (1 + 1e-9):
+        _say_once(logging.WARNING, (
+            f"warning: upqc.rating = {rating:g} pu: its largest series power |Vu|max · "
+            f"|I_line| = {p_series:.4g} MVA is {100 * p_series / s_line:.0f} % of the line's "
+            f"power at load '{load}' ({s_line:.4g} MVA = |V_r| {v_r:.4g} pu × |I_line| "
+            f"{i_line:.4g} pu on {Sb:g} MVA): a series voltage above the shunt bus's own. "
+            f"Results at this rating are beyond a plausible device; a rating at most "
+            f"{v_r:.3g} pu keeps it within the line"))
+
+
 def build_setup(study, load: str | None = None, upqc: str | None = None,
                 variant: str = "upqc") -> Setup:
     """Build and set up the study's grid at ``load`` with the UPQC in structure ``upqc``;
@@ -605,6 +647,8 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
     yu = 1.0 / complex(net.branch[k_up, BR_R], net.branch[k_up, BR_X])
     I = yu * (net.pf.V[r] - net.pf.V[b1])
     p_line = abs(float((net.pf.V[r] * np.conj(I)).real)) * net.Sb
+    if upqc_name:
+        _plausible_rating(up, load, abs(net.pf.V[r]), abs(I), float(net.Sb))
     if der.machine == "gti":
         measure_signals = gti_signals(ctl_name)
         state_map = gti_state_map(s, ctl_name)

@@ -34,11 +34,11 @@ from ..models import load_preset
 from .build import build_setup
 from .cache import inputs_key, load_run, remove_stale, save_run
 from .claims import judge_all
-from .controllers import controller_kind, train_hji
+from .controllers import controller_kind, controller_variant, train_hji
 from .figures import figure_specs, write_figures
 from .report import write_html, write_tables
 from ..sweep import open_client, run_sweep
-from .runner import Run, RunRecord, run_scenario
+from .runner import Run, RunRecord, make_events, run_scenario
 from .sweep import _axes, describe_sweep, run_point, sweep_points
 from .sweep_estimate import estimate_sweep, run_cost
 from .sweep_maps import draw_maps, map_summaries
@@ -170,6 +170,20 @@ def planned_files(out: Path, plan, quick: bool, maps: bool) -> list[Path]:
     return files
 
 
+def check_events(plan) -> None:
+    """Build every run's events on its grid (:func:`weakgrid.study.runner.make_events`) so
+    that an event the grid cannot carry (an unknown bus or branch, the UPQC's own branch, a
+    load step beyond the grid's size, overlapping faults) stops the command before any
+    training; a grid is set up once per (study, load, UPQC structure, variant)."""
+    setups = {}
+    for st, runs, _ in plan:
+        for run in runs:
+            key = (id(st), run.load, run.upqc, controller_variant(st, run.controller))
+            if key not in setups:
+                setups[key] = build_setup(st, *key[1:])
+            make_events(setups[key], run)
+
+
 def run_studies(studies, output, quick=False, log=None, title=None, progress=True,
                 scheduler=None, workers=None, maps=True, force=False) -> dict:
     """Run every (scenario, controller) of ``studies`` and write everything to ``output``.
@@ -205,9 +219,12 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                                    if n_maps else "") + f", {_sweep_file(quick)}")
     total = sum(len(r) + len(k) for _, r, k in plan)
     # the files this plan writes are weakgrid's (listed before they are written); a file of
-    # the user's in the way stops here, before any work
+    # the user's in the way, or a bad event, stops here, before any work or write
     manifest = Manifest(out)
-    manifest.claim(planned_files(out, plan, quick, maps), force=force)
+    files = planned_files(out, plan, quick, maps)
+    manifest.check(files, force=force)
+    check_events(plan)
+    manifest.claim(files, force=force)
     runs_dir.mkdir(parents=True, exist_ok=True)
     # a used folder: runs this plan does not make are stale (only those weakgrid wrote);
     # finished runs with the same inputs are kept and not redone (an interrupted run
@@ -240,6 +257,7 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                 problem, ctl = train_hji(st, setup.design)
                 ctl.problem["inputs_key"] = ckey
                 ctl.save(cpath)
+                manifest.record([cpath])
             else:
                 n_kept += 1
             trained[(load, upqc)] = ctl
@@ -291,6 +309,7 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                 run, rkey = futs[fut]
                 records[run.id] = rec = fut.result()
                 save_run(rec, runs_dir, rkey)    # kept as soon as it is finished
+                manifest.record(runs_dir / f"{run.id}{x}" for x in (".parquet", ".json"))
                 rec.results = None               # every signal is in its run file now
                 bar.set_postfix_str(run.id)
                 bar.update(1)
@@ -299,6 +318,7 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                 bar.set_postfix_str(run.id)
                 records[run.id] = rec = run_scenario(st, run, trained)
                 save_run(rec, runs_dir, rkey)
+                manifest.record(runs_dir / f"{run.id}{x}" for x in (".parquet", ".json"))
                 rec.results = None               # every signal is in its run file now
                 bar.update(1)
         metrics = [records[run.id].metrics for _, run, _, _ in all_runs]
@@ -349,6 +369,7 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
     write_json_atomic(out / "claims.json", {"claims": claims, "weakgrid_version": __version__,
                                             "quick": quick, "wall_s": wall})
     write_json_atomic(out / "designs.json", {"designs": designs, "weakgrid_version": __version__})
+    manifest.record(planned_files(out, plan, quick, maps))   # their content, as written
     log(f"wrote {report}, {csv}, {md}, {len(figs)} figure files in {wall:.0f} s")
     return {"claims": claims, "metrics": metrics, "figures": figs, "report": report,
             "csv": csv, "markdown": md, "wall_s": wall, "designs": designs,

@@ -353,6 +353,10 @@ def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
     out = Path(output)
     table_path = claim_sweep_outputs(study, out, quick, maps, force)
     pts = sweep_points(study, quick)
-    return run_sweep(pts, run_point, cache_dir=cache_dir or out / "cache", scheduler=scheduler,
-                     workers=workers, progress=progress, log=log, cost=run_cost,
-                     table_path=table_path, desc=f"sweep {study.name}")
+    from ..manifest import Manifest
+
+    table = run_sweep(pts, run_point, cache_dir=cache_dir or out / "cache",
+                      scheduler=scheduler, workers=workers, progress=progress, log=log,
+                      cost=run_cost, table_path=table_path, desc=f"sweep {study.name}")
+    Manifest(out).record([table_path])   # its content, as written
+    return table
