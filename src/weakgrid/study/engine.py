@@ -195,6 +195,8 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
     weakgrid writes only into ``output`` and deletes there only files it wrote (its manifest,
     :class:`weakgrid.manifest.Manifest`): a file of another origin with the name of an output
     stops the run before any work (unless ``force``: overwritten); other files are left alone.
+    Every run's events are built on its grid while planning (:func:`check_events`): a bad
+    event stops the command before any training or write.
 
     Returns a summary dict (claims, metrics, figures, report, designs, maps).
     """
