@@ -31,6 +31,10 @@ def controller_name(study, name: str) -> str:
     return full if name == kind else f"{name} ({full})"
 
 
+def _bus(b) -> str:
+    return str(b) if str(b).lower().startswith("bus") else f"bus {b}"
+
+
 def _t(x) -> str:
     return f"{float(x):g} s"
 
@@ -41,7 +45,7 @@ def describe_event(ev: dict) -> str:
     if kind == "fault":
         t_on = float(ev["t_on"])
         t_off = float(ev["t_off"]) if "t_off" in ev else t_on + float(ev["duration"])
-        return (f"three-phase fault at bus {ev['bus']} at t = {_t(t_on)} for "
+        return (f"three-phase fault at {_bus(ev['bus'])} at t = {_t(t_on)} for "
                 f"{(t_off - t_on) * 1e3:g} ms (cleared at {_t(t_off)}), fault impedance "
                 f"{float(ev.get('rf', 0.0)):g} + j{float(ev.get('xf', 0.0)):g} pu")
     if kind == "line_trip":
@@ -50,26 +54,38 @@ def describe_event(ev: dict) -> str:
         return (f"branch {br} {'closes' if ev.get('close') else 'opens'} at t = "
                 f"{_t(ev['t'])}")
     if kind == "load_step":
-        return (f"load step at bus {ev['bus']} at t = {_t(ev['t'])}: ΔP = "
+        return (f"load step at {_bus(ev['bus'])} at t = {_t(ev['t'])}: ΔP = "
                 f"{float(ev.get('dP', 0.0)):g} pu, ΔQ = {float(ev.get('dQ', 0.0)):g} pu")
     return ", ".join(f"{k} = {v}" for k, v in ev.items())
 
 
-def speed_machine(study) -> str:
-    """The machine whose speed the report draws (``report.speed_of``, else the controlled
-    machine)."""
-    return study.data.get("report", {}).get("speed_of") or study.data["machine"]["name"]
+def speed_machine(study) -> str | None:
+    """The synchronous machine whose speed the report draws (as the run's ``sg_speed``
+    signal, :func:`weakgrid.study.build.build_setup`): ``report.speed_of``, else the
+    controlled machine when it is an SG, else the first ``[[dynamics.generator]]``; None when
+    there is none (``speed_of = ""``)."""
+    from .build import _first_generator
+
+    d = study.data
+    speed_of = d.get("report", {}).get("speed_of")
+    if speed_of is not None:
+        return speed_of or None
+    name = d["machine"]["name"]
+    gti = any(g["name"] == name for g in d.get("dynamics", {}).get("gti", []))
+    return (_first_generator(d) if gti else name) or None
 
 
 def protocol_of(study, quick: bool = False) -> list[str]:
     """The protocol paragraphs of ``study`` from its own data."""
     d = study.data
     g, m, up = d["grid"], d["machine"], d.get("upqc") or {}
-    grid = g.get("network") or g.get("file") or g.get("case") or "inline"
-    out = [f"{study.name}: {d['study'].get('title', study.name)}. Grid: {g['kind']} "
-           f"network {grid}; controlled machine {m['name']}"
-           + (f"; speed drawn and measured: {speed_machine(study)}" if
-              d.get('report', {}).get('speed_of') != "" else "") + "."]
+    src = g.get("network") or g.get("file") or g.get("case")
+    grid = f"{g['kind']} network {src}" if src else f"{g['kind']} grid given in the study file"
+    gti = any(x["name"] == m["name"] for x in d.get("dynamics", {}).get("gti", []))
+    out = [f"{study.name}: {d['study'].get('title', study.name)}. Grid: {grid}; controlled "
+           f"machine {m['name']} ({'a grid-tied inverter' if gti else 'a synchronous machine'})"
+           + (f"; speed drawn and measured: {speed_machine(study)}" if speed_machine(study)
+              else "") + "."]
     if up:
         ins = up.get("insert") or {}
         where = (f", inserted in {ins.get('element', '')} {ins.get('index', '')} "
