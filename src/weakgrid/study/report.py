@@ -265,11 +265,11 @@ def write_html(path, *, claims, metrics, figures, designs, meta, notes=None, map
              ]
     with_maps = any(c.get("map_region") for c in claims)
     if claims:
-        parts.append("<h2>Claims</h2><div class='scroll'><table><tr><th>claim</th><th>case</th><th>paper"
-                     "</th><th>measured (shipped setting)</th><th>rule</th><th>verdict at the "
-                     "shipped setting</th>" + ("<th>map: value at the shipped setting (HIGH-"
-                                               "load design)</th><th>map: where it holds</th>"
-                                               if with_maps else "") + "</tr>")
+        parts.append("<h2>Claims</h2><div class='scroll'><table><tr><th>claim</th>"
+                     "<th>case</th><th>paper</th><th>measured (shipped setting)</th>"
+                     "<th>rule</th><th>verdict at the shipped setting</th>"
+                     + ("<th>map: value at the shipped setting (HIGH-load design)</th>"
+                        "<th>map: where it holds</th>" if with_maps else "") + "</tr>")
     for c in claims:
         cls = c["verdict"].replace(" ", "")
         parts.append(f"<tr><td>{e(c['id'])}</td><td>{e(c['case'])}</td><td>{e(c['paper'])}"
