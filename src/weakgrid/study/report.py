@@ -233,7 +233,7 @@ def _metrics_html(metrics) -> str:
 _CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em}
 .scroll{overflow-x:auto;max-width:100%}table{border-collapse:collapse;font-size:0.85em;
 margin:1em 0}td,th{border:1px solid #ccc;padding:3px 6px;vertical-align:top;min-width:4em;
-max-width:40em;overflow-wrap:break-word}pre{white-space:pre-wrap;overflow-wrap:anywhere;
+max-width:40em;overflow-wrap:break-word}td:first-child{white-space:nowrap}pre{white-space:pre-wrap;overflow-wrap:anywhere;
 max-height:30em;overflow:auto}th{background:#f4f4f4}.reproduced{background:#d8f5d8}
 .partly{background:#fff3c4}.not{background:#f8d0d0}.notrun{background:#eee}
 img{max-width:100%;border:1px solid #ddd;margin:0.5em 0}"""
