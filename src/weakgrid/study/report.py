@@ -93,8 +93,8 @@ def sweep_html(entry: dict) -> str:
     return (f"<h2>Sweep of {e(entry['study'])}</h2><p>{e(entry['text'])}. Every metric of "
             f"every run: <code>{e(entry['file'])}</code>.</p><details"
             f"{' open' if entry.get('open') else ''}><summary>{len(df)} runs"
-            f"{f', {n_fail} failed' if n_fail else ''}</summary><table><tr>{head}</tr>{rows}"
-            "</table></details>")
+            f"{f', {n_fail} failed' if n_fail else ''}</summary><div class='scroll'><table><tr>"
+            f"{head}</tr>{rows}</table></div></details>")
 
 
 def metrics_frame(metrics: list[dict]) -> pd.DataFrame:
@@ -284,14 +284,15 @@ def write_html(path, *, claims, metrics, figures, designs, meta, notes=None, map
         parts.append("<h2>Protocol</h2>" + "".join(f"<p>{e(p)}</p>" for p in protocol))
     parts.append(_best_html(best or []))
     if maps:
-        parts.append("<h2>Where the claims hold: maps</h2><table><tr><th>study</th><th>map"
+        parts.append("<h2>Where the claims hold: maps</h2><div class='scroll'><table><tr>"
+                     "<th>study</th><th>map"
                      "</th><th>value at the shipped setting (verdict)</th><th>where it holds"
                      "</th></tr>")
         for m in maps:
             parts.append(f"<tr><td>{e(m['study'])}</td><td>{e(m['claim'])}: {e(m['title'])}"
                          f"</td><td>{e(m['at_setting'])}</td><td>{e(m['region'])} "
                          f"({m['n_holds']} of {m['n_cells']} cells)</td></tr>")
-        parts.append("</table>")
+        parts.append("</table></div>")
         parts.append(f"<p>{e(FAILED_CELLS_NOTE)}</p>")
         for m in maps:
             if m.get("path"):
