@@ -9,14 +9,15 @@ import pandas as pd
 import pytest
 
 from weakgrid.cli.main import main
-from weakgrid.study.figures import PANELS, figure_specs
+from weakgrid.study.figures import figure_specs, panel_label
 from weakgrid.study.report import COLUMNS
 from weakgrid.study.reproduce import paper_studies
 
 pytestmark = pytest.mark.slow
 
 
-FIGURES = [(f["id"], f["title"], [(k, PANELS[k]) for k in f["panels"]], f["runs"])
+FIGURES = [(f["id"], f["title"], [(k, panel_label(k, f.get("machine"))) for k in f["panels"]],
+            f["runs"])
            for st in paper_studies() for f in figure_specs(st, quick=True)]
 RUN_IDS = [f"{sc['id']}-{c}" for st in paper_studies() for sc, c in st.runs(quick=True)]
 

@@ -149,6 +149,10 @@ def _write_state_matrix(path, system, setup):
     print(f"  wrote {path} (A {A.shape}, B {B.shape}, C {C.shape}; {how})")
 
 
+EM_HZ_MAX = 3.0     # Hz, the top of the electromechanical range the eigenvalue plot shows
+EM_ZETA_MAX = 0.3   # damping ratio above which an oscillatory pole is not an electromechanical mode
+
+
 def _plot(path, m, k_m, lam_d, setup, name):
     import numpy as np
 
@@ -164,11 +168,25 @@ def _plot(path, m, k_m, lam_d, setup, name):
     if lam_d is not None:
         ax.scatter([0, 0], [lam_d.imag, -lam_d.imag], marker="x", c="k",
                    label="design model (10)")
-    osc = np.abs(lam.imag)[np.abs(lam.imag) > 1e-6]
-    top = abs(lam_d.imag) if lam_d is not None else (osc.max() if osc.size else 0.0)
-    lim = max(40.0, 1.2 * top)
-    ax.set_ylim(-lim, lim)
-    ax.set_xlim(max(lam.real.min(), -4 * lim), max(1.0, lam.real.max() + 1))
+    # zoomed on the electromechanical range (lightly damped, |f| ≤ EM_HZ_MAX), not autoscaled
+    # to the fastest pole; the poles outside the view are counted in a note
+    zeta = -lam.real / np.maximum(np.abs(lam), 1e-12)
+    em = lam[(np.abs(lam.imag) > 1e-6) & (np.abs(lam.imag) <= 2 * np.pi * EM_HZ_MAX)
+             & (zeta <= EM_ZETA_MAX)]
+    tops = list(np.abs(em.imag)) + ([abs(lam_d.imag)] if lam_d is not None else [])
+    ylim = 1.15 * max(tops + [2 * np.pi * EM_HZ_MAX])
+    re = list(em.real) + ([lam[k_m].real] if k_m is not None else [])
+    lo, hi = min(re + [-0.5]), max(re + [0.0])
+    ax.set_ylim(-ylim, ylim)
+    ax.set_xlim(2.0 * lo, max(0.5, 2.0 * hi))
+    x0, x1 = ax.get_xlim()
+    out = lam[(lam.real < x0) | (lam.real > x1) | (np.abs(lam.imag) > ylim)]
+    if out.size:
+        w = np.abs(out.imag).max()
+        ax.text(0.01, 0.01, f"{out.size} poles outside the view (σ from {out.real.min():.3g} "
+                f"to {out.real.max():.3g} 1/s" + (f", |ω| up to {w:.3g} rad/s" if w > ylim
+                                                   else "") + ")",
+                transform=ax.transAxes, fontsize=7, color="0.3")
     for z in (0.05, 0.1):
         x = np.linspace(ax.get_xlim()[0], 0, 2)
         ax.plot(x, -x * np.sqrt(1 - z**2) / z, ":", c="0.6", lw=0.8)
@@ -176,7 +194,8 @@ def _plot(path, m, k_m, lam_d, setup, name):
     ax.set_xlabel("real part σ [1/s]")
     ax.set_ylabel("imaginary part ω [rad/s]")
     load = f"{setup.load} load; " if setup is not None else ""
-    ax.set_title(f"{name}: eigenvalues ({load}dotted: ζ = 5 %, 10 %)", fontsize=10)
+    ax.set_title(f"{name}: electromechanical eigenvalues, |f| ≤ {EM_HZ_MAX:g} Hz ({load}"
+                 "dotted: ζ = 5 %, 10 %)", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()

@@ -36,24 +36,20 @@ from .cache import inputs_key, load_run, remove_stale, save_run
 from .claims import judge_all
 from .controllers import controller_kind, controller_variant, train_hji
 from .figures import figure_specs, write_figures
-from .report import write_html, write_tables
+from .protocol import controller_name, protocol_of
+from .report import who_did_best, write_html, write_tables
 from ..sweep import open_client, run_sweep
 from .runner import Run, RunRecord, make_events, run_scenario
 from .sweep import _axes, describe_sweep, run_point, sweep_points
 from .sweep_estimate import estimate_sweep, run_cost
-from .sweep_maps import draw_maps, map_summaries
+from .sweep_maps import draw_maps, map_summaries, metric_uncertainty
 
 __all__ = ["run_studies", "mode_check", "MODE_TOLERANCE"]
 
 MODE_TOLERANCE = 0.05
-PROTOCOL = [
-    "Maps: each claim's measured quantity and verdict over the UPQC rating × the fault "
-    "severity (fault duration) at both load levels, from the study's [sweep]; the shipped "
-    "(paper's) setting is outlined. The claim table gives the verdict at the shipped setting "
-    "(the regular runs) and, from the maps, the value there and the region where it holds.",
-    "Low load (paper's protocol): in the maps the controllers are designed at HIGH load and "
-    "applied at both loads ([sweep] design_load = \"high\"); the regular runs (c1-low-*, "
-    "c2-low-*) keep the per-load redesign as an extra row.",
+# the definitions every report states (whatever the study); a study's own protocol is
+# weakgrid.study.protocol.protocol_of (its data) and its [report] notes
+DEFINITIONS = [
     "Rating: per run, clip_fraction = fraction of the post-fault controller samples at which "
     "the demanded |u| exceeds the UPQC rating (u is then scaled down to it); the demanded "
     "(u_demanded_peak_pu) and applied (u_applied_peak_pu) peaks and control costs are both "
@@ -61,22 +57,19 @@ PROTOCOL = [
     "Training region Ω: omega_reach = max over samples and states of x_i / (Ω's bound on "
     "that side); > 1 means the controller evaluates its value function outside the region it "
     "was trained on (extrapolation = true).",
-    "C2-voltage is judged on the DEMANDED series voltage: the applied one cannot exceed the "
-    "rating, which equals the claim's threshold, so judging it would be a tautology.",
-    "Ties: the numerical uncertainty of a metric is |m(T) − m(T/2)| / |m(T)|, measured by "
-    "running the [sweep.dt_check] points again at half the integration step (per load and "
-    "fault severity, applied to every rating of that row); a difference smaller than it is "
-    "a tie (=), not a win. Not measured in --quick (no ties there).",
     "Numerics: every run integrates with the study's [simulation] step and Newton tolerance "
     "(default: the controller's sampling period T and the simulator's tolerance scaled with "
-    "it); the half-step runs that measure the uncertainty use the simulator's default "
-    "(tighter) tolerance, so the uncertainty includes the tolerance chosen.",
-    "PQ baseline: the GTI's dc link is regulated by an outer dc-voltage PI loop setting P_ref "
-    "(kp_v, ki_v in the case-1 study file), as a real PQ-controlled GTI does; without it the "
-    "dc link settled at 1.11 pu and every dc-link comparison against PQ was an artifact.",
-    "Figs. 10 and 13: J(x(t)) of (30) of the trained HJI controller along each run, beside "
-    "the accumulated running cost of the discrete-time game (18) with and without the "
-    "−γ²w'Pw term (w the worst-case disturbance at x).",
+    "it).",
+]
+SWEEP_DEFINITIONS = [
+    "Maps: each claim's measured quantity and verdict over the axes of the study's [sweep]; "
+    "the study's own setting is outlined. The claim table gives the verdict at that setting "
+    "(the regular runs) and, from the maps, the value there and the region where it holds.",
+    "Ties: the numerical uncertainty of a metric is |m(T) − m(T/2)| / |m(T)|, measured by "
+    "running the [sweep.dt_check] points again at half the integration step; a difference "
+    "smaller than it is a tie (=), not a win. The half-step runs use the simulator's default "
+    "(tighter) tolerance, so the uncertainty includes the tolerance chosen. Not measured in "
+    "--quick (no ties there).",
 ]   # design-model mode vs the full grid's mode: relative frequency mismatch
 
 
@@ -241,7 +234,7 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
     all_runs = []   # (study, Run, trained controllers)
     for st, runs, keys in plan:
         trained = {}
-        case_notes = list(st.data["study"]["notes"]) + list(st.data["report"]["notes"])
+        case_notes = list(st.data["study"]["notes"])
         sim = st.data.get("simulation") or {}
         if sim:
             case_notes.append("numerics: " + ", ".join(
@@ -337,7 +330,7 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                                     progress=progress, log=log, cost=run_cost,
                                     table_path=out / _sweep_file(quick),
                                     desc="maps")
-    map_list, sweeps = [], []
+    map_list, sweeps, uncertainty = [], [], {}
     for st in swept:
         sub = sweep_table[sweep_table["scenario"].isin(st.data["sweep"]["scenarios"])]
         sub = sub.dropna(axis=1, how="all")
@@ -347,9 +340,18 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                        "axes": list(_axes(st.data["sweep"], quick)),
                        "text": describe_sweep(st, quick),
                        "open": not any(m.get("path") for m in drawn)})
+        for k, u in metric_uncertainty(sub, _axes(st.data["sweep"], quick)).items():
+            uncertainty[k] = max(uncertainty.get(k, 0.0), u)
     summaries = map_summaries(map_list)
     figs = write_figures(records, out / "figures", fig_specs)
-    csv, md = write_tables(metrics, out)
+    run_title = title or ", ".join(st.data["study"].get("title", st.name) for st in studies)
+    csv, md = write_tables(metrics, out, title=run_title)
+    protocol = [p for st in studies for p in protocol_of(st, quick)
+                + list(st.data["report"]["notes"])]
+    protocol += DEFINITIONS + (SWEEP_DEFINITIONS if swept else [])
+    names = {c: controller_name(st, c) for st in studies for sc in st.scenarios(quick)
+             for c in sc["controllers"]}
+    best = who_did_best(metrics, uncertainty, names)
     claims = judge_all(claims_spec, {m["id"]: m for m in metrics})
     for c in claims:
         ms = [m for m in summaries if m["claim"] == c["id"]]
@@ -362,12 +364,12 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                          "quick": quick}, indent=1, default=str)
     report = write_html(out / "report.html", claims=claims, metrics=metrics,
                         figures=[p for p in figs if p.suffix == ".png"],
-                        designs=designs, notes=notes, protocol=PROTOCOL,
+                        designs=designs, notes=notes, protocol=protocol, best=best,
                         maps=[dict(s_, path=m["path"], study=m["study"]) for s_, m in
                               zip(summaries, map_list)], sweeps=sweeps,
                         meta={"version": __version__, "n_runs": len(metrics), "wall_s": wall,
                               "mode": "quick" if quick else "full", "parameters": params,
-                              "title": title or ", ".join(st.name for st in studies)})
+                              "title": run_title})
     write_json_atomic(out / "claims.json", {"claims": claims, "weakgrid_version": __version__,
                                             "quick": quick, "wall_s": wall})
     write_json_atomic(out / "designs.json", {"designs": designs, "weakgrid_version": __version__})

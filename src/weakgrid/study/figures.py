@@ -7,12 +7,14 @@ figure's note.
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 from ..figure import new_figure
 from ..fileio import savefig_atomic
+from .protocol import controller_name, describe_event, speed_machine
 
-__all__ = ["PANELS", "figure_specs", "write_figures"]
+__all__ = ["PANELS", "MACHINE_PANELS", "figure_specs", "panel_label", "write_figures"]
 
 # panel key -> axis label (with unit); keys are run series (see weakgrid.study.build signals)
 PANELS = {
@@ -30,23 +32,36 @@ PANELS = {
     "phi_hat": "GTI phase error [rad]",
     "sg_pe": "SG electrical power [pu]",
 }
+# panels of one machine: their label names it (``{m}``: the machine, spec key ``machine``)
+MACHINE_PANELS = {"sg_speed": "speed of {m} [pu]", "sg_pe": "electrical power of {m} [pu]"}
+
+
+def panel_label(key: str, machine: str | None = None) -> str:
+    """The axis label of panel ``key``, naming ``machine`` where the panel is one machine's."""
+    if machine and key in MACHINE_PANELS:
+        return MACHINE_PANELS[key].format(m=machine)
+    return PANELS.get(key, key)
 
 
 def figure_specs(study, quick=False) -> list[dict]:
     """The study's ``[[figures]]`` (id, title, panels, runs = [[run id, label]]), or one figure
     per scenario (every controller; speed, dc link, series voltage, power) if it gives none."""
     figs = study.data.get("figures") or []
+    machine = speed_machine(study)
     if figs:
-        return [dict(f) for f in figs]
+        return [dict(f, machine=machine) for f in figs]
     out = []
     kind_gti = any(g["name"] == study.data["machine"]["name"] for g in
                    study.data["dynamics"]["gti"])
     for sc in study.scenarios(quick):
         speed = [] if study.data["report"].get("speed_of") == "" else ["sg_speed"]
         panels = speed + (["dc_voltage"] if kind_gti else []) + ["vu", "p_series_mw"]
-        out.append({"id": f"{study.name}-{sc['id']}", "title": f"{study.name}: {sc['id']}",
+        event = "; ".join(describe_event(e) for e in sc["events"]) or "no event"
+        out.append({"id": f"{study.name}-{sc['id']}", "machine": machine,
+                    "title": f"{study.name}, {sc['id']}: {event}",
                     "panels": panels,
-                    "runs": [[f"{sc['id']}-{c}", c] for c in sc["controllers"]]})
+                    "runs": [[f"{sc['id']}-{c}", controller_name(study, c)]
+                             for c in sc["controllers"]]})
     return out
 
 
@@ -87,7 +102,7 @@ def write_figures(records: dict, folder, specs, formats=("png", "svg")) -> list[
     written = []
     for spec in specs:
         fig_id, title = spec["id"], spec["title"]
-        panels = [(k, PANELS.get(k, k)) for k in spec["panels"]]
+        panels = [(k, panel_label(k, spec.get("machine"))) for k in spec["panels"]]
         runs = [tuple(r) for r in spec["runs"]]
         fig, axes = new_figure(len(panels), 1, figsize=(7.0, 2.6 * len(panels) + 0.6),
                                sharex=True, squeeze=False)
@@ -111,7 +126,8 @@ def write_figures(records: dict, folder, specs, formats=("png", "svg")) -> list[
             if ax.lines:
                 ax.legend(fontsize=8, loc="best")
         axes[-1, 0].set_xlabel("time [s]")
-        fig.suptitle(f"{spec.get('label', fig_id)} — {title}", fontsize=10)
+        fig.suptitle("\n".join(textwrap.wrap(f"{spec.get('label', fig_id)} — {title}", 90)),
+                     fontsize=10)
         if missing:
             fig.text(0.01, 0.005, "not run: " + ", ".join(missing), fontsize=7, color="0.4")
         fig.tight_layout(rect=(0, 0.02, 1, 1))

@@ -72,6 +72,27 @@ def _rel_uncertainty(half, full, match, row_keys, metric, ctl):
     return out
 
 
+def metric_uncertainty(table: pd.DataFrame, axes) -> dict:
+    """metric → the largest relative ``|m(T) − m(T/2)| / |m(T)|`` over the half-step runs of
+    ``table`` (a sweep's table; every controller and point with both runs); metrics without a
+    half-step run are absent."""
+    if "dt_factor" not in table or "controller" not in table:
+        return {}
+    full, half = table[table["dt_factor"] == 1.0], table[table["dt_factor"] != 1.0]
+    if half.empty:
+        return {}
+    from .report import BETTER
+
+    match = list(axes) + ["scenario", "controller"]
+    out = {}
+    for m in BETTER:
+        for c in full["controller"].unique():
+            by = _rel_uncertainty(half, full, match, [], m, c)
+            if by:
+                out[m] = max(out.get(m, 0.0), max(by.values()))
+    return out
+
+
 def _why_missing(metric, who) -> str:
     """Why ``metric`` has no value for the finished run(s) of ``who`` (short, for a cell)."""
     who = " & ".join(who)
