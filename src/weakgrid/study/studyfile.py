@@ -42,6 +42,7 @@ from pathlib import Path
 from ..dotted import get_path as _get, set_path as _set
 from ..fileio import check_file_name, safe_name
 from ..game.errors import ParameterError
+from .grid_edits import EDITS, validate_edits
 
 __all__ = ["Study", "load_study", "apply_overrides", "study_from_dict", "get_path", "set_path", "shipped_studies",
            "read_study_dict", "event_end", "EVENT_KINDS"]
@@ -356,8 +357,17 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         _inline_grid(g)
     elif g["kind"] == "pandapower":
         _need(g, "network", "grid", str)
+        if g["network"] == "from_json":
+            v = _need(g, "file", "grid", str)
+            if not v.lower().endswith(".json"):
+                raise ParameterError("grid.file", v, "give the .json file written by "
+                                     "pandapower.to_json (path relative to the study file)")
+        elif "file" in g:
+            raise ParameterError("grid.file", g["file"], 'a file is read with network = '
+                                 '"from_json"; else network names a function of '
+                                 "pandapower.networks")
     elif g["kind"] == "psse":
-        _keys(g, {"kind", "raw", "dyr", "f_hz"}, "grid")
+        _keys(g, {"kind", "raw", "dyr", "f_hz", *EDITS}, "grid")
         for k in ("raw", "dyr"):
             if k in g or k == "raw":
                 v = _need(g, k, "grid", str)
@@ -371,6 +381,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         _num(g, "f_hz", "grid", positive=True)
     for level in _load_levels(g):
         check_file_name(level, f"grid.loads.{level}")
+    validate_edits(g, _load_levels(g))
     dyn = d.setdefault("dynamics", {})
     _keys(dyn, {"generator", "gti"}, "dynamics")
     names = []
