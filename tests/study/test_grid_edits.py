@@ -103,6 +103,25 @@ def test_andes_ieee14_gains_a_pv_plant():
     assert_responds(t, p, P_MW / 100.0)
 
 
+@pytest.mark.andes
+def test_andes_static_generator_becomes_a_gti():
+    """ieee14 without dynamic data: its PV generators are static (PVSource); the one at bus 2
+    (40 MW), halved and moved behind a new branch, becomes the study's GTI."""
+    pytest.importorskip("andes")
+    edits = pv_edits(2, 69.0)
+    edits.pop("add_gen")
+    grid = {"kind": "andes", "file": "andes:ieee14/ieee14.raw", **edits,
+            "sgen_to_gen": [{"name": "PV_2", "bus": "PV", "scale": 0.5}]}
+    s, t, p = run_fault(pv_study(grid, 2), p_mw=20.0)
+    assert "PV_2" not in s.system.components["PVSource"].names
+    net = s.system.network
+    assert net.bus[net.index_of(2), 1] == 1                  # bus 2 kept no generator: PQ
+    assert_responds(t, p, 0.2)
+    d = pv_study(dict(grid, sgen_to_gen=[{"name": "PV_9"}]), 2)
+    with pytest.raises(ParameterError, match=r"sgen_to_gen.0.name.*PV_9.*PV_2"):
+        build_setup(study_from_dict(d))
+
+
 def test_pandapower_network_from_a_json_file(tmp_path):
     """The user's own pandapower network (pandapower.to_json), edited like a stock one."""
     import pandapower as pp
@@ -149,7 +168,7 @@ def test_unknown_bus_lists_the_valid_ones():
      "grid.add_impedance.0.x_pu", "non-zero"),
     ({"add_gen": [{"name": "G", "bus": 1, "p_mw": {"peak": 3}}]}, "grid.add_gen.0.p_mw.peak",
      "no load level"),
-    ({"sgen_to_gen": [{"name": "WT"}]}, "grid.sgen_to_gen", "pandapower"),
+    ({"sgen_to_gen": [{"name": "WT"}]}, "grid.sgen_to_gen", "no static generators"),
     ({"add_gen": {"name": "G"}}, "grid.add_gen", "list of tables"),
 ])
 def test_edit_validation(edit, field, text):

@@ -424,7 +424,44 @@ def _edit_system(system, g, load, bus_id, names):
     net = system.network
     case = dict(net.case, bus_names=net.bus_names, branch_names=list(net.branch_names))
     case = _edit_case(case, g, load, bus_id, names)
+    for j, sg in enumerate(g.get("sgen_to_gen", [])):
+        _static_to_gen(system, case, sg, f"grid.sgen_to_gen.{j}", bus_id)
     system.network = _rebuilt(net, case)
+
+
+def _static_to_gen(system, case, sg, where, bus_id):
+    """A static generator of an imported grid (a PV generator without a dynamic model, which
+    the importer holds as a constant-P, constant-|V| ``PVSource`` named ``PV_<idx>`` (ANDES)
+    or ``PVSource_<bus>_<id>`` (PSS/E)) freed for the study's dynamics: the source leaves the
+    system and its generator row stays in the power flow, ``scale``-d, at ``vm_pu``,
+    moved to ``bus`` if given; ``case`` (the edited tables) is changed in place."""
+    comp = system.components.get("PVSource")
+    known = list(comp.names) if comp is not None else []
+    if sg["name"] not in known:
+        raise ParameterError(f"{where}.name", sg["name"], "no static generator (a generator "
+                             "without a dynamic model) of that name; this grid's: "
+                             f"{known or 'none'}")
+    row = int(comp.links[known.index(sg["name"])]["gen"])
+    comp.remove(sg["name"])
+    if comp.n == 0:
+        del system.components["PVSource"]
+    system.is_setup = False
+    gen, bus = case["gen"], case["bus"]
+    gen[row, 1] *= float(sg.get("scale", 1.0))
+    if "bus" in sg:
+        from types import SimpleNamespace
+
+        nums = [int(b) for b in bus[:, 0]]
+        grid = SimpleNamespace(bus_ids=nums, _pos={b: i for i, b in enumerate(nums)})
+        new = _bus_ref(sg["bus"], bus_id, grid, f"{where}.bus")
+        old = int(gen[row, 0])
+        gen[row, 0] = new
+        if not np.any(gen[:, 0].astype(int) == old) and bus[nums.index(old), 1] == 2:
+            bus[nums.index(old), 1] = 1            # no generator left: a PQ bus
+        if bus[nums.index(new), 1] == 1:
+            bus[nums.index(new), 1] = 2
+    if "vm_pu" in sg:
+        gen[row, 5] = float(sg["vm_pu"])
 
 
 def _rebuilt(net, case):

@@ -6,8 +6,11 @@ the UPQC is inserted and before the power flow, so a new generator is in the pow
 * ``[[grid.add_bus]]`` ``name``, ``vn_kv`` [kV], ``number`` (optional: the new bus's number;
   default: one above the grid's largest) — a PQ bus without load;
 * ``[[grid.sgen_to_gen]]`` ``name``, ``bus`` (optional: move it), ``vm_pu`` [1.0], ``scale``
-  [1.0] — a pandapower static generator (``net.sgen``) becomes a voltage-controlled generator
-  (pandapower grids only: the other kinds have no static generator table);
+  [1.0] — a static generator becomes a voltage-controlled generator whose dynamics the study
+  gives (e.g. a GTI): pandapower's ``net.sgen`` by name; on ANDES and PSS/E grids a generator
+  without a dynamic model (the importer's constant-P, constant-|V| ``PVSource``, named
+  ``PV_<idx>`` / ``PVSource_<bus>_<id>``; an unknown name is refused with the list);
+  MATPOWER cases have none (every generator gets its dynamics from the study);
 * ``[[grid.add_impedance]]`` ``name``, ``from``, ``to``, ``r_pu``, ``x_pu``, ``sn_mva``
   (the base of ``r_pu``, ``x_pu``) — a series branch (a line, a transformer at nominal ratio);
 * ``[[grid.add_gen]]`` ``name``, ``bus``, ``p_mw`` (a number or a table per load level),
@@ -68,11 +71,11 @@ def validate_edits(g: dict, levels=()) -> None:
                                      "branches and generators itself: add them to "
                                      "[[grid.bus]], [[grid.branch]], [[grid.gen]]")
         return
-    if kind != "pandapower" and g.get("sgen_to_gen"):
-        raise ParameterError("grid.sgen_to_gen", g["sgen_to_gen"], "static generators to "
-                             "convert are pandapower's (net.sgen); on a "
-                             f"{kind} grid add the unit with [[grid.add_gen]] (and remove or "
-                             "scale its load) instead")
+    if kind == "matpower" and g.get("sgen_to_gen"):
+        raise ParameterError("grid.sgen_to_gen", g["sgen_to_gen"], "a MATPOWER case has no "
+                             "static generators: each of its generators gets its dynamics "
+                             "from [[dynamics.generator]] or [[dynamics.gti]] at its bus; add a "
+                             "unit with [[grid.add_gen]]")
     for key in EDITS:
         tab = g.get(key, [])
         if not isinstance(tab, list):
