@@ -6,12 +6,12 @@ Grid kinds (``[grid] kind``):
   (``[[grid.bus]] id, name, type, base_kv``; ``[[grid.branch]] name, from, to, r, x, b``
   (pu on ``Sb_mva``); ``[[grid.gen]] name, bus, P_mw, Q_mvar, V_set, Mbase``;
   ``[grid.loads.LEVEL] "BUS" = [P_MW, Q_Mvar]``, constant impedance).
-* ``pandapower`` — ``network`` names a function of ``pandapower.networks`` (``kwargs``), then
-  edits in this order: ``keep_buses`` (regex on bus names; the rest is dropped), ``islanded``
-  (external grids removed), ``loads.levels`` (p_mw multiplier per level) and ``loads.pf``
-  (power factor by load name), ``add_bus``, ``sgen_to_gen`` (static generators turned into voltage-
-  controlled generators, e.g. a wind turbine that becomes a GTI; ``bus`` moves it),
-  ``add_impedance``, ``add_gen`` (``p_mw`` a number or a table per level).
+* ``pandapower`` — ``network`` names a function of ``pandapower.networks`` (``kwargs``), or
+  ``network = "from_json"`` reads ``file`` (the user's network, written by
+  ``pandapower.to_json``; path relative to the study file); then in this order: ``keep_buses``
+  (regex on bus names; the rest is dropped), ``islanded`` (external grids removed),
+  ``loads.levels`` (p_mw multiplier per level) and ``loads.pf`` (power factor by load name),
+  then the grid edits.
 * ``matpower`` — ``file`` (a ``.m``/``.mat`` case); ``loads.levels`` scale PD, QD.
 * ``andes`` — ``file`` (any case ANDES parses: PSS/E ``.raw``, ``.xlsx``, ``.json``; ``andes:``
   prefix for ANDES's stock cases) and ``dyr`` (PSS/E dynamic data): machines and controls come
@@ -25,6 +25,11 @@ Grid kinds (``[grid] kind``):
   and controls come from the ``.dyr`` (named ``GENROU_<bus>_<id>`` …), the UPQC is an existing
   branch (``upqc.branch = "I-J-CKT"``, e.g. ``"101-102-1"``, or ``{from, to}``) or inserted into
   one (``upqc.insert = {branch = "I-J-CKT", side, r, x}``, pu on the system base).
+
+Grid edits, the same on every kind but ``inline`` (:mod:`weakgrid.study.grid_edits`):
+``add_bus``, ``sgen_to_gen`` (a static generator handed to the study's dynamics, e.g. a wind
+turbine that becomes a GTI; ``bus`` moves it), ``add_impedance``, ``add_gen`` (``p_mw`` a number
+or a table per level) — applied before the power flow and before the UPQC is inserted.
 
 Buses are referred to by the source's number (inline/matpower/PSS/E, an ANDES idx), by name
 (PSS/E ``.raw``, ANDES ``Bus.name``, pandapower, inline), or by pandapower index — which is the

@@ -10,7 +10,9 @@ Tables (defaults in brackets)::
 
     [study]       name, title [""], reproduce [false] (part of `weakgrid reproduce`), notes [[]]
     [grid]        kind = "inline" | "pandapower" | "matpower" | "andes" | "psse"; see
-                  weakgrid.study.build (psse: raw, dyr [none], paths relative to the study file)
+                  weakgrid.study.build (psse: raw, dyr [none], paths relative to the study file;
+                  pandapower: network = "from_json" with file); edits add_bus, sgen_to_gen,
+                  add_impedance, add_gen on every kind but inline: weakgrid.study.grid_edits
     [[dynamics.generator]]  name, bus, machine = {model, …}, exciter/governor/pss [none]
     [[dynamics.gti]]        name, bus, C, Vc0, chi, B, ks_max, tau, mode ["energy"]
     [machine]     name (the controlled GTI or SG)
