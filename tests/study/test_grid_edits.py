@@ -186,3 +186,21 @@ def test_inline_grid_refuses_edits():
     d["grid"]["add_gen"] = [{"name": "G", "bus": 1}]
     with pytest.raises(ParameterError, match="grid.add_gen.*inline"):
         study_from_dict(d)
+
+
+def test_added_bus_number_taken():
+    grid = {"kind": "matpower", "file": "matpower/case9.m", **pv_edits(5, 345.0)}
+    grid["add_bus"][0]["number"] = 5
+    with pytest.raises(ParameterError, match=r"grid.add_bus.0.number.*exists.*largest: 9"):
+        build_setup(study_from_dict(pv_study(grid, 5), base_dir=DATA))
+
+
+@pytest.mark.parametrize("grid, text", [
+    ({"network": "from_json"}, "grid.file.*missing"),
+    ({"network": "from_json", "file": "net.p"}, "grid.file.*pandapower.to_json"),
+    ({"network": "case9", "file": "net.json"}, "grid.file.*from_json"),
+])
+def test_from_json_fields(grid, text):
+    d = pv_study({"kind": "pandapower", **grid}, "Bus 7")
+    with pytest.raises(ParameterError, match=text):
+        study_from_dict(d)
