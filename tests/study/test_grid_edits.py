@@ -204,3 +204,15 @@ def test_from_json_fields(grid, text):
     d = pv_study({"kind": "pandapower", **grid}, "Bus 7")
     with pytest.raises(ParameterError, match=text):
         study_from_dict(d)
+
+
+def test_psse_generator_without_dynamic_data_becomes_a_gti():
+    """The OMIB .raw without its .dyr: the 90 MW generator at bus 1 is static
+    (PVSource_1_1); scaled to 27 MW and moved behind a new branch, it becomes a GTI."""
+    edits = pv_edits("GENBUS", 24.0)
+    edits.pop("add_gen")
+    grid = {"kind": "psse", "raw": "raw/PSS2A__OMIB.raw", **edits,
+            "sgen_to_gen": [{"name": "PVSource_1_1", "bus": "PV", "scale": 0.3}]}
+    s, t, p = run_fault(pv_study(grid, "GENBUS"), base_dir=DATA / "psse_reader", p_mw=27.0)
+    assert "PVSource" not in s.system.components
+    assert_responds(t, p, 0.27)
