@@ -6,12 +6,12 @@ Grid kinds (``[grid] kind``):
   (``[[grid.bus]] id, name, type, base_kv``; ``[[grid.branch]] name, from, to, r, x, b``
   (pu on ``Sb_mva``); ``[[grid.gen]] name, bus, P_mw, Q_mvar, V_set, Mbase``;
   ``[grid.loads.LEVEL] "BUS" = [P_MW, Q_Mvar]``, constant impedance).
-* ``pandapower`` — ``network`` names a function of ``pandapower.networks`` (``kwargs``), then
-  edits in this order: ``keep_buses`` (regex on bus names; the rest is dropped), ``islanded``
-  (external grids removed), ``loads.levels`` (p_mw multiplier per level) and ``loads.pf``
-  (power factor by load name), ``add_bus``, ``sgen_to_gen`` (static generators turned into voltage-
-  controlled generators, e.g. a wind turbine that becomes a GTI; ``bus`` moves it),
-  ``add_impedance``, ``add_gen`` (``p_mw`` a number or a table per level).
+* ``pandapower`` — ``network`` names a function of ``pandapower.networks`` (``kwargs``), or
+  ``network = "from_json"`` reads ``file`` (the user's network, written by
+  ``pandapower.to_json``; path relative to the study file); then in this order: ``keep_buses``
+  (regex on bus names; the rest is dropped), ``islanded`` (external grids removed),
+  ``loads.levels`` (p_mw multiplier per level) and ``loads.pf`` (power factor by load name),
+  then the grid edits.
 * ``matpower`` — ``file`` (a ``.m``/``.mat`` case); ``loads.levels`` scale PD, QD.
 * ``andes`` — ``file`` (any case ANDES parses: PSS/E ``.raw``, ``.xlsx``, ``.json``; ``andes:``
   prefix for ANDES's stock cases) and ``dyr`` (PSS/E dynamic data): machines and controls come
@@ -25,6 +25,11 @@ Grid kinds (``[grid] kind``):
   and controls come from the ``.dyr`` (named ``GENROU_<bus>_<id>`` …), the UPQC is an existing
   branch (``upqc.branch = "I-J-CKT"``, e.g. ``"101-102-1"``, or ``{from, to}``) or inserted into
   one (``upqc.insert = {branch = "I-J-CKT", side, r, x}``, pu on the system base).
+
+Grid edits, the same on every kind but ``inline`` (:mod:`weakgrid.study.grid_edits`):
+``add_bus``, ``sgen_to_gen`` (a static generator handed to the study's dynamics, e.g. a wind
+turbine that becomes a GTI; ``bus`` moves it), ``add_impedance``, ``add_gen`` (``p_mw`` a number
+or a table per level) — applied before the power flow and before the UPQC is inserted.
 
 Buses are referred to by the source's number (inline/matpower/PSS/E, an ANDES idx), by name
 (PSS/E ``.raw``, ANDES ``Bus.name``, pandapower, inline), or by pandapower index — which is the
@@ -49,6 +54,7 @@ import numpy as np
 
 from ..design import derive_design
 from ..design.upqc_insert import insert_upqc_matpower, insert_upqc_pandapower
+from .grid_edits import apply_case_edits, has_edits
 from ..game.errors import ParameterError
 from ..logs import quiet_loggers
 from ..sim.errors import DataError, DataWarning
@@ -167,10 +173,14 @@ def _per_level(v, load, where):
     return float(v)
 
 
-def _pandapower_net(g, load):
+def _pandapower_net(g, load, resolve=str):
+    """The pandapower network of ``[grid]`` at ``load``, edited; ``resolve`` maps a file name
+    of the study to its path. Returns ``(net, bus name → index, bus reference function)``."""
     import pandapower as pp
     import pandapower.networks as pn
 
+    if g["network"] == "from_json":
+        return _pandapower_edits(g, load, _pandapower_from_json(g, resolve))
     fn = getattr(pn, g["network"], None)
     if fn is None or not callable(fn):
         raise ParameterError("grid.network", g["network"], "not a function of "
@@ -195,6 +205,44 @@ def _pandapower_net(g, load):
         except (ValueError, TypeError, KeyError, NotImplementedError) as exc:
             raise ParameterError("grid.kwargs", kwargs, f"pandapower.networks.{g['network']} "
                                  f"refused them: {exc}") from None
+    return _pandapower_edits(g, load, net)
+
+
+def _pandapower_from_json(g, resolve=str):
+    """The user's pandapower network: ``[grid] network = "from_json"``, ``file`` (written by
+    ``pandapower.to_json``; the path resolved against the study file by the validator)."""
+    import pandapower as pp
+
+    path = g.get("file")
+    if not path:
+        raise ParameterError("grid.file", None, 'network = "from_json" needs file = "NET.json" '
+                             "(written by pandapower.to_json), relative to the study file")
+    from pathlib import Path
+
+    p = Path(resolve(path))
+    if not p.is_file():
+        raise ParameterError("grid.file", path, "no such file; paths are relative to the "
+                             "study file")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            net = pp.from_json(str(p))
+        except Exception as exc:   # noqa: BLE001 - any parser failure is the file's fault
+            raise ParameterError("grid.file", path, "not a pandapower network written by "
+                                 f"pandapower.to_json ({type(exc).__name__}: {exc})") from None
+    if not isinstance(net, pp.pandapowerNet) or "bus" not in net:
+        raise ParameterError("grid.file", path, "not a pandapower network written by "
+                             f"pandapower.to_json (it holds a {type(net).__name__})")
+    return net
+
+
+def _pandapower_edits(g, load, net):
+    """``[grid]``'s edits of a pandapower network (:mod:`weakgrid.study.grid_edits`), with
+    pandapower's own ``create_*`` functions."""
+    import pandapower as pp
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
         if "keep_buses" in g:
             keep = net.bus.name.astype(str).str.match(g["keep_buses"])
             pp.toolbox.drop_buses(net, net.bus.index[~keep], drop_elements=True)
@@ -228,8 +276,13 @@ def _pandapower_net(g, load):
                 else:
                     net.load.at[i, "q_mvar"] = float(row.q_mvar) * scale
                 net.load.at[i, "scaling"] = 1.0
-        for b in g.get("add_bus", []):
-            bus_of[b["name"]] = int(pp.create_bus(net, float(b["vn_kv"]), name=b["name"]))
+        for j, b in enumerate(g.get("add_bus", [])):
+            if "number" in b and b["number"] in net.bus.index:
+                raise ParameterError(f"grid.add_bus.{j}.number", b["number"], "a bus of that "
+                                     f"index exists; choose another (largest: "
+                                     f"{int(net.bus.index.max())})")
+            kw = {"index": int(b["number"])} if "number" in b else {}
+            bus_of[b["name"]] = int(pp.create_bus(net, float(b["vn_kv"]), name=b["name"], **kw))
         for j, sg in enumerate(g.get("sgen_to_gen", [])):
             w = f"grid.sgen_to_gen.{j}"
             hit = net.sgen.index[net.sgen.name == sg["name"]]
@@ -251,6 +304,8 @@ def _pandapower_net(g, load):
         for j, ge in enumerate(g.get("add_gen", [])):
             w = f"grid.add_gen.{j}"
             kw = {"slack": True} if ge.get("slack") else {}
+            if "sn_mva" in ge:
+                kw["sn_mva"] = float(ge["sn_mva"])
             pp.create_gen(net, bref(ge["bus"], f"{w}.bus"),
                           p_mw=_per_level(ge.get("p_mw", 0.0), load, f"{w}.p_mw"),
                           vm_pu=ge.get("vm_pu", 1.0), name=ge["name"], **kw)
@@ -263,7 +318,7 @@ def _network(study, load):
     g = study.data["grid"]
     up = study.data["upqc"]
     if g["kind"] == "pandapower":
-        net, bus_of, bref = _pandapower_net(g, load)
+        net, bus_of, bref = _pandapower_net(g, load, study.resolve)
         ins = up.get("insert")
         ends = None
         if ins:
@@ -302,9 +357,9 @@ def _network(study, load):
                                  "no unique series branch from the shunt bus to that bus")
         return network, bus_id, {}, rows[0], None
     if g["kind"] == "andes":
-        return _andes_network(study, g, up)
+        return _andes_network(study, g, up, load)
     if g["kind"] == "psse":
-        return _psse_network(study, g, up)
+        return _psse_network(study, g, up, load)
     if g["kind"] == "inline":
         case, names, bus_id = _inline_case(g, load)
         f_hz = float(g.get("f_hz", 60.0))
@@ -317,6 +372,7 @@ def _network(study, load):
             case["bus"] = np.array(case["bus"], float)
             case["bus"][:, 2:4] *= float(lv[load])
         names, bus_id = {}, {}
+        case = _edit_case(case, g, load, bus_id, names)
         f_hz = float(g.get("f_hz", 60.0))
 
     def row_of(ref, where):
@@ -341,6 +397,90 @@ def _network(study, load):
     return network, bus_id, names, k_up, None
 
 
+def _edit_case(case, g, load, bus_id, names):
+    """``[grid]``'s edits (:mod:`.grid_edits`) applied to a MATPOWER-layout case; the new
+    buses and branches join ``bus_id`` (name → number) and ``names`` (name → row) in place."""
+    if not has_edits(g):
+        return case
+    from types import SimpleNamespace
+
+    nums = [int(b) for b in np.asarray(case["bus"])[:, 0]]
+    known = dict(bus_id)
+    for num, name in dict(case.get("bus_names") or {}).items():
+        known.setdefault(str(name), int(num))
+    grid = SimpleNamespace(bus_ids=nums, _pos={b: i for i, b in enumerate(nums)})
+
+    def ref(r, where, new):
+        if isinstance(r, str) and r not in known and r not in new and r.strip().isdigit():
+            r = int(r)                       # "7": a bus number written as a string
+        return _bus_ref(r, {**known, **new}, grid, where)
+
+    case, new_bus, new_br = apply_case_edits(case, g, load, ref)
+    bus_id.update(new_bus)
+    names.update(new_br)
+    return case
+
+
+def _edit_system(system, g, load, bus_id, names):
+    """``[grid]``'s edits of an imported System's network (ANDES, PSS/E): rows are appended,
+    so the machines and controls keep their generator rows and buses."""
+    if not has_edits(g):
+        return
+    net = system.network
+    case = dict(net.case, bus_names=net.bus_names, branch_names=list(net.branch_names))
+    case = _edit_case(case, g, load, bus_id, names)
+    for j, sg in enumerate(g.get("sgen_to_gen", [])):
+        _static_to_gen(system, case, sg, f"grid.sgen_to_gen.{j}", bus_id)
+    system.network = _rebuilt(net, case)
+
+
+def _static_to_gen(system, case, sg, where, bus_id):
+    """A static generator of an imported grid (a PV generator without a dynamic model, which
+    the importer holds as a constant-P, constant-|V| ``PVSource`` named ``PV_<idx>`` (ANDES)
+    or ``PVSource_<bus>_<id>`` (PSS/E)) freed for the study's dynamics: the source leaves the
+    system and its generator row stays in the power flow, ``scale``-d, at ``vm_pu``,
+    moved to ``bus`` if given; ``case`` (the edited tables) is changed in place."""
+    comp = system.components.get("PVSource")
+    known = list(comp.names) if comp is not None else []
+    if sg["name"] not in known:
+        raise ParameterError(f"{where}.name", sg["name"], "no static generator (a generator "
+                             "without a dynamic model) of that name; this grid's: "
+                             f"{known or 'none'}")
+    row = int(comp.links[known.index(sg["name"])]["gen"])
+    comp.remove(sg["name"])
+    if comp.n == 0:
+        del system.components["PVSource"]
+    system.is_setup = False
+    gen, bus = case["gen"], case["bus"]
+    gen[row, 1] *= float(sg.get("scale", 1.0))
+    if "bus" in sg:
+        from types import SimpleNamespace
+
+        nums = [int(b) for b in bus[:, 0]]
+        grid = SimpleNamespace(bus_ids=nums, _pos={b: i for i, b in enumerate(nums)})
+        new = _bus_ref(sg["bus"], bus_id, grid, f"{where}.bus")
+        old = int(gen[row, 0])
+        gen[row, 0] = new
+        if not np.any(gen[:, 0].astype(int) == old) and bus[nums.index(old), 1] == 2:
+            bus[nums.index(old), 1] = 1            # no generator left: a PQ bus
+        if bus[nums.index(new), 1] == 1:
+            bus[nums.index(new), 1] = 2
+    if "vm_pu" in sg:
+        gen[row, 5] = float(sg["vm_pu"])
+
+
+def _rebuilt(net, case):
+    """A new :class:`Network` of ``case`` keeping ``net``'s declarations (series capacitors,
+    negative resistances, generator split, names) and frequency."""
+    case = dict(case)
+    case.setdefault("series_capacitors", sorted(net.series_capacitors))
+    case.setdefault("negative_resistance", sorted(net.negative_resistance))
+    case.setdefault("gen_split", net.gen_split)
+    case.setdefault("branch_names", list(net.branch_names))
+    case.setdefault("bus_names", net.bus_names)
+    return Network(case, f_hz=net.f_hz)
+
+
 def _andes_file(study, name):
     if name.startswith("andes:"):
         import andes
@@ -349,7 +489,7 @@ def _andes_file(study, name):
     return str(study.resolve(name))
 
 
-def _andes_network(study, g, up):
+def _andes_network(study, g, up, load):
     """An ANDES/PSS/E case (``file``, optional ``dyr``) with its machines and controls."""
     try:
         import andes
@@ -369,6 +509,7 @@ def _andes_network(study, g, up):
     system, _ = from_andes(ss, include_events=False)
     bus_id = {str(k): int(v) for k, v in system.andes_bus_id.items()}
     names = {str(k): int(v) for k, v in system.andes_line_row.items()}
+    _edit_system(system, g, load, bus_id, names)
     ins = up.get("insert")
     ref = str(ins.get("branch", ins.get("index")) if ins else up["branch"])
     if ref not in names:
@@ -378,14 +519,13 @@ def _andes_network(study, g, up):
         net = system.network
         case, k_up, _, _ = insert_upqc_matpower(net.case, names[ref], ins["side"],
                                                 ins.get("r", 0.0), ins["x"])
-        case.update(branch_names=list(net.branch_names), bus_names=net.bus_names)
-        system.network = Network(case, f_hz=net.f_hz)
+        system.network = _rebuilt(net, case)
         names[up["name"]] = k_up
         return system.network, bus_id, names, k_up, system
     return system.network, bus_id, names, names[ref], system
 
 
-def _psse_network(study, g, up):
+def _psse_network(study, g, up, load):
     """A PSS/E ``.raw`` (+ ``.dyr``) case read natively, with its machines and controls."""
     from ..sim.io.psse import from_psse
 
@@ -409,6 +549,8 @@ def _psse_network(study, g, up):
     for (i, j, k, c), rows in system.psse_transformer_rows.items():
         if k == 0:
             names[f"{i}-{j}-{c}"] = int(rows[0])
+    _edit_system(system, g, load, bus_id, names)
+    net = system.network
     ins = up.get("insert")
     ref = ins.get("branch", ins.get("index")) if ins else up["branch"]
     where = "upqc.insert.branch" if ins else "upqc.branch"
@@ -431,10 +573,7 @@ def _psse_network(study, g, up):
         k_ref = names[str(ref)]
     if ins:     # a new bus and series branch (pu on the system base), appended to the tables
         case, k_up, _, _ = insert_upqc_matpower(net.case, k_ref, ins["side"], ins.get("r", 0.0), ins["x"])
-        case.update(series_capacitors=sorted(net.series_capacitors),
-                    negative_resistance=sorted(net.negative_resistance), gen_split=net.gen_split)
-        case.update(branch_names=list(net.branch_names), bus_names=net.bus_names)
-        system.network = Network(case, f_hz=net.f_hz)
+        system.network = _rebuilt(net, case)
         names[up["name"]] = k_up
         return system.network, bus_id, names, k_up, system
     return net, bus_id, names, k_ref, system

@@ -10,7 +10,9 @@ Tables (defaults in brackets)::
 
     [study]       name, title [""], reproduce [false] (part of `weakgrid reproduce`), notes [[]]
     [grid]        kind = "inline" | "pandapower" | "matpower" | "andes" | "psse"; see
-                  weakgrid.study.build (psse: raw, dyr [none], paths relative to the study file)
+                  weakgrid.study.build (psse: raw, dyr [none], paths relative to the study file;
+                  pandapower: network = "from_json" with file); edits add_bus, sgen_to_gen,
+                  add_impedance, add_gen on every kind but inline: weakgrid.study.grid_edits
     [[dynamics.generator]]  name, bus, machine = {model, …}, exciter/governor/pss [none]
     [[dynamics.gti]]        name, bus, C, Vc0, chi, B, ks_max, tau, mode ["energy"]
     [machine]     name (the controlled GTI or SG)
@@ -42,6 +44,7 @@ from pathlib import Path
 from ..dotted import get_path as _get, set_path as _set
 from ..fileio import check_file_name, safe_name
 from ..game.errors import ParameterError
+from .grid_edits import EDITS, validate_edits
 
 __all__ = ["Study", "load_study", "apply_overrides", "study_from_dict", "get_path", "set_path", "shipped_studies",
            "read_study_dict", "event_end", "EVENT_KINDS"]
@@ -356,8 +359,17 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         _inline_grid(g)
     elif g["kind"] == "pandapower":
         _need(g, "network", "grid", str)
+        if g["network"] == "from_json":
+            v = _need(g, "file", "grid", str)
+            if not v.lower().endswith(".json"):
+                raise ParameterError("grid.file", v, "give the .json file written by "
+                                     "pandapower.to_json (path relative to the study file)")
+        elif "file" in g:
+            raise ParameterError("grid.file", g["file"], 'a file is read with network = '
+                                 '"from_json"; else network names a function of '
+                                 "pandapower.networks")
     elif g["kind"] == "psse":
-        _keys(g, {"kind", "raw", "dyr", "f_hz"}, "grid")
+        _keys(g, {"kind", "raw", "dyr", "f_hz", *EDITS}, "grid")
         for k in ("raw", "dyr"):
             if k in g or k == "raw":
                 v = _need(g, k, "grid", str)
@@ -371,6 +383,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         _num(g, "f_hz", "grid", positive=True)
     for level in _load_levels(g):
         check_file_name(level, f"grid.loads.{level}")
+    validate_edits(g, _load_levels(g))
     dyn = d.setdefault("dynamics", {})
     _keys(dyn, {"generator", "gti"}, "dynamics")
     names = []
