@@ -83,7 +83,7 @@ def test_matpower_case_gets_classical_machines_and_a_trip(tmp_path, capsys):
     from weakgrid import read_run
 
     df = read_run(out, ["*.omega"])
-    assert sorted(df.columns) == ["G0.omega", "G1.omega", "t"]
+    assert sorted(df.columns) == ["GENCLS_1_1.omega", "GENCLS_2_1.omega", "t"]   # GENCLS_<bus>_<k>
     assert (df.drop(columns="t").sub(1.0).abs().max() > 1e-5).all()
 
 
