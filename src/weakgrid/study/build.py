@@ -54,7 +54,7 @@ import numpy as np
 
 from ..design import derive_design
 from ..design.upqc_insert import insert_upqc_matpower, insert_upqc_pandapower
-from .grid_edits import apply_case_edits, has_edits
+from .grid_edits import apply_case_edits, has_edits, per_level
 from ..game.errors import ParameterError
 from ..logs import quiet_loggers
 from ..sim.errors import DataError, DataWarning
@@ -163,14 +163,6 @@ def _inline_case(g, load, where="grid"):
     names = {br.get("name", br.get("role", str(k))): k for k, br in enumerate(g["branch"])}
     bus_id = {b["name"]: int(b["id"]) for b in g["bus"] if "name" in b}
     return case, names, bus_id
-
-
-def _per_level(v, load, where):
-    if isinstance(v, dict):
-        if load not in v:
-            raise ParameterError(where, v, f"give a value for load level '{load}'")
-        return float(v[load])
-    return float(v)
 
 
 def _pandapower_net(g, load, resolve=str):
@@ -307,7 +299,7 @@ def _pandapower_edits(g, load, net):
             if "sn_mva" in ge:
                 kw["sn_mva"] = float(ge["sn_mva"])
             pp.create_gen(net, bref(ge["bus"], f"{w}.bus"),
-                          p_mw=_per_level(ge.get("p_mw", 0.0), load, f"{w}.p_mw"),
+                          p_mw=per_level(ge.get("p_mw", 0.0), load, f"{w}.p_mw"),
                           vm_pu=ge.get("vm_pu", 1.0), name=ge["name"], **kw)
     return net, bus_of, bref
 

@@ -125,7 +125,8 @@ def validate_edits(g: dict, levels=()) -> None:
                 raise ParameterError(f"{w}.slack", e["slack"], "true or false")
 
 
-def _per_level(v, load, where):
+def per_level(v, load, where):
+    """``v`` [MW] at load level ``load``: a number, or a table of one value per level."""
     if isinstance(v, dict):
         if load not in v:
             raise ParameterError(where, v, f"give a value for load level '{load}'")
@@ -206,7 +207,7 @@ def apply_case_edits(case: dict, g: dict, load: str, bus_ref) -> tuple[dict, dic
         b = ref(ge["bus"], f"{w}.bus")
         vm = float(ge.get("vm_pu", 1.0))
         row = np.zeros(ncol)
-        row[:10] = [b, _per_level(ge.get("p_mw", 0.0), load, f"{w}.p_mw"), 0.0, 9999.0,
+        row[:10] = [b, per_level(ge.get("p_mw", 0.0), load, f"{w}.p_mw"), 0.0, 9999.0,
                     -9999.0, vm, float(ge.get("sn_mva", Sb)), 1, 9999.0, -9999.0]
         gen = np.vstack([gen, row]) if gen.size else row[None, :]
         i = pos[b]
