@@ -8,7 +8,7 @@ the UPQC is inserted and before the power flow, so a new generator is in the pow
 * ``[[grid.sgen_to_gen]]`` ``name``, ``bus`` (optional: move it), ``vm_pu`` [1.0], ``scale``
   [1.0] — a static generator becomes a voltage-controlled generator whose dynamics the study
   gives (e.g. a GTI): pandapower's ``net.sgen`` by name; on ANDES and PSS/E grids a generator
-  without a dynamic model (the importer's constant-P, constant-|V| ``PVSource``, named
+  without a dynamic model (the importer's constant-power, constant-voltage ``PVSource``, named
   ``PV_<idx>`` / ``PVSource_<bus>_<id>``; an unknown name is refused with the list);
   MATPOWER cases have none (every generator gets its dynamics from the study);
 * ``[[grid.add_impedance]]`` ``name``, ``from``, ``to``, ``r_pu``, ``x_pu``, ``sn_mva``

@@ -149,8 +149,8 @@ def who_did_best(metrics: list[dict], uncertainty: dict | None = None,
                  names: dict | None = None) -> list[dict]:
     """Per scenario and metric of :data:`BETTER`, the controller that did best.
 
-    ``uncertainty``: metric → relative numerical uncertainty (|m(T) − m(T/2)| / |m(T)|, the
-    sweeps' half-step check), when measured; a controller within it of the best is a tie.
+    ``uncertainty``: metric → relative numerical uncertainty (``|m(T) − m(T/2)| / |m(T)|``,
+    the sweeps' half-step check), when measured; a controller within it of the best is a tie.
     ``names``: controller → full name. Returns rows ``scenario``, ``metric``, ``best``
     (names, ``" = "`` between tied ones), ``value``, ``tie`` (bool), ``uncertainty`` (NaN when
     not measured), ``others`` (the rest, with their values). Failed runs are left out, and

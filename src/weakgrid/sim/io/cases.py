@@ -2,19 +2,17 @@
 
 One entry point, :func:`load_case`, for the formats the importers read:
 
-===================  ============================================================================
-``.raw`` (+ ``.dyr``) PSS/E, weakgrid's own reader (:func:`weakgrid.sim.io.psse.from_psse`); buses
-                     keep their PSS/E numbers, generators without a machine record are ideal
-                     sources (as ANDES runs them)
-``.m``, ``.mat``     MATPOWER (:func:`weakgrid.sim.io.matpower.load_matpower`), a power-flow case:
-                     a classical machine at every in-service generator
-                     (:func:`weakgrid.sim.templates.classical_system`)
-``.json``            pandapower (``pandapower.to_json``, recognised by its ``pandapowerNet``
-                     marker; classical machines as for MATPOWER, buses numbered 1..n in the order
-                     of ``net.bus``), else an ANDES JSON case
-``.xlsx``            an ANDES case (:func:`weakgrid.sim.io.andes.from_andes`; needs the optional
-                     ANDES, ``pip install 'weakgrid[andes]'``)
-===================  ============================================================================
+* ``.raw`` (+ ``.dyr``): PSS/E, weakgrid's own reader (:func:`weakgrid.sim.io.psse.from_psse`);
+  buses keep their PSS/E numbers, generators without a machine record are ideal sources (as
+  ANDES runs them);
+* ``.m``, ``.mat``: MATPOWER (:func:`weakgrid.sim.io.matpower.load_matpower`), a power-flow
+  case: a classical machine at every in-service generator
+  (:func:`weakgrid.sim.templates.classical_system`);
+* ``.json``: pandapower (``pandapower.to_json``, recognised by its ``pandapowerNet`` marker;
+  classical machines as for MATPOWER, buses numbered by their pandapower index), else an ANDES
+  JSON case;
+* ``.xlsx``: an ANDES case (:func:`weakgrid.sim.io.andes.from_andes`; needs the optional ANDES,
+  ``pip install 'weakgrid[andes]'``).
 
 A ``.dyr`` file may accompany a ``.raw`` (weakgrid's reader) or an ANDES case (ANDES's
 ``addfile``). The timed events a case file holds (ANDES ``Toggle``, ``Fault``) are returned
