@@ -7,8 +7,25 @@ them as attributes so that callers (the CLI, a γ search) can act on them.
 from __future__ import annotations
 
 
+def _restore(cls, args, state):
+    """An error of class ``cls`` with its ``args`` and attributes, without calling its
+    ``__init__`` (see :meth:`WeakgridError.__reduce__`)."""
+    err = cls.__new__(cls, *args)
+    err.args = args
+    err.__dict__.update(state)
+    return err
+
+
 class WeakgridError(Exception):
-    """Base class of every error raised by weakgrid."""
+    """Base class of every error raised by weakgrid.
+
+    Picklable whatever its ``__init__`` takes (an error raised in a Dask worker, or a failed
+    run's cause carried in its record, travels to the client by pickle; Python's default would
+    call ``__init__`` with the message alone and fail for errors with several fields).
+    """
+
+    def __reduce__(self):
+        return _restore, (type(self), self.args, dict(self.__dict__))
 
 
 class ParameterError(WeakgridError, ValueError):

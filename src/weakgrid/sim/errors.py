@@ -7,9 +7,12 @@ the simulator's source.
 
 from __future__ import annotations
 
+from ..game.errors import WeakgridError
 
-class SimError(Exception):
-    """Base class of all errors raised by :mod:`weakgrid.sim`."""
+
+class SimError(WeakgridError):
+    """Base class of all errors raised by :mod:`weakgrid.sim` (picklable, see
+    :class:`weakgrid.game.errors.WeakgridError`)."""
 
 
 class DataError(SimError, ValueError):
