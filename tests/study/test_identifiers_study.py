@@ -54,9 +54,12 @@ def test_events_address_source_buses_and_act_there(lv):
                                "rf": 0.0, "xf": 1e-4},
                               {"kind": "fault", "bus": r15, "t_on": 0.2, "t_off": 0.3,
                                "rf": 0.0, "xf": 1e-4},
-                              {"kind": "line_trip", "branch": "UPQC series", "t": 0.5}))
+                              {"kind": "line_trip", "branch": "Line R4-R12", "t": 0.5}))
     assert isinstance(ev[0], Fault) and ev[0].bus == ev[1].bus == r15
-    assert isinstance(ev[2], LineTrip) and ev[2].branch == lv.upqc_branch
+    assert isinstance(ev[2], LineTrip) and ev[2].branch == lv.branch_names["Line R4-R12"]
+    # the UPQC's own branch, by its name: addressed, and refused (tripping it disconnects it)
+    with pytest.raises(ParameterError, match="UPQC's own series branch"):
+        make_events(lv, _run({"kind": "line_trip", "branch": "UPQC series", "t": 0.5}))
     res = Simulator(lv.system, dt=2e-3, record=["bus*.v"]).run(0.06, events=ev[:1])
     k = (res.t > 0.025) & (res.t < 0.045)
     v = {n: float(res[n][k].mean()) for n in res.names}
