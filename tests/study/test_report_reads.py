@@ -103,3 +103,11 @@ def test_report_of_a_non_paper_study(tmp_path, monkeypatch):
     legends = [t.get_text() for ax in made[0].axes if ax.get_legend()
                for t in ax.get_legend().get_texts()]
     assert "PSS only (UPQC idle)" in legends
+
+
+def test_a_load_step_is_described_in_the_units_of_the_study_file():
+    # a study file's dP, dQ are MW and Mvar (weakgrid.sim.events.LoadStep), not pu
+    from weakgrid.study.protocol import describe_event
+
+    text = describe_event({"kind": "load_step", "bus": 3, "t": 1.0, "dP": 20.0, "dQ": 5.0})
+    assert "ΔP = 20 MW" in text and "ΔQ = 5 Mvar" in text

@@ -55,7 +55,7 @@ def describe_event(ev: dict) -> str:
                 f"{_t(ev['t'])}")
     if kind == "load_step":
         return (f"load step at {_bus(ev['bus'])} at t = {_t(ev['t'])}: ΔP = "
-                f"{float(ev.get('dP', 0.0)):g} pu, ΔQ = {float(ev.get('dQ', 0.0)):g} pu")
+                f"{float(ev.get('dP', 0.0)):g} MW, ΔQ = {float(ev.get('dQ', 0.0)):g} Mvar")
     return ", ".join(f"{k} = {v}" for k, v in ev.items())
 
 
