@@ -28,21 +28,11 @@ NOTES_SHOWN = 5
 
 def _check_record(system, dt, record):
     """Every ``--record`` name or pattern names a signal (else the closest names)."""
-    import difflib
-    import fnmatch
-
-    from ..game.errors import ParameterError
     from ..sim.integrate import Simulator
+    from ..sim.runfile import match_signals
 
     names = Simulator(system, dt=dt, record="all").run(dt, on_failure="return").names
-    for w in record:
-        if w in names or (any(ch in w for ch in "*?[") and fnmatch.filter(names, w)):
-            continue
-        close = difflib.get_close_matches(w, names, n=8, cutoff=0.6) or \
-            [n for n in names if w.split(".")[-1].lower() in n.lower()][:8]
-        raise ParameterError("--record", w, f"no such signal; close names: {close} "
-                             f"({len(names)} signals in all, e.g. {names[:4]}; patterns such as "
-                             "'*.omega' select several)")
+    match_signals(names, record, "--record")
 
 
 def _final_state(res) -> list[str]:

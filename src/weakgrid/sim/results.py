@@ -15,13 +15,13 @@ with ``si=True`` converts to MW/Mvar, kV, rad/s and degrees.
 
 from __future__ import annotations
 
-import fnmatch
 import math
 
 import numpy as np
 
 from .errors import DataError
 from .runfile import UNIT_LABELS as _LABEL  # unit kind -> (pu label, SI label)
+from .runfile import match_signals
 
 #: systems with more DAE variables than this record only machine speeds and angles by default
 RECORD_ALL_MAX = 3000
@@ -227,21 +227,7 @@ class _Recorder:
         else:
             want = list(rec)
         col = {n: i for i, n in enumerate(self.names)}
-        sel = []
-        for w in want:
-            if w in col:
-                sel.append(col[w])
-                continue
-            hits = [col[n] for n in fnmatch.filter(self.names, w)] if any(ch in w for ch in "*?[") else []
-            if not hits:
-                import difflib
-
-                close = difflib.get_close_matches(w, self.names, n=6, cutoff=0.5) or \
-                    [n for n in self.names if w.split(".")[-1] in n][:6]
-                raise DataError("simulation", "record", w, f"no such variable or pattern; "
-                                f"closest: {close} (names <device>.<signal>, fnmatch patterns "
-                                f"such as '*.omega' allowed)")
-            sel += hits
+        sel = [col[n] for n in match_signals(self.names, want, "simulation", "record")]
         sel = np.array(sorted(set(sel)), dtype=int)
         self.sel = sel
         self.names = [self.names[i] for i in sel]

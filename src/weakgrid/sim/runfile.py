@@ -224,11 +224,12 @@ def run_signals(path) -> list[str]:
             if n not in ("t", "pre_event") and not n.startswith(SAMPLE_PREFIX)]
 
 
-def match_signals(names, wanted, where="signals") -> list[str]:
+def match_signals(names, wanted, where="signals", field="signal") -> list[str]:
     """``wanted`` names or ``fnmatch`` patterns resolved against ``names`` (in order, once).
 
-    Raises :class:`~weakgrid.sim.errors.DataError` naming the closest names for one
-    that matches nothing.
+    Raises :class:`~weakgrid.sim.errors.DataError` (element ``where``, field ``field``) naming
+    the closest names for one that matches nothing. The one matcher of signal names: run
+    files, the recorder's ``record=`` and ``simulate --record``.
     """
     import difflib
 
@@ -239,7 +240,7 @@ def match_signals(names, wanted, where="signals") -> list[str]:
         if not hits:
             close = difflib.get_close_matches(w, names, n=8, cutoff=0.5) or \
                 [n for n in names if w.split(".")[-1] in n][:8]
-            raise DataError(where, "signal", w, f"no such signal; closest: {close or names[:8]}"
+            raise DataError(where, field, w, f"no such signal; closest: {close or names[:8]}"
                             " (names are <device>.<signal>; fnmatch patterns like '*.omega' "
                             "allowed)")
         out += [h for h in hits if h not in out]
