@@ -775,3 +775,32 @@ def test_basfrq_override_is_the_runs_base_frequency():
     with pytest.raises(DataError) as e:
         from_psse(raw, dyr, basfrq=0.0)
     assert e.value.field == "basfrq"
+
+
+def test_static_generators_sharing_a_bus_are_one_source(tmp_path):
+    """Two generators without a machine record on one bus (ACTIVSg2000's bus 1090 has two):
+    one ideal source holds the bus (a bus takes one voltage constraint) and carries both
+    units' active power; both are noted. Before, setup refused the second PVSource ("bus
+    already held") and ACTIVSg2000 could not be set up."""
+    def split(lines):
+        out = []
+        for s in lines:
+            if s.lstrip().startswith("102,'1 ',   100.000"):
+                out.append(s.replace("102,'1 ',   100.000,    -3.247", "102,'1 ',    60.000,    -2.000"))
+                out.append(s.replace("102,'1 ',   100.000,    -3.247", "102,'2 ',    40.000,    -1.247"))
+            else:
+                out.append(s)
+        return out
+    p = _rewrite(GENROU_RAW, tmp_path / "two.raw", split)
+    system, _ = from_psse(p)
+    src = system.components["PVSource"]
+    assert src.names == ["PVSource_102_1"]
+    assert sum("PVSource_102_1 with its bus's other units" in n for n in system.import_notes) == 1
+    assert system.psse_machine[(102, "2")] == "PVSource_102_1"
+    system.setup()                          # an equilibrium (checked by setup) at the .raw's point
+    assert src.p0[0] * system.Sb == pytest.approx(100.0, abs=1e-6)
+    from weakgrid.sim.integrate import Simulator
+
+    res = Simulator(system, dt=0.01, record=["PVSource_102_1.P"]).run(0.5)
+    assert res.ok
+    assert np.allclose(res["PVSource_102_1.P"], 1.0, atol=1e-6)

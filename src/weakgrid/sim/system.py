@@ -326,6 +326,11 @@ class System:
                     if shared:
                         shares.setdefault(int(g), []).append(
                             (c.element(i), c.p.get("gammap", np.ones(c.n))[i], c.p.get("gammaq", np.ones(c.n))[i]))
+                for i, rows in enumerate(getattr(c, "gen_also", ())):   # an ideal source's other units
+                    for g in rows:
+                        if g in gen_used:
+                            raise DataError(c.element(i), "also", int(g), f"gen row already used by {gen_used[g][0]}")
+                        gen_used[g] = (c.element(i), False)
         for g, devs in shares.items():
             for k, f in ((1, "gammap"), (2, "gammaq")):
                 tot = sum(d[k] for d in devs)

@@ -43,14 +43,23 @@ class _BusConstraint(Component):
     outputs = ("P", "Q")
     units = {"P": "power", "Q": "power"}
 
-    def add_source(self, name, gen):
-        """Add a source for the gen-table row ``gen`` (0-based, in service)."""
-        self.add(name, {"gen": gen}, {})
+    def add_source(self, name, gen, also=()):
+        """Add a source for the gen-table row ``gen`` (0-based, in service).
+
+        ``also``: further in-service gen-table rows at the same bus that no other device
+        represents (several static generators on one bus: PSS/E's ACTIVSg2000 has two at bus
+        1090). One source holds the bus for all of them and carries their summed scheduled
+        active power (a bus can hold only one voltage constraint)."""
+        link = {"gen": gen}
+        if len(also):
+            link["also"] = [int(g) for g in also]
+        self.add(name, link, {})
         return name
 
     def setup(self, system):
         super().setup(system)
         self.resolve_gen_rows(system)
+        self.gen_also = self._resolve_also(system)
         seen = {}
         for i, b in enumerate(self.bus):
             if b in seen:
@@ -66,6 +75,23 @@ class _BusConstraint(Component):
                         raise DataError(self.element(i), "gen", int(self.gen[i]),
                                         f"bus {system.network.bus_ids[b]} already holds another ideal source")
         self._ver = None
+
+    def _resolve_also(self, system):
+        """The ``also`` rows of each instance (a list per instance), checked: in service and
+        at the instance's bus."""
+        from ..network import GEN_BUS, GEN_STATUS
+
+        net, out = system.network, []
+        for i, lk in enumerate(self.links):
+            rows = [int(g) for g in lk.get("also", [])]
+            for g in rows:
+                if not (0 <= g < net.gen.shape[0]) or net.gen[g, GEN_STATUS] <= 0 or \
+                        int(net.gen[g, GEN_BUS]) != int(net.gen[self.gen[i], GEN_BUS]):
+                    raise DataError(self.element(i), "also", g,
+                                    "give in-service gen-table rows at the source's own bus "
+                                    f"{system.network.bus_ids[self.bus[i]]}")
+            out.append(rows)
+        return out
 
     def pattern(self, system):
         """Rows of the source's bus: its own and neighbouring bus voltages, and the states of
@@ -88,6 +114,8 @@ class _BusConstraint(Component):
         net = system.network
         self.V0 = net.pf.V[self.bus].copy()
         self.p0 = net.pf.Pg[self.gen].copy()
+        for i, rows in enumerate(getattr(self, "gen_also", [])):
+            self.p0[i] += float(np.sum(net.pf.Pg[rows])) if rows else 0.0
         self._nb = net.nb
 
     def _rows(self, system):

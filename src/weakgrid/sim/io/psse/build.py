@@ -365,16 +365,22 @@ class _Builder:
             raise DataError(f"{self.rname}", "generators", names,
                             f"the generators {names} have no machine record in the .dyr; add one or "
                             "set their status to 0")
-        for (b, i), row in bare:
+        by_bus = {}
+        for (b, i), row in bare:               # one ideal source per bus (one V constraint)
+            by_bus.setdefault(b, []).append((i, row))
+        for b, units in by_bus.items():
+            (i, row), rest = units[0], units[1:]
             slack = net.bus[net.index_of(b), 1] == 3
             src = "InfiniteBus" if slack else "PVSource"
             name = f"{src}_{b}_{i}"
-            system._component(src, "device").add_source(name, row)
-            self.machines[(b, i)] = name
+            system._component(src, "device").add_source(name, row, also=[r for _, r in rest])
             what = ("an ideal voltage source (infinite bus: fixed voltage and angle)" if slack else
                     "a constant-P, constant-|V| source (no inertia, unlimited reactive power)")
-            self.notes.append(f"generator at bus {b} id '{i}': no machine record; simulated as "
-                              f"{what} ({src})")
+            for k, (j, _) in enumerate(units):
+                self.machines[(b, j)] = name
+                share = "" if k == 0 else f"; held by {name} with its bus's other units, P summed"
+                self.notes.append(f"generator at bus {b} id '{j}': no machine record; simulated "
+                                  f"as {what} ({src}){share}")
 
     def finish(self, dyr):
         """PSS/E identifiers and the notes, on the system."""
