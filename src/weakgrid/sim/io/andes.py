@@ -86,6 +86,7 @@ ANDES_CONVENTIONS = {
     "EXAC2": {"TR_used": 0.0},    # as its EXAC1
     "ESDC2A": {"TR_used": 0.0},   # idem
     "REGCA1": {"LVPL_strict": 0.0},  # LVPL resets S0 only while dS0/dt >= 0 (S0 may stay above it)
+    "REPCA1": {"P_total": 0.0},   # Pmin, Pmax bound the increment Pext, not the total P reference
     "IEEEX1": {"VR_Vt": 0.0},     # regulator limits VRMAX, VRMIN, not times Vt
     "EXST1": {"VR_limited": 0.0},  # output limit tested on the rate feedback (in effect never acts)
     "IEEEVC": {"on_Sb": 1.0},     # rc, xc on the system base (its IEEEVC has no Sn)

@@ -14,8 +14,18 @@ s; ``V`` is the voltage of the converter's bus, the line is the monitored branch
     Pline --[Lag 1/(1+sTp)]--> s4
     ferr = 1 - f;   droop = Ddn * fdb if fdb < 0 else Dup * fdb,   fdb = deadband(ferr; fdbd1, fdbd2)
     Perr = droop + PLflag (Pline0 - s4),   fe = clip(Perr, femin, femax)
-    fe --[PI Kpg, Kig (tracking anti-windup), Pmin..Pmax]--> s5 --[Lag 1/(1+sTg)]--> s6
+    fe --[PI Kpg, Kig (tracking anti-windup), Pmin - P0..Pmax - P0]--> s5 --[Lag 1/(1+sTg)]--> s6
     Pext = Fflag * s6
+
+``Pext`` is an increment on the converter's initial power ``P0`` (ANDES's form), so the plant's
+power reference is ``P0 + s5``. ``Pmin``, ``Pmax`` bound that *total* reference, as in the WECC
+REPC_A diagram and PSS/E's REPCA1, whose PI output is the electrical control's ``Pref`` itself
+(started at ``P0``): the PI's limits are ``Pmin - P0``, ``Pmax - P0``. ANDES 2.0 applies them to
+the increment ``s5`` (its default ``Pmin = -999``); ``P_total = 0`` reproduces that (the ANDES
+importer sets it). With PSS/E data (``Pmin = 0``) ANDES's form pins ``s5`` at 0 from below: the
+plant cannot lower its power, and PSS/E's RENA frequency-flag case (``Fflag = 1``, ``Kpg = 1``,
+``Tp = 0.25``) showed no undershoot where PSS/E's power dips 2.6e-4 pu below P0 (0.39974 at
+1.21 s).
 
 Without a monitored line, ANDES 2.0 (and an ANDES import) takes ``Pline = Qline = 0``: the
 plant's Q/V and P loops then see no power at all. PSS/E's REPCA1 without a monitored branch
@@ -82,6 +92,8 @@ class REPCA1(Component):
         Param("Pmax", 999.0, "pu (Sn)", "upper limit of the P PI output", "", "power"),
         Param("Pmin", -999.0, "pu (Sn)", "lower limit of the P PI output", "", "power"),
         Param("Tg", 0.02, "s", "Pext lag time constant (0: none)", "nonneg"),
+        _flag("P_total", "1: Pmin, Pmax bound the total power reference P0 + s5 (WECC, PSS/E); "
+              "0: the increment s5 (ANDES 2.0)", 1.0),
         Param("Ddn", 10.0, "pu/pu", "down-regulation droop gain (over-frequency)"),
         Param("Dup", 10.0, "pu/pu", "up-regulation droop gain (under-frequency)"),
         Param("fn", 60.0, "Hz", "nominal frequency", "pos"),
@@ -290,6 +302,11 @@ class REPCA1(Component):
         self.V0 = V[self.bus].copy()
         P, Q, vcsel, v = self._line(V, self.regc.p0[self.r] + 1j * self.regc.q0[self.r])
         self.Pline0, self.Qline0, self.Vref0 = P, Q, vcsel
+        # the P PI's limits: on the total reference P0 + s5 (P_total = 1) or on s5 (ANDES)
+        p0 = np.where(self.p["P_total"] > 0, self.regc.p0[self.r], 0.0)
+        self.Plo, self.Phi = self.p["Pmin"] - p0, self.p["Pmax"] - p0
+        self.initial_bounds = [("s5 (plant power reference - P0)", np.zeros(self.n), self.Plo, self.Phi,
+                                "Pmin - P0", "Pmax - P0")]
         for i in np.nonzero(v < self.p["Vfrz"])[0]:
             raise DataError(self.element(i), "Vfrz", self.p["Vfrz"][i],
                             f"the initial voltage {v[i]:.4g} pu is below Vfrz: the control would start held")
@@ -325,7 +342,7 @@ class REPCA1(Component):
         droop = np.where(fdb < 0, fdb * p["Ddn"], fdb * p["Dup"])
         perr = droop + np.where(p["PLflag"] > 0, self.Pline0 - s4y, 0.0)
         fe = np.clip(perr, p["femin"], p["femax"])
-        s5y = self.s5b.output(s5, fe, p["Pmin"], p["Pmax"])
+        s5y = self.s5b.output(s5, fe, self.Plo, self.Phi)
         s6y = self.s6b.output(s6, s5y)
         pext = np.where(p["Fflag"] > 0, s6y, 0.0)
         for tn, (n, rows, idx) in self._targets.items():
@@ -339,7 +356,7 @@ class REPCA1(Component):
         fd[..., sl[2]] = self.s2b.deriv(s2, ehld, p["Qmin"], p["Qmax"])
         fd[..., sl[3]] = self.s3b.deriv(s3, s2y)
         fd[..., sl[4]] = self.s4b.deriv(s4, P)
-        fd[..., sl[5]] = self.s5b.deriv(s5, fe, p["Pmin"], p["Pmax"])
+        fd[..., sl[5]] = self.s5b.deriv(s5, fe, self.Plo, self.Phi)
         fd[..., sl[6]] = self.s6b.deriv(s6, s5y)
         fd[..., sl[7]] = err / p["Tf"]
         fd[..., sl[8]] = self.WOb.deriv(wo, L)
