@@ -15,11 +15,13 @@ intermediate value and where it came from:
   simulator is on the system base) and ``ωs = 2π·f``.
 
 ``grid_model="thevenin"`` (:mod:`weakgrid.design.thevenin`, SG only) replaces the stiff
-shunt-bus voltage by the grid seen from r: ``V̄r``/``ϕs0`` refer to the Thevenin voltage ``E_th``, ``B`` is the
-transfer admittance through the path *and* ``Z_th`` (:meth:`TwoPort.through`; its reactance only
-for the lossless SG), and ``a`` is multiplied by the two-machine inertia factor ``1 + M1/M2``. A GTI's angle is
-referred to r by its own control (its PLL), so the grid behind r does not enter its angle
-dynamics: for a GTI the Thevenin form *is* the paper's. Both forms are always derived (``Derivation.forms``) so that the mode check can print both.
+shunt-bus voltage by the grid seen from r: ``V̄r``/``ϕs0`` refer to the Thevenin voltage
+``E_th``, ``B`` is the transfer admittance through the path *and* ``Z_th``
+(:meth:`TwoPort.through`; its reactance only for the lossless SG), and ``a`` is multiplied by
+the two-machine inertia factor ``1 + M1/M2``. A GTI's angle is referred to r by its own
+control (its PLL), so the grid behind r does not enter its angle dynamics: for a GTI the
+Thevenin form *is* the paper's. Both forms are always derived (``Derivation.forms``) so that
+the mode check can print both.
 
 The continuous model (9) linearized at ϕs0 oscillates at ``ω = sqrt(a·V̄r·cos ϕs0)`` (rad/s):
 :func:`design_mode` returns it for comparison with the full grid's mode
@@ -41,8 +43,8 @@ from .twoport import TwoPort, source_twoport
 
 GRID_MODELS = ("paper", "thevenin")
 
-__all__ = ["GRID_MODELS", "Derivation", "derive_design", "design_mode", "find_machine", "mode_states",
-           "upqc_branch_of"]
+__all__ = ["GRID_MODELS", "Derivation", "derive_design", "design_mode", "find_machine",
+           "mode_states", "upqc_branch_of"]
 
 
 @dataclass

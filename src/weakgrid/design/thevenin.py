@@ -9,9 +9,9 @@ replaces the stiff ``Vr`` by
 * the grid's Thevenin equivalent at r, ``E_th`` behind ``Z_th``: the network with the UPQC branch
   open (so the controlled machine and its side are removed), every load as its constant
   impedance at the power-flow voltage, every other synchronous machine with an exciter as a
-  voltage source at its terminal (its voltage regulator holds it), one without as ``E'`` behind
-  ``ra + j·x'd`` (the classical model), every other GTI as its internal voltage behind ``1/(j·B)``; the sources
-  shorted for ``Z_th``::
+  voltage source at its terminal (its voltage regulator holds it), one without as ``E'``
+  behind ``ra + j·x'd`` (the classical model), every other GTI as its internal voltage behind
+  ``1/(j·B)``; the sources shorted for ``Z_th``::
 
       Z_th = [Y_grid⁻¹]_rr ,   E_th = Vr + Z_th·I       (I: current of the UPQC branch r → b1)
 
