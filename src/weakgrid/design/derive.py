@@ -242,7 +242,8 @@ def _add_thevenin(d, system, comp, i, Vr, lossless_sg, sources):
     d.add("E_th", float(abs(th.E)), "pu", "|Vr + Z_th·I| (I: UPQC branch current r → b1)")
     d.add("B_th", B_th, "pu", "|Y12·y_th/(Y22 + y_th)|: the path and Z_th"
           + (" (reactance only)" if lossless else ""))
-    d.add("M2", th.M_behind, "s", "Σ M = 2H of the machines behind r (system base)")
+    if math.isfinite(th.M_behind):
+        d.add("M2", th.M_behind, "s", "Σ M = 2H of the machines behind r (system base)")
     d.add("k_inertia", k, "", "two-machine factor 1 + M1/M2")
     d.add("a_th", a_th, "rad/s²/pu", "a·(B_th/B)·k")
     d.add("phi_th", phi_th, "rad", "∠source − ∠E_th")
