@@ -76,6 +76,11 @@ def run(args) -> int:
     verdict = "agree" if chk["ok"] else "MISMATCH"
     print(f"  frequency mismatch {chk['mismatch']:+.1%} (tolerance {MODE_TOLERANCE:.0%}): "
           f"{verdict}")
+    for name, fm in chk.get("forms", {}).items():   # both forms of design.grid_model
+        used = " (used)" if name == chk.get("grid_model") else ""
+        print(f"  grid_model = {name!r}{used}: {fm['f_hz']:.4g} Hz, {fm['mismatch']:+.1%}")
+    if der.forms_note:
+        print(f"  grid_model = 'thevenin': {der.forms_note}")
     if args.no_train:
         return 0
     out = args.output or Path(f"{st.name}-{setup.load}-{setup.upqc}.controller.json")

@@ -111,6 +111,14 @@ def run(args) -> int:
         lam_d = design_mode(setup.derivation.model)
         print(f"  => mode of the controlled machine '{setup.source}' (participation {part:.2f}); "
               f"design model (10): {abs(lam_d.imag) / (2 * np.pi):.4g} Hz")
+        f_grid = float(m.frequency_hz[k_m]) if k_m is not None else float("nan")
+        for name, mod in setup.derivation.forms.items():     # both forms of design.grid_model
+            if mod is None:
+                continue
+            fd = abs(design_mode(mod).imag) / (2 * np.pi)
+            used = " (used)" if name == setup.derivation.grid_model else ""
+            print(f"     grid_model = {name!r}{used}: {fd:.4g} Hz, "
+                  f"{(fd - f_grid) / f_grid:+.1%} vs the grid's {f_grid:.4g} Hz")
     if args.plot:
         _plot(args.plot, m, k_m, lam_d, setup, st.name if st is not None else str(args.study))
     return 0

@@ -14,6 +14,15 @@ intermediate value and where it came from:
   ``ϕs0 = ∠E' − ∠Vr``; ``a = ωs·E'·B/(2H)``, with ``H`` on the system base (``M = 2H`` of the
   simulator is on the system base) and ``ωs = 2π·f``.
 
+``grid_model="thevenin"`` (:mod:`weakgrid.design.thevenin`, SG only) replaces the stiff
+shunt-bus voltage by the grid seen from r: ``V̄r``/``ϕs0`` refer to the Thevenin voltage
+``E_th``, ``B`` is the transfer admittance through the path *and* ``Z_th``
+(:meth:`TwoPort.through`; its reactance only for the lossless SG), and ``a`` is multiplied by
+the two-machine inertia factor ``1 + M1/M2``. A GTI's angle is referred to r by its own
+control (its PLL), so the grid behind r does not enter its angle dynamics: for a GTI the
+Thevenin form *is* the paper's. Both forms are always derived (``Derivation.forms``) so that
+the mode check can print both.
+
 The continuous model (9) linearized at ϕs0 oscillates at ``ω = sqrt(a·V̄r·cos ϕs0)`` (rad/s):
 :func:`design_mode` returns it for comparison with the full grid's mode
 (:mod:`weakgrid.design.modes`).
@@ -29,10 +38,13 @@ import numpy as np
 from ..game.errors import ParameterError
 from ..models.design import UPQCDesignModel, sg_design_model
 from ..sim.network import BR_R, BR_X, F_BUS, T_BUS
+from .thevenin import GridThevenin, grid_thevenin, two_machine_factor
 from .twoport import TwoPort, source_twoport
 
-__all__ = ["Derivation", "derive_design", "design_mode", "find_machine", "mode_states",
-           "upqc_branch_of"]
+GRID_MODELS = ("paper", "thevenin")
+
+__all__ = ["GRID_MODELS", "Derivation", "derive_design", "design_mode", "find_machine",
+           "mode_states", "upqc_branch_of"]
 
 
 @dataclass
@@ -54,6 +66,12 @@ class Derivation:
     twoport : TwoPort
     details : dict
         Flat checks (exact two-port power vs design model's, loss angle …).
+    grid_model : {"paper", "thevenin"}
+        Which form ``model`` is.
+    forms : dict
+        ``{"paper": UPQCDesignModel, "thevenin": UPQCDesignModel or None}``: both forms (None
+        when the grid behind r has no source; ``forms_note`` says why).
+    thevenin : GridThevenin or None
     """
 
     model: UPQCDesignModel
@@ -64,6 +82,10 @@ class Derivation:
     values: list = field(default_factory=list)
     twoport: TwoPort | None = None
     details: dict = field(default_factory=dict)
+    grid_model: str = "paper"
+    forms: dict = field(default_factory=dict)
+    forms_note: str = ""
+    thevenin: GridThevenin | None = None
 
     def add(self, name, value, unit, source):
         self.values.append({"name": name, "value": value, "unit": unit, "source": source})
@@ -84,7 +106,10 @@ class Derivation:
                 "shunt_bus": self.shunt_bus, "upqc_branch": self.upqc_branch,
                 "values": [dict(v, value=float(v["value"]) if isinstance(v["value"], (float, int,
                             np.floating)) else str(v["value"])) for v in self.values],
-                "details": {k: float(v) for k, v in self.details.items()}}
+                "details": {k: float(v) for k, v in self.details.items()},
+                "grid_model": self.grid_model,
+                "forms": {k: (m.to_dict() if m is not None else None)
+                          for k, m in self.forms.items()}}
 
 
 def design_mode(model) -> complex:
@@ -127,7 +152,8 @@ def upqc_branch_of(system, upqc):
 
 
 def derive_design(system, machine: str, upqc, T: float, structure: str = "conventional",
-                  lossless_sg: bool = True) -> Derivation:
+                  lossless_sg: bool = True, grid_model: str = "paper",
+                  thevenin_sources: str = "auto") -> Derivation:
     """Derive the design model (10) of ``machine`` behind the UPQC ``upqc``.
 
     Parameters
@@ -144,7 +170,15 @@ def derive_design(system, machine: str, upqc, T: float, structure: str = "conven
         UPQC structure (the model is the same, (16)).
     lossless_sg : bool
         SG: B from reactances only (the classical model's lossless path).
+    grid_model : {"paper", "thevenin"}
+        The paper's stiff shunt-bus voltage, or the grid's Thevenin equivalent at r with the
+        two-machine inertia factor (:mod:`weakgrid.design.thevenin`). Both are derived; this
+        chooses ``Derivation.model``.
+    thevenin_sources : {"auto", "terminal", "transient"}
+        How the other machines enter the Thevenin equivalent (:func:`grid_thevenin`).
     """
+    if grid_model not in GRID_MODELS:
+        raise ParameterError("design.grid_model", grid_model, f"choose one of {GRID_MODELS}")
     if not getattr(system, "is_setup", False):
         raise ParameterError("system", "not set up", "call System.setup() before deriving")
     net = system.network
@@ -154,8 +188,68 @@ def derive_design(system, machine: str, upqc, T: float, structure: str = "conven
     Vr = net.pf.V[r]
     kind, comp, i = find_machine(system, machine)
     if kind == "gti":
-        return _derive_gti(system, comp, i, k_up, r_id, Vr, T, structure)
-    return _derive_sg(system, comp, i, k_up, r_id, Vr, T, structure, lossless_sg)
+        d = _derive_gti(system, comp, i, k_up, r_id, Vr, T, structure)
+    else:
+        d = _derive_sg(system, comp, i, k_up, r_id, Vr, T, structure, lossless_sg)
+    _add_thevenin(d, system, comp, i, Vr, lossless_sg, thevenin_sources)
+    if grid_model == "thevenin":
+        if d.forms["thevenin"] is None:
+            raise ParameterError("design.grid_model", "thevenin", d.forms_note)
+        d.model = d.forms["thevenin"]
+        d.grid_model = "thevenin"
+    return d
+
+
+def _add_thevenin(d, system, comp, i, Vr, lossless_sg, sources):
+    """Derive the Thevenin form beside the paper's (``d.forms``) and record its values."""
+    d.forms = {"paper": d.model, "thevenin": None}
+    if d.machine == "gti":
+        # the GTI's angle is referred to the shunt bus r (its PLL, checked in _derive_gti): the
+        # grid behind r does not enter its angle dynamics, the Thevenin form is the paper's
+        d.forms["thevenin"] = d.model
+        d.forms_note = "GTI referred to r: the Thevenin form is the paper's"
+        d.details.update(omega_design_paper=abs(design_mode(d.model)),
+                         omega_design_thevenin=abs(design_mode(d.model)))
+        return
+    try:
+        th = grid_thevenin(system, d.upqc_branch, int(comp.bus[i]), sources)
+    except ParameterError as exc:
+        d.forms_note = exc.fix
+        return
+    d.thevenin = th
+    p = d.model
+    lossless = lossless_sg
+    z = complex(0.0, th.Z.imag) if lossless else th.Z
+    B_th = float(abs(d.twoport.through(z)))
+    B = next(v["value"] for v in d.values if v["name"] == "B")
+    src_angle = p.phi_s0 + float(np.angle(Vr))                # ∠E'
+    base = p.a / B
+    k = two_machine_factor(float(comp.p["M"][i]), th.M_behind)  # M = 2H, system base
+    a_th = base * B_th * k
+    phi_th = float(np.angle(np.exp(1j * (src_angle - np.angle(th.E)))))
+    try:
+        m = UPQCDesignModel(p.T, a_th, float(abs(th.E)), phi_th, machine=p.machine, upqc=p.upqc,
+                            source=dict(p.source, grid_model="thevenin", B=B_th,
+                                        Vr_bar=float(abs(th.E)), phi_s0=phi_th,
+                                        Z_th=[th.Z.real, th.Z.imag], inertia_factor=k))
+    except ParameterError as exc:
+        d.forms_note = f"the Thevenin form has no valid operating point: {exc.fix}"
+        return
+    d.forms["thevenin"] = m
+    d.add("R_th", float(th.Z.real), "pu", "grid's Thevenin resistance at r")
+    d.add("X_th", float(th.Z.imag), "pu", "grid's Thevenin reactance at r (UPQC branch open, "
+          f"loads at their power-flow impedance, sources: {', '.join(th.sources)})")
+    d.add("E_th", float(abs(th.E)), "pu", "|Vr + Z_th·I| (I: UPQC branch current r → b1)")
+    d.add("B_th", B_th, "pu", "|Y12·y_th/(Y22 + y_th)|: the path and Z_th"
+          + (" (reactance only)" if lossless else ""))
+    if math.isfinite(th.M_behind):
+        d.add("M2", th.M_behind, "s", "Σ M = 2H of the machines behind r (system base)")
+    d.add("k_inertia", k, "", "two-machine factor 1 + M1/M2")
+    d.add("a_th", a_th, "rad/s²/pu", "a·(B_th/B)·k")
+    d.add("phi_th", phi_th, "rad", "∠source − ∠E_th")
+    d.details.update(omega_design_paper=abs(design_mode(p)),
+                     omega_design_thevenin=abs(design_mode(m)),
+                     inertia_factor=k, X_th=th.Z.imag, R_th=th.Z.real, B_th=B_th)
 
 
 def _buses(net, ids) -> str:

@@ -40,6 +40,9 @@ class TwoPort:
         0-based rows of the machine-side branches in the path.
     lossless : bool
         Whether resistances and line charging were dropped (reactances only).
+    Y22 : complex
+        Driving-point admittance at ``V'`` (pu), used to add the grid's Thevenin impedance behind
+        ``V'`` (:meth:`through`).
     """
 
     Y11: complex
@@ -47,6 +50,18 @@ class TwoPort:
     buses: list
     branches: list
     lossless: bool
+    Y22: complex = complex("nan")
+
+    def through(self, z: complex) -> complex:
+        """Transfer admittance ``Y12·y/(Y22 + y)`` from the source to a node behind ``V'``
+        through the series impedance ``z`` (pu), e.g. the grid's Thevenin impedance.
+
+        ``V'`` is eliminated (Kron reduction of ``[E, V', E_th]``); ``z = 0`` returns ``Y12``.
+        """
+        if z == 0:
+            return self.Y12
+        y = 1.0 / z
+        return self.Y12 * y / (self.Y22 + y)
 
     @property
     def B(self) -> float:
@@ -148,4 +163,5 @@ def source_twoport(system, source_bus: int, source_y: complex, upqc_branch: int,
     ext, inn = [0, m + 1], list(range(1, m + 1))
     Yr = Y[np.ix_(ext, ext)] - Y[np.ix_(ext, inn)] @ np.linalg.solve(Y[np.ix_(inn, inn)],
                                                                       Y[np.ix_(inn, ext)])
-    return TwoPort(Yr[0, 0], Yr[0, 1], [int(net.bus_ids[b]) for b in buses], rows, lossless)
+    return TwoPort(Yr[0, 0], Yr[0, 1], [int(net.bus_ids[b]) for b in buses], rows, lossless,
+                   Yr[1, 1])

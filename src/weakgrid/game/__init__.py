@@ -7,8 +7,8 @@ the two-loop HJI policy iteration and its exact special case, the LQ game.
 # Lazy (PEP 562): a name is imported from its module on first use, so that importing one
 # submodule (e.g. ``weakgrid.game.errors``) does not load SciPy and the solvers.
 _WHERE = {
-    "bases": ("PolynomialBasis", "even_monomials", "from_generator", "paper_basis",
-              "quadratic_basis"),
+    "bases": ("PolynomialBasis", "even_monomials", "full_monomials", "from_generator",
+              "paper_basis", "quadratic_basis"),
     "controller": ("GameController", "load_controller"),
     "cost": ("GameCost",),
     "errors": ("ControlHessianError", "ConvergenceError", "GammaTooSmallError",
@@ -40,7 +40,8 @@ def __dir__():
 
 
 __all__ = [
-    "PolynomialBasis", "even_monomials", "from_generator", "paper_basis", "quadratic_basis",
+    "PolynomialBasis", "even_monomials", "full_monomials", "from_generator", "paper_basis",
+    "quadratic_basis",
     "GameController", "load_controller", "GameCost", "ControlHessianError", "ConvergenceError",
     "GammaTooSmallError", "InitialPolicyError", "NonFiniteError", "ParameterError", "ShapeError",
     "WeakgridError", "IterationRecord", "SolverSettings", "closed_loop_spectral_radius",

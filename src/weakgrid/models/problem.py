@@ -38,6 +38,7 @@ from ..game import (
     ParameterError,
     SolverSettings,
     even_monomials,
+    full_monomials,
     from_generator,
     paper_basis,
     solve_hji,
@@ -184,6 +185,8 @@ def _basis(d: dict, n: int) -> PolynomialBasis:
         return paper_basis()
     if kind == "even":
         return even_monomials(n, int(_num(d, "degree", "basis")))
+    if kind == "full":
+        return full_monomials(n, _num(d, "degree", "basis"))
     if kind == "generator":
         coef = d.get("coefficients")
         return from_generator(n, _array(d, "powers", "basis", [2, 4]),
@@ -193,7 +196,8 @@ def _basis(d: dict, n: int) -> PolynomialBasis:
         if np.any(e < 0) or np.any(e != np.round(e)):
             raise ParameterError("basis.exponents", e.tolist(), "exponents are whole numbers ≥ 0")
         return PolynomialBasis(e.astype(int), name="custom")
-    raise ParameterError("basis.kind", kind, "use 'paper', 'even', 'generator' or 'custom'")
+    raise ParameterError("basis.kind", kind, "use 'paper', 'even', 'full', 'generator' or "
+                         "'custom'")
 
 
 def _policy(d: dict, system):

@@ -772,7 +772,8 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
         upqc_name = up["name"]
     with _data_warnings_once():
         s.setup()
-    der = derive_design(s, ctl_name, k_up, float(d["design"]["T"]), structure=upqc)
+    der = derive_design(s, ctl_name, k_up, float(d["design"]["T"]), structure=upqc,
+                        grid_model=d["design"].get("grid_model", "paper"))
     b1 = net.index_of(int(net.branch[k_up, T_BUS]))
     r = net.index_of(r_id)
     yu = 1.0 / complex(net.branch[k_up, BR_R], net.branch[k_up, BR_X])

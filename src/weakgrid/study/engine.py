@@ -96,6 +96,12 @@ def mode_check(setup) -> dict:
     lam = m.eigenvalues[k]
     f = float(m.frequency_hz[k])
     mis = abs(out["design_f_hz"] - f) / f
+    out["grid_model"] = der.grid_model
+    out["forms"] = {}     # both design forms (paper's stiff Vr, grid's Thevenin): signed mismatch
+    for name, mod in der.forms.items():
+        if mod is not None:
+            fd = abs(design_mode(mod).imag) / (2 * np.pi)
+            out["forms"][name] = {"f_hz": fd, "mismatch": (fd - f) / f}
     out.update(grid_lambda=complex(lam), grid_f_hz=f, grid_zeta=float(m.damping_ratio[k]),
                participation=part, mismatch=mis, ok=bool(mis <= MODE_TOLERANCE),
                dominant=", ".join(f"{n} {p:.2f}" for n, p in m.dominant_states(k)))

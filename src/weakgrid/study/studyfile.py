@@ -433,9 +433,13 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         _num(ins, "x", "upqc.insert", positive=True)
         ins.setdefault("r", 0.0)
     ds = _need(d, "design", "study file", dict)
-    _keys(ds, {"T", "settings", "cost", "mesh", "basis", "initial_policy", "solver", "load"},
-          "design")
+    _keys(ds, {"T", "settings", "cost", "mesh", "basis", "initial_policy", "solver", "load",
+               "grid_model"}, "design")
     _num(ds, "T", "design", positive=True)
+    from ..design.derive import GRID_MODELS
+
+    _choice(ds, "grid_model", "design", GRID_MODELS, default="paper")   # not set: the key of
+    # every cached run stays as it was
     ds.setdefault("settings", "case1-paper")
     from ..models import preset_names
 
