@@ -118,7 +118,7 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name):
             rec.add(k * dt)
     sim.stop()
     wall = time.perf_counter() - t0
-    log.info("DPsim %s: %d steps of %g s in %.2f s", domain, n_steps, dt, wall)
+    log.debug("DPsim %s: %d steps of %g s in %.2f s", domain, n_steps, dt, wall)
     return rec.finish({"steps": n_steps, "wall_s": wall, "engine": engine, "dt": float(dt)})
 
 
