@@ -30,6 +30,7 @@ from .dpsim_module import DOMAINS, Kit, domain_of
 from .events import build_events
 from .machines import build_machines, check_machines
 from .topology import build_network, bus_base, check_devices
+from .upqc import UPQCBridge
 
 log = logging.getLogger(__name__)
 
@@ -37,7 +38,7 @@ __all__ = ["DOMAINS", "simulate_dpsim"]
 
 
 def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float = 1e-4,
-                   events=(), decimate: int = 1, name: str = "weakgrid") -> Results:
+                   events=(), decimate: int = 1, name: str = "weakgrid", sample=None) -> Results:
     """Simulate a set-up ``system`` in DPsim from ``t = 0`` to ``t_end`` [s].
 
     Parameters
@@ -57,6 +58,11 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
         Record every ``decimate``-th step.
     name : str
         DPsim simulation name (its log directory, logging off).
+    sample : (float, callable), optional
+        ``(T, f)``: a sampled controller in the loop. At ``t = 0, T, 2T, ...`` [s]
+        ``f(t, signals)`` is called with the latest recorded values (a dict, names as recorded)
+        and may set UPQC inputs (``system.components["UPQC"].set_input``); the UPQC's series
+        source and shunt converter follow them from the next step (zero-order hold).
 
     Returns
     -------
@@ -87,12 +93,13 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
         # DPsim writes its own log files (MnaSolverFactory.log, scheduler.log) to a log
         # directory (default ./logs): kept out of the user's working directory
         kit.d.Logger.set_log_dir(logdir)
-        return _run(system, kit, engine, domain, t_end, dt, events, decimate, name)
+        return _run(system, kit, engine, domain, t_end, dt, events, decimate, name, sample)
 
 
-def _run(system, kit, engine, domain, t_end, dt, events, decimate, name):
+def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, sample):
     net = system.network
     cir = build_network(system, kit)
+    bridge = UPQCBridge(system, kit, cir)
     gens = build_machines(system, kit, cir.nodes, cir.Vpf)
     cir.components.extend(g for _, g in gens)
     sw_events = build_events(system, kit, cir, events)
@@ -107,13 +114,25 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name):
     sim.do_system_matrix_recomputation(True)      # the switches change the system matrix
     for ev in sw_events:
         sim.add_event(ev)
-    rec = _Recorder(system, kit, gens, cir)
+    if sample is not None:
+        T, f = sample
+        if not (isinstance(T, (int, float)) and T >= dt) or not callable(f):
+            raise DataError("simulate_dpsim", "sample", sample,
+                            f"give (T, f) with a period T >= dt = {dt:g} s and a callable f")
+        every = max(1, int(round(T / dt)))
+    rec = _Recorder(system, kit, gens, cir, bridge)
     n_steps = int(round(t_end / dt))
     t0 = time.perf_counter()
     sim.start()
+    rec.measure(0.0)
     rec.add(0.0)
     for k in range(1, n_steps + 1):
+        t = (k - 1) * dt
+        if sample is not None and (k - 1) % every == 0:
+            f(t, rec.latest())
+        rec.upqc = bridge.update(t, rec.phasor, rec.current)
         sim.next()
+        rec.measure(k * dt)
         if k % decimate == 0 or k == n_steps:
             rec.add(k * dt)
     sim.stop()
@@ -125,9 +144,9 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name):
 class _Recorder:
     """Reads DPsim attributes after each step into weakgrid signal columns."""
 
-    def __init__(self, system, kit, gens, cir):
+    def __init__(self, system, kit, gens, cir, bridge):
         net = system.network
-        self.kit, self.gens, self.nodes = kit, gens, cir.nodes
+        self.kit, self.gens, self.nodes, self.bridge = kit, gens, cir.nodes, bridge
         self.w = 2 * math.pi * net.f_hz
         Vb, _ = bus_base(system)
         self.Vb = Vb
@@ -140,6 +159,11 @@ class _Recorder:
             names += [f"bus{bid}.v", f"bus{bid}.a"]
             kinds += ["voltage", "angle"]
             fac += [net.base_kv[b], 180 / math.pi]
+        for it in bridge.items:
+            nm = it["name"]
+            names += [f"{nm}.Vup", f"{nm}.Vuq", f"{nm}.Vu", f"{nm}.P_series"]
+            kinds += ["pu", "pu", "pu", "power"]
+            fac += [1.0, 1.0, 1.0, system.Sb]
         if kit.three_phase:
             for b, bid in enumerate(net.bus_ids):
                 names += [f"bus{bid}.va", f"bus{bid}.vb", f"bus{bid}.vc"]
@@ -148,23 +172,55 @@ class _Recorder:
         self.names, self.kinds, self.fac = names, kinds, fac
         self.t, self.rows = [], []
         self._a = np.exp(2j * np.pi / 3)
+        self.upqc = [(it["name"], 0.0, 0.0, 0.0, 0.0) for it in bridge.items]
+        self._ph, self._abc, self._t = None, None, 0.0
 
-    def add(self, t):
-        row = []
-        for _, g in self.gens:
-            row += [g.attr("w_r").get(), g.attr("delta").get(), g.attr("Te").get()]
-        pk = []
+    def _space_vector(self, x, t):
+        """Line-to-line RMS-scale phasor of three instantaneous phase values (EMT)."""
+        x = np.asarray(x, float).ravel()
+        sv = (2 / 3) * (x[0] + self._a * x[1] + self._a ** 2 * x[2]) * np.exp(-1j * self.w * t)
+        return sv / math.sqrt(2 / 3)
+
+    def measure(self, t):
+        """Read every node's voltage at time ``t`` (phasors in pu; EMT: phase values too)."""
+        ph, abc = [], []
         for b, n in enumerate(self.nodes):
             v = np.asarray(n.attr("v").get()).ravel()
             if self.kit.three_phase:
-                vabc = v.real / (self.Vb[b] * math.sqrt(2 / 3))
-                ph = (2 / 3) * (vabc[0] + self._a * vabc[1] + self._a ** 2 * vabc[2]) * np.exp(-1j * self.w * t)
-                pk += list(vabc)
+                abc.append(v.real / (self.Vb[b] * math.sqrt(2 / 3)))
+                ph.append(self._space_vector(v.real, t) / self.Vb[b])
             else:
-                ph = complex(v[0]) / self.Vb[b]
+                ph.append(complex(v[0]) / self.Vb[b])
+        self._ph, self._abc, self._t = ph, abc, t
+
+    def phasor(self, b):
+        """Bus ``b``'s voltage phasor [pu] at the last measurement."""
+        return self._ph[b]
+
+    def current(self, src):
+        """Current [A, line-to-line RMS-scale phasor] from terminal 1 to 2 inside ``src``."""
+        i = -np.asarray(src.attr("i_intf").get()).ravel()
+        return self._space_vector(i.real, self._t) if self.kit.three_phase else complex(i[0])
+
+    def _row(self):
+        row = []
+        for _, g in self.gens:
+            row += [g.attr("w_r").get(), g.attr("delta").get(), g.attr("Te").get()]
+        for ph in self._ph:
             row += [abs(ph), float(np.angle(ph))]
+        for _, up, uq, vu, P in self.upqc:
+            row += [up, uq, vu, P]
+        for abc in self._abc:
+            row += list(abc)
+        return row
+
+    def latest(self) -> dict:
+        """The signals at the last measurement, by name."""
+        return dict(zip(self.names, self._row()))
+
+    def add(self, t):
         self.t.append(t)
-        self.rows.append(row + pk)
+        self.rows.append(self._row())
 
     def finish(self, stats):
         return Results(np.array(self.t), self.names, np.array(self.rows, dtype=float), self.kinds,

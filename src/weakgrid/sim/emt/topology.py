@@ -28,7 +28,8 @@ from ..errors import DataError
 from ..network import BR_B, BR_R, BR_STATUS, BR_X, SHIFT, TAP, T_BUS, F_BUS, GS, BS
 
 #: non-machine component types the DPsim engines map
-DEVICE_MAP = {"InfiniteBus": "NetworkInjection"}
+DEVICE_MAP = {"InfiniteBus": "NetworkInjection",
+              "UPQC": "VoltageSource + CurrentSource (conventional structure, weakgrid.sim.emt.upqc)"}
 
 
 class Circuit:
@@ -88,8 +89,10 @@ def build_network(system, kit) -> Circuit:
     cir.Vpf = Vpf
     off = kit.d.LogLevel.off
     ph = kit.ph
+    up = system.components.get("UPQC")
+    upqc_rows = set(np.asarray(up.branch).tolist()) if up is not None and up.n else set()
     for k, row in enumerate(net.branch):
-        if row[BR_STATUS] <= 0:
+        if row[BR_STATUS] <= 0 or k in upqc_rows:     # a UPQC branch: weakgrid.sim.emt.upqc
             continue
         f, t = net.index_of(int(row[F_BUS])), net.index_of(int(row[T_BUS]))
         where = f"branch {net.branch_label(k)}"
