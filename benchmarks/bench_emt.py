@@ -74,7 +74,8 @@ def main(argv=None):
     for eng, dt in RUNS:
         med = statistics.median(times[(eng, dt)])
         p = peak[(eng, dt)]
-        print(f"{eng:<10} {dt:>8g} {round(a.t_end / dt):>7d} {med:>11.3f} {p:>10.5f} {(p - ref) / ref:>+10.2%}")
+        print(f"{eng:<10} {dt:>8g} {round(a.t_end / dt):>7d} {med:>11.3f} {p:>10.5f} "
+              f"{(p - ref) / ref:>+10.2%}")
 
 
 if __name__ == "__main__":

@@ -12,10 +12,11 @@ Mapping
   (a series capacitor), an off-nominal ``TAP`` or a ``SHIFT``, ends at different base voltages
   (a transformer: not mapped in this first slice);
 * bus loads ``PD + jQD`` and shunts ``GS + jBS``: one constant admittance per bus, the
-  impedance weakgrid's phasor engine uses (:meth:`Network.load_admittance` at the solved
+  impedance weakgrid's phasor engine uses (:meth:`weakgrid.sim.network.Network.load_admittance` at the solved
   voltage): a resistor and an inductor or capacitor to ground;
 * :class:`~weakgrid.sim.sources.InfiniteBus`: DPsim's ``NetworkInjection`` (an ideal source) at
-  the power-flow phasor; other devices (GTI, UPQC, converters, PVSource, ZIP loads) are refused.
+  the power-flow phasor; the conventional UPQC: :mod:`weakgrid.sim.emt.upqc`; other devices (GTI,
+  converters, PVSource, ZIP loads) are refused.
 """
 
 from __future__ import annotations
