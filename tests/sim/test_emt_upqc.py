@@ -1,9 +1,9 @@
 """The UPQC's series voltage in DPsim (weakgrid.sim.emt.upqc) against the phasor engine.
 
 The SMIB of test_emt_dpsim with a conventional UPQC in its line (shunt bus = the machine's
-bus). At 0.1 s a sampled controller (period 1 ms, zero-order hold) steps the UPQC's inputs
+bus). At 0.1 s a DigitalController (period 1 ms, zero-order hold) steps the UPQC's inputs
 ``(Vup, Vuq)`` from zero to a constant: the machine swings to a new angle. Oracles: the
-phasor engine (weakgrid's DigitalController doing the same), EMT and DP on the same data;
+phasor engine running the same controller, EMT and DP on the same data;
 the series voltage recorded as commanded; the rating clip applied.
 """
 
@@ -40,23 +40,21 @@ def _smib(vmax=0.2):
     return s
 
 
+def _controller(u):
+    """The same DigitalController object type in every engine: a constant law from 0.1 s."""
+    return DigitalController(lambda m: list(u), T, lambda sim, t, z, ctx: np.zeros(1),
+                             UPQCTarget("U"), enable=[(T_STEP, 10.0)])
+
+
 def _phasor(u):
-    K = DigitalController(lambda m: list(u), T, lambda sim, t, z, ctx: np.zeros(1),
-                          UPQCTarget("U"), enable=[(T_STEP, 10.0)])
-    return simulate(_smib(), T_END, dt=1e-4, controllers=[K])
+    return simulate(_smib(), T_END, dt=1e-4, controllers=[_controller(u)])
 
 
 def _dpsim(u, engine, vmax=0.2):
-    s = _smib(vmax)
-    up = s.components["UPQC"]
-    seen = []
-
-    def law(t, signals):                     # the controller in the loop, sampled every T
-        seen.append(t)
-        up.set_input("U", *(u if t >= T_STEP - 1e-12 else (0.0, 0.0)))
-
-    res = simulate_dpsim(s, T_END, engine=engine, dt=1e-4, sample=(T, law))
-    assert len(seen) == pytest.approx(T_END / T, abs=1)
+    dc = _controller(u)
+    res = simulate_dpsim(_smib(vmax), T_END, engine=engine, dt=1e-4, controllers=[dc])
+    assert len(dc.log_t) == pytest.approx(T_END / T, abs=1)        # sampled every T
+    assert np.allclose(np.diff(dc.log_t), T)
     return res
 
 
@@ -100,6 +98,8 @@ def test_rating_clip_applies(runs):
     assert np.allclose(r["U.Vup"][after], 0.1 / np.sqrt(2))
 
 
-def test_bad_sample_is_refused():
-    with pytest.raises(DataError, match="sample"):
-        simulate_dpsim(_smib(), 0.01, engine="dpsim-dp", dt=1e-4, sample=(1e-5, lambda t, s: None))
+def test_a_period_off_the_step_grid_is_refused():
+    dc = DigitalController(lambda m: [0, 0], 1.5e-4, lambda sim, t, z, ctx: np.zeros(1),
+                           UPQCTarget("U"))
+    with pytest.raises(DataError, match="whole number of DPsim steps"):
+        simulate_dpsim(_smib(), 0.01, engine="dpsim-dp", dt=1e-4, controllers=[dc])

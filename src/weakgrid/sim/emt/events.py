@@ -6,10 +6,17 @@
   ``|rf + j xf| <= BOLTED_MAX`` [pu] (weakgrid's default ``xf = 1e-4``): its closed resistance is
   ``|rf + j xf| Zb`` [Ω] — at that size the impedance's angle does not change the run. A larger
   fault impedance is refused (field ``xf``/``rf``), not replaced by a resistance.
+* a fault at a bus joined to the rest only by inductive branches (no load or shunt conductance,
+  no machine, no source) is refused: opening the switch interrupts the difference of the branch
+  currents, which then has no path but the open switch, and DPsim's trapezoidal rule rings
+  undamped (measured: 9 pu at the bus, period 2 dt, after clearing). A load or a shunt
+  conductance at the bus gives that current a path.
 * every other event (line trips, generator trips, load steps) is refused naming it.
 """
 
 from __future__ import annotations
+
+import numpy as np
 
 from ..errors import DataError
 from ..events import Fault
@@ -46,6 +53,12 @@ def build_events(system, kit, cir, events):
                             f"DPsim's fault switch is resistive; only a bolted fault "
                             f"(|rf + j xf| <= {BOLTED_MAX:g} pu) is mapped")
         b = system.network.index_of(ev.bus, f"Fault at bus {ev.bus}", "bus")
+        if ev.t_off is not None and b not in _damped_buses(system):
+            raise DataError(f"Fault at bus {ev.bus}", "bus", ev.bus,
+                            "clearing a fault at a bus with only inductive branches (no load or "
+                            "shunt conductance, machine or source) rings undamped in DPsim's "
+                            "trapezoidal rule; fault a bus with a load, or add a shunt "
+                            "conductance (GS) there")
         sw = kit.ph.Switch(f"fault{j}", kit.d.LogLevel.off)
         sw.set_parameters(kit.param(OPEN_PU * Zb[b]), kit.param(z * Zb[b]))
         sw.open()
@@ -54,4 +67,17 @@ def build_events(system, kit, cir, events):
         out.append(kit.event(ev.t_on, sw, True))
         if ev.t_off is not None:
             out.append(kit.event(float(ev.t_off), sw, False))
+    return out
+
+
+def _damped_buses(system) -> set:
+    """Bus positions with a resistive shunt (load or GS > 0), a machine or an ideal source."""
+    net = system.network
+    from ..network import GS
+
+    g = net.load_admittance(net.pf.V).real + net.bus[:, GS] / system.Sb
+    out = {int(b) for b in np.nonzero(g > 0)[0]}
+    for c in system.components.values():
+        if c.kind == "machine" or c.type_name == "InfiniteBus":
+            out.update(int(b) for b in np.atleast_1d(c.bus))
     return out

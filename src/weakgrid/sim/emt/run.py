@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import DataError
 from ..results import Results
+from .controllers import _Loop, bind, sample_all
 from .dpsim_module import DOMAINS, Kit, domain_of
 from .events import build_events
 from .machines import build_machines, check_machines
@@ -38,7 +39,7 @@ __all__ = ["DOMAINS", "simulate_dpsim"]
 
 
 def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float = 1e-4,
-                   events=(), decimate: int = 1, name: str = "weakgrid", sample=None) -> Results:
+                   events=(), controllers=(), decimate: int = 1, name: str = "weakgrid") -> Results:
     """Simulate a set-up ``system`` in DPsim from ``t = 0`` to ``t_end`` [s].
 
     Parameters
@@ -58,11 +59,11 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
         Record every ``decimate``-th step.
     name : str
         DPsim simulation name (its log directory, logging off).
-    sample : (float, callable), optional
-        ``(T, f)``: a sampled controller in the loop. At ``t = 0, T, 2T, ...`` [s]
-        ``f(t, signals)`` is called with the latest recorded values (a dict, names as recorded)
-        and may set UPQC inputs (``system.components["UPQC"].set_input``); the UPQC's series
-        source and shunt converter follow them from the next step (zero-order hold).
+    controllers : list of weakgrid.sim.controllers.DigitalController
+        Sampled controllers in the loop (:mod:`weakgrid.sim.emt.controllers`): each sampled at
+        ``t = 0, T, 2T, ...`` with its measurement reading DPsim's latest signals; a UPQC's
+        series source and shunt converter follow the held output from the next step
+        (zero-order hold).
 
     Returns
     -------
@@ -93,10 +94,10 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
         # DPsim writes its own log files (MnaSolverFactory.log, scheduler.log) to a log
         # directory (default ./logs): kept out of the user's working directory
         kit.d.Logger.set_log_dir(logdir)
-        return _run(system, kit, engine, domain, t_end, dt, events, decimate, name, sample)
+        return _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers)
 
 
-def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, sample):
+def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers):
     net = system.network
     cir = build_network(system, kit)
     bridge = UPQCBridge(system, kit, cir)
@@ -114,12 +115,8 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, sample)
     sim.do_system_matrix_recomputation(True)      # the switches change the system matrix
     for ev in sw_events:
         sim.add_event(ev)
-    if sample is not None:
-        T, f = sample
-        if not (isinstance(T, (int, float)) and T >= dt) or not callable(f):
-            raise DataError("simulate_dpsim", "sample", sample,
-                            f"give (T, f) with a period T >= dt = {dt:g} s and a callable f")
-        every = max(1, int(round(T / dt)))
+    bound = bind(controllers, system, dt)
+    loop = _Loop(system)
     rec = _Recorder(system, kit, gens, cir, bridge)
     n_steps = int(round(t_end / dt))
     t0 = time.perf_counter()
@@ -128,8 +125,8 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, sample)
     rec.add(0.0)
     for k in range(1, n_steps + 1):
         t = (k - 1) * dt
-        if sample is not None and (k - 1) % every == 0:
-            f(t, rec.latest())
+        if bound and any((k - 1) % every == 0 for every, _ in bound):
+            sample_all(bound, loop, k - 1, t, rec.latest())
         rec.upqc = bridge.update(t, rec.phasor, rec.current)
         sim.next()
         rec.measure(k * dt)
