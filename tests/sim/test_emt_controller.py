@@ -101,3 +101,11 @@ def test_the_law_sees_dpsims_speed(runs):
 def test_clearing_a_fault_at_a_purely_inductive_bus_is_refused():
     with pytest.raises(DataError, match="rings undamped"):
         simulate_dpsim(_system(load_mw=0.0), 0.2, engine="dpsim-dp", events=EVENTS)
+
+
+def test_a_measurement_of_an_unknown_machine_is_refused():
+    dc = DigitalController(lambda m: [0.0, 0.0], 1e-3,
+                           mapped(sg_signals_dpsim("G9", 3), lambda s: sg_state_map(s, "G1", 3)),
+                           UPQCTarget("U"))
+    with pytest.raises(DataError, match="G9.delta"):
+        simulate_dpsim(_system(), 0.01, engine="dpsim-dp", controllers=[dc])

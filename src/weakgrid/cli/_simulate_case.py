@@ -163,6 +163,10 @@ def _run_dpsim(system, engine, t_end, dt, events, args, case) -> int:
                 "events": [describe_event(e) for e in events], "t_end": t_end, "dt": dt}
         write_run(out, res, samples=None, meta=meta)
         print(f"wrote {out}")
+    if not res.ok:
+        print(f"weakgrid simulate: the run ended unstable: {res.failure}", file=sys.stderr,
+              flush=True)
+        return 3
     return 0
 
 

@@ -33,6 +33,11 @@ def sg_signals(machine_name, upqc_bus):
     keys = (f"{machine_name}.delta", f"bus{upqc_bus}.a", f"{machine_name}.omega")
 
     def measure(sim, t, z, ctx):
+        missing = [k for k in keys if k not in ctx]
+        if missing:
+            raise DataError("sg_signals", "signal", missing[0],
+                            f"no such DPsim signal (machine '{machine_name}', bus {upqc_bus}); "
+                            f"recorded: {sorted(ctx)[:8]} ...")
         return np.array([ctx[k] for k in keys])
 
     return measure

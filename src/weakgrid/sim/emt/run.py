@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from ..errors import DataError
+from ..errors import DataError, SimulationError
 from ..results import Results
 from .controllers import _Loop, bind, sample_all
 from .dpsim_module import DOMAINS, Kit, domain_of
@@ -68,7 +68,9 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
     Returns
     -------
     Results
-        With ``stats = {"steps", "wall_s", "engine", "dt"}``.
+        With ``stats = {"steps", "wall_s", "engine", "dt"}``; ``failure`` a
+        :class:`~weakgrid.sim.errors.SimulationError` (``"divergence"``) when a bus voltage
+        became non-finite (the run stops there).
     """
     domain = domain_of(engine)
     if not system.is_setup:
@@ -120,6 +122,7 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
     rec = _Recorder(system, kit, gens, cir, bridge)
     n_steps = int(round(t_end / dt))
     t0 = time.perf_counter()
+    failure = None
     sim.start()
     rec.measure(0.0)
     rec.add(0.0)
@@ -130,12 +133,17 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
         rec.upqc = bridge.update(t, rec.phasor, rec.current)
         sim.next()
         rec.measure(k * dt)
+        if not np.isfinite(rec._ph).all():
+            rec.add(k * dt)
+            failure = SimulationError(k * dt, "divergence", "a DPsim bus voltage is not finite")
+            break
         if k % decimate == 0 or k == n_steps:
             rec.add(k * dt)
     sim.stop()
     wall = time.perf_counter() - t0
     log.debug("DPsim %s: %d steps of %g s in %.2f s", domain, n_steps, dt, wall)
-    return rec.finish({"steps": n_steps, "wall_s": wall, "engine": engine, "dt": float(dt)})
+    return rec.finish({"steps": k if n_steps else 0, "wall_s": wall, "engine": engine,
+                       "dt": float(dt)}, failure)
 
 
 class _Recorder:
@@ -219,6 +227,6 @@ class _Recorder:
         self.t.append(t)
         self.rows.append(self._row())
 
-    def finish(self, stats):
+    def finish(self, stats, failure=None):
         return Results(np.array(self.t), self.names, np.array(self.rows, dtype=float), self.kinds,
-                       self.fac, stats=stats)
+                       self.fac, failure=failure, stats=stats)
