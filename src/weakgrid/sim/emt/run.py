@@ -1,0 +1,232 @@
+"""Run a weakgrid System in DPsim (EMT or DP) step by step and record weakgrid's Results.
+
+Recorded signals (names as the phasor engine's where they exist):
+
+* ``<machine>.omega`` [pu speed], ``<machine>.delta`` [rad, synchronous frame of the power flow],
+  ``<machine>.te`` [pu on Sb, DPsim's air-gap torque ``Te``];
+* ``bus<id>.v`` [pu], ``bus<id>.a`` [rad]: the bus voltage phasor — in DP the node's dynamic
+  phasor; in EMT the space vector ``(2/3)(va + a vb + a² vc)`` taken to the synchronous frame
+  (``e^{-j w t}``), equal to the phasor in balanced operation (a dc offset shows as a ripple
+  at the nominal frequency);
+* EMT only, in addition: ``bus<id>.va``, ``.vb``, ``.vc`` [pu of the peak phase-to-ground base
+  ``sqrt(2/3) kV``; SI: kV instantaneous], the three-phase instantaneous voltages.
+
+Time: DPsim steps at a fixed ``dt``; sample ``k`` is the state at ``t = k dt`` (``k = 0``: the
+initial point after ``sim.start()``).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import tempfile
+import time
+
+import numpy as np
+
+from ..errors import DataError, SimulationError
+from ..results import Results
+from .controllers import _Loop, bind, sample_all
+from .dpsim_module import DOMAINS, Kit, domain_of
+from .events import build_events
+from .machines import build_machines, check_machines
+from .topology import build_network, bus_base, check_devices
+from .upqc import UPQCBridge
+
+log = logging.getLogger(__name__)
+
+__all__ = ["DOMAINS", "simulate_dpsim"]
+
+
+def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float = 1e-4,
+                   events=(), controllers=(), decimate: int = 1, name: str = "weakgrid") -> Results:
+    """Simulate a set-up ``system`` in DPsim from ``t = 0`` to ``t_end`` [s].
+
+    Parameters
+    ----------
+    system : weakgrid.sim.system.System
+        Set up (power flow solved); its models must have a DPsim mapping
+        (:mod:`weakgrid.sim.emt.machines`, :mod:`weakgrid.sim.emt.topology`).
+    t_end : float
+        Final time [s].
+    engine : {"dpsim-emt", "dpsim-dp"}
+        DPsim domain.
+    dt : float
+        Fixed time step [s] (EMT needs a step well below the nominal period: 1e-4 s at 50/60 Hz).
+    events : list
+        weakgrid events (:mod:`weakgrid.sim.emt.events` says which are mapped).
+    decimate : int
+        Record every ``decimate``-th step.
+    name : str
+        DPsim simulation name (its log directory, logging off).
+    controllers : list of weakgrid.sim.controllers.DigitalController
+        Sampled controllers in the loop (:mod:`weakgrid.sim.emt.controllers`): each sampled at
+        ``t = 0, T, 2T, ...`` with its measurement reading DPsim's latest signals; a UPQC's
+        series source and shunt converter follow the held output from the next step
+        (zero-order hold).
+
+    Returns
+    -------
+    Results
+        With ``stats = {"steps", "wall_s", "engine", "dt"}``; ``failure`` a
+        :class:`~weakgrid.sim.errors.SimulationError` (``"divergence"``) when a bus voltage
+        became non-finite (the run stops there).
+    """
+    domain = domain_of(engine)
+    if not system.is_setup:
+        raise DataError("simulate_dpsim", "system", "not set up", "call System.setup() first")
+    for fld, v in (("t_end", t_end), ("dt", dt)):
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+            raise DataError("simulate_dpsim", fld, v, "must be a positive number of seconds")
+    if dt > t_end:
+        raise DataError("simulate_dpsim", "dt", dt, f"must not exceed t_end = {t_end} s")
+    if not (isinstance(decimate, int) and decimate >= 1):
+        raise DataError("simulate_dpsim", "decimate", decimate, "must be an integer >= 1")
+    check_machines(system)
+    check_devices(system)
+    net = system.network
+    for c in system.components.values():
+        if c.kind == "machine":
+            bad = [v for v in c.p["fn"] if v != net.f_hz]
+            if bad:
+                raise DataError(c.names[0], "fn", float(bad[0]),
+                                f"the DPsim network runs at one frequency, the grid's {net.f_hz:g} Hz")
+    kit = Kit(domain)
+    with tempfile.TemporaryDirectory(prefix="weakgrid-dpsim-") as logdir:
+        # DPsim writes its own log files (MnaSolverFactory.log, scheduler.log) to a log
+        # directory (default ./logs): kept out of the user's working directory
+        kit.d.Logger.set_log_dir(logdir)
+        return _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers)
+
+
+def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers):
+    net = system.network
+    cir = build_network(system, kit)
+    bridge = UPQCBridge(system, kit, cir)
+    gens = build_machines(system, kit, cir.nodes, cir.Vpf)
+    cir.components.extend(g for _, g in gens)
+    sw_events = build_events(system, kit, cir, events)
+    d = kit.d
+    topo = d.SystemTopology(net.f_hz, cir.nodes + cir.extra_nodes, cir.components)
+    sim = d.Simulation(name, d.LogLevel.off)
+    sim.set_system(topo)
+    sim.set_domain(kit.sim_domain)
+    sim.set_time_step(float(dt))
+    sim.set_final_time(float(t_end))
+    sim.do_init_from_nodes_and_terminals(True)
+    sim.do_system_matrix_recomputation(True)      # the switches change the system matrix
+    for ev in sw_events:
+        sim.add_event(ev)
+    bound = bind(controllers, system, dt)
+    loop = _Loop(system)
+    rec = _Recorder(system, kit, gens, cir, bridge)
+    n_steps = int(round(t_end / dt))
+    t0 = time.perf_counter()
+    failure = None
+    sim.start()
+    rec.measure(0.0)
+    rec.add(0.0)
+    for k in range(1, n_steps + 1):
+        t = (k - 1) * dt
+        if bound and any((k - 1) % every == 0 for every, _ in bound):
+            sample_all(bound, loop, k - 1, t, rec.latest())
+        rec.upqc = bridge.update(t, rec.phasor, rec.current)
+        sim.next()
+        rec.measure(k * dt)
+        if not np.isfinite(rec._ph).all():
+            rec.add(k * dt)
+            failure = SimulationError(k * dt, "divergence", "a DPsim bus voltage is not finite")
+            break
+        if k % decimate == 0 or k == n_steps:
+            rec.add(k * dt)
+    sim.stop()
+    wall = time.perf_counter() - t0
+    log.debug("DPsim %s: %d steps of %g s in %.2f s", domain, n_steps, dt, wall)
+    return rec.finish({"steps": k if n_steps else 0, "wall_s": wall, "engine": engine,
+                       "dt": float(dt)}, failure)
+
+
+class _Recorder:
+    """Reads DPsim attributes after each step into weakgrid signal columns."""
+
+    def __init__(self, system, kit, gens, cir, bridge):
+        net = system.network
+        self.kit, self.gens, self.nodes, self.bridge = kit, gens, cir.nodes, bridge
+        self.w = 2 * math.pi * net.f_hz
+        Vb, _ = bus_base(system)
+        self.Vb = Vb
+        names, kinds, fac = [], [], []
+        for nm, _ in gens:
+            names += [f"{nm}.omega", f"{nm}.delta", f"{nm}.te"]
+            kinds += ["speed", "angle", "power"]
+            fac += [self.w, 180 / math.pi, system.Sb]
+        for b, bid in enumerate(net.bus_ids):
+            names += [f"bus{bid}.v", f"bus{bid}.a"]
+            kinds += ["voltage", "angle"]
+            fac += [net.base_kv[b], 180 / math.pi]
+        for it in bridge.items:
+            nm = it["name"]
+            names += [f"{nm}.Vup", f"{nm}.Vuq", f"{nm}.Vu", f"{nm}.P_series"]
+            kinds += ["pu", "pu", "pu", "power"]
+            fac += [1.0, 1.0, 1.0, system.Sb]
+        if kit.three_phase:
+            for b, bid in enumerate(net.bus_ids):
+                names += [f"bus{bid}.va", f"bus{bid}.vb", f"bus{bid}.vc"]
+                kinds += ["voltage"] * 3
+                fac += [net.base_kv[b] * math.sqrt(2 / 3)] * 3
+        self.names, self.kinds, self.fac = names, kinds, fac
+        self.t, self.rows = [], []
+        self._a = np.exp(2j * np.pi / 3)
+        self.upqc = [(it["name"], 0.0, 0.0, 0.0, 0.0) for it in bridge.items]
+        self._ph, self._abc, self._t = None, None, 0.0
+
+    def _space_vector(self, x, t):
+        """Line-to-line RMS-scale phasor of three instantaneous phase values (EMT)."""
+        x = np.asarray(x, float).ravel()
+        sv = (2 / 3) * (x[0] + self._a * x[1] + self._a ** 2 * x[2]) * np.exp(-1j * self.w * t)
+        return sv / math.sqrt(2 / 3)
+
+    def measure(self, t):
+        """Read every node's voltage at time ``t`` (phasors in pu; EMT: phase values too)."""
+        ph, abc = [], []
+        for b, n in enumerate(self.nodes):
+            v = np.asarray(n.attr("v").get()).ravel()
+            if self.kit.three_phase:
+                abc.append(v.real / (self.Vb[b] * math.sqrt(2 / 3)))
+                ph.append(self._space_vector(v.real, t) / self.Vb[b])
+            else:
+                ph.append(complex(v[0]) / self.Vb[b])
+        self._ph, self._abc, self._t = ph, abc, t
+
+    def phasor(self, b):
+        """Bus ``b``'s voltage phasor [pu] at the last measurement."""
+        return self._ph[b]
+
+    def current(self, src):
+        """Current [A, line-to-line RMS-scale phasor] from terminal 1 to 2 inside ``src``."""
+        i = -np.asarray(src.attr("i_intf").get()).ravel()
+        return self._space_vector(i.real, self._t) if self.kit.three_phase else complex(i[0])
+
+    def _row(self):
+        row = []
+        for _, g in self.gens:
+            row += [g.attr("w_r").get(), g.attr("delta").get(), g.attr("Te").get()]
+        for ph in self._ph:
+            row += [abs(ph), float(np.angle(ph))]
+        for _, up, uq, vu, P in self.upqc:
+            row += [up, uq, vu, P]
+        for abc in self._abc:
+            row += list(abc)
+        return row
+
+    def latest(self) -> dict:
+        """The signals at the last measurement, by name."""
+        return dict(zip(self.names, self._row()))
+
+    def add(self, t):
+        self.t.append(t)
+        self.rows.append(self._row())
+
+    def finish(self, stats, failure=None):
+        return Results(np.array(self.t), self.names, np.array(self.rows, dtype=float), self.kinds,
+                       self.fac, failure=failure, stats=stats)

@@ -1,0 +1,138 @@
+"""The UPQC (conventional structure) in DPsim: a series voltage source and its shunt converter.
+
+weakgrid's UPQC (:mod:`weakgrid.sim.upqc`) inserts ``Vu = (Vuq + j Vup) e^{j theta_r}`` in its
+branch, at the shunt bus ``r``, and (conventional structure) draws the series real power
+``P_series = Re(Vu conj(I))`` from bus ``r`` through its shunt converter. In DPsim:
+
+* the branch becomes ``bus r — VoltageSource(Vu) — node — R — L — bus 1``; the source's set
+  point is rewritten between steps (zero-order hold over one step ``dt``) from the held inputs
+  ``Vup``, ``Vuq`` (after the rating clip ``Vmax``, :func:`weakgrid.sim.upqc.rating_clip`) and
+  the angle ``theta_r`` of bus ``r`` measured at the previous step;
+* the shunt converter is a current source at bus ``r`` drawing ``P_series`` at the measured bus
+  voltage, rewritten between steps likewise.
+
+The phasor engine applies both algebraically at every instant; here they lag by one step
+(1e-4 s by default). The reduced structure (fed from a GTI's dc link) is refused: the GTI has no
+DPsim mapping yet.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import DataError
+from ..network import BR_R, BR_X
+from ..upqc import rating_clip
+
+
+class UPQCBridge:
+    """The DPsim side of every UPQC of a system: sources to update between steps."""
+
+    def __init__(self, system, kit, cir):
+        self.kit, self.items = kit, []
+        comp = system.components.get("UPQC")
+        if comp is None or comp.n == 0:
+            return
+        if comp.reduced.any():
+            bad = [nm for nm, red in zip(comp.names, comp.reduced) if red]
+            raise DataError(f"UPQC '{bad[0]}'", "structure", "reduced",
+                            "the reduced UPQC draws from a GTI's dc link; the GTI has no DPsim "
+                            "mapping yet (refused, not substituted)")
+        net = system.network
+        w = 2 * math.pi * net.f_hz
+        off, ph = kit.d.LogLevel.off, kit.ph
+        self.w = w
+        for i, nm in enumerate(comp.names):
+            k, r, b1 = int(comp.branch[i]), int(comp.r[i]), int(comp.b1[i])
+            row = net.branch[k]
+            vb = float(net.base_kv[r]) * 1e3
+            zb = float(net.base_kv[r]) ** 2 / system.Sb
+            Vr = cir.Vpf[r]
+            mid = kit.node(f"{nm}.u", Vr)        # the source's far side (Vu = 0 at the start)
+            cir.extra_nodes.append(mid)
+            src = ph.VoltageSource(f"{nm}.Vu", off)
+            self._set_v(src, 0j, init=True, f=net.f_hz)
+            src.connect([cir.nodes[r], mid])
+            cir.components.append(src)
+            a = mid
+            if row[BR_R] > 0:
+                Is = (Vr - cir.Vpf[b1]) / (complex(row[BR_R], row[BR_X]) * zb)
+                a = kit.node(f"{nm}.R", Vr - Is * row[BR_R] * zb)
+                cir.extra_nodes.append(a)
+                res = ph.Resistor(f"{nm}.Ru", off)
+                res.set_parameters(kit.param(row[BR_R] * zb))
+                res.connect([mid, a])
+                cir.components.append(res)
+            ind = ph.Inductor(f"{nm}.Lu", off)
+            ind.set_parameters(kit.param(row[BR_X] * zb / w))
+            ind.connect([a, cir.nodes[b1]])
+            cir.components.append(ind)
+            sh = ph.CurrentSource(f"{nm}.shunt", off)
+            self._set_i(sh, 0j, init=True, f=net.f_hz)
+            # injection into bus r: DPsim 1.4's DP current source drives I_ref from its terminal 1
+            # into terminal 2, its EMT one the other way (both checked by the SMIB test against
+            # the phasor engine: the wrong way round the run diverges)
+            sh.connect([cir.nodes[r], kit.gnd] if kit.three_phase else [kit.gnd, cir.nodes[r]])
+            cir.components.append(sh)
+            # the branch current is read from the series inductor (DPsim 1.4 does not update a
+            # VoltageSource's i_intf in these runs: it stays 0)
+            self.items.append(dict(name=nm, i=i, branch=k, r=r, src=src, sh=sh, ind=ind, mid=mid, vb=vb,
+                                   ib=system.Sb * 1e6 / vb, Vmax=float(comp.p["Vmax"][i])))
+        self.comp = comp
+        cir.upqc_branches = {it["branch"] for it in self.items}
+
+    # phasor → DPsim set point (EMT: three rotating phasors, same scale as the node voltages)
+    def _abc(self, X):
+        a = np.exp(-2j * np.pi / 3)
+        return np.array([[X], [X * a], [X * a * a]], dtype=complex)
+
+    def _set_v(self, src, V, init=False, f=None):
+        if self.kit.three_phase:
+            if init:
+                src.set_parameters(V_ref=self._abc(V), f_src=f)
+            else:
+                src.attr("V_ref").set(self._abc(V))
+        elif init:
+            src.set_parameters(V_ref=complex(V))
+        else:
+            src.attr("V_ref").set(complex(V))
+
+    def _set_i(self, src, current, init=False, f=None):
+        """``current`` [A, line-to-line RMS scale, ``S = V conj(I)``]. DPsim 1.4's EMT current
+        source takes the line current's RMS phasor (peak ``sqrt(2) |I_ref|``, measured), a third
+        of the scale's square: ``I_ref = current / sqrt(3)``; its DP one takes the scale as is."""
+        if self.kit.three_phase:
+            current = current / math.sqrt(3)
+            if init:
+                src.set_parameters(I_ref=self._abc(current), f_src=f)
+            else:
+                src.attr("I_ref").set(self._abc(current))
+        elif init:
+            src.set_parameters(I_ref=complex(current))
+        else:
+            src.attr("I_ref").set(complex(current))
+
+    def update(self, t, phasor_of, current_of):
+        """Rewrite every UPQC's set points from its held inputs and the measured phasors.
+
+        ``phasor_of(b)``: bus ``b``'s voltage [pu phasor]; ``current_of(element)``: the current
+        [A phasor, line-to-line RMS scale] from terminal 1 to terminal 2 inside a DPsim element
+        (here the branch's series inductor: from bus r towards bus 1).
+        """
+        out = []
+        for it in self.items:
+            i = it["i"]
+            u = rating_clip(np.array([self.comp.u_p[i], self.comp.u_q[i]]), it["Vmax"])
+            Vr = phasor_of(it["r"])
+            ur = Vr / abs(Vr) if abs(Vr) > 1e-9 else 1.0
+            Vu = complex(u[1], u[0]) * ur                       # pu
+            self._set_v(it["src"], Vu * it["vb"])
+            I = current_of(it["ind"]) / it["ib"]                # pu on Sb, bus r -> bus 1
+            P = (Vu * np.conj(I)).real
+            Vr_safe = Vr if abs(Vr) > 1e-6 else 1e-6
+            Ish = -(P / np.conj(Vr_safe))                       # injected into bus r [pu]
+            self._set_i(it["sh"], Ish * it["ib"])
+            out.append((it["name"], u[0], u[1], abs(Vu), P))
+        return out
