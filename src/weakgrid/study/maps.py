@@ -23,8 +23,8 @@ VERDICT_MARKS = {"holds": "✓", "not": "✗", "tie": "=", "failed": "!", None: 
 #: corner marker of a cell whose UPQC power exceeded its rating ("rating") or the line's
 #: power ("line"), and its legend
 DEVICE_MARK = {"rating": "S>", "line": "S>L", "rating+line": "S>L"}
-DEVICE_LEGEND = ("S> device power above its rating, S>L above its rating or the line's "
-                 "power (corner)")
+DEVICE_LEGEND = ("corner S>: the UPQC's peak device power above its rating (s_rating), "
+                 "S>L: above the line's power")
 
 
 def _fmt(v):
