@@ -150,6 +150,8 @@ class UPQC(Component):
         self._any_conv = bool(self._conv.any())
         self._any_red = bool(self.reduced.any())
         self._uniq = len(set(self.r.tolist()) | set(self.b1.tolist())) == 2 * n
+        self._all_conv = bool(self._conv.all())
+        self._any_chi = bool((self.p["chi"] > 0).any())
         self._imax = np.where(self.p["Imax"] > 0, self.p["Imax"], np.inf)
         self._uniq_g = len(set(self.gti_i[self.reduced].tolist())) == int(self.reduced.sum())
 
@@ -190,48 +192,60 @@ class UPQC(Component):
         Vu = (self.u_q + 1j * self.u_p) * ur
         mag = np.abs(Vu)
         Vmax = p["Vmax"]
+        conv = self._conv
         if self._any_conv:   # the series voltage the dc link can carry: Vmax at Vdc >= Vdc0
             Vdc = ctx.x[..., self.sl(0)]
-            Vmax = np.where(self._conv, Vmax * np.clip(Vdc / p["Vdc0"], 0.0, 1.0), Vmax)
+            low = Vdc < p["Vdc0"]
+            if low.any():
+                Vmax = np.where(conv & low, Vmax * np.maximum(Vdc, 0.0) / p["Vdc0"], Vmax)
         if (mag > Vmax).any():
             Vu = Vu * np.where(mag > Vmax, Vmax / np.where(mag > 0, mag, 1.0), 1.0)
+            mag = np.abs(Vu)
         if not on.all():
             Vu = np.where(on, Vu, 0.0)
+            mag = np.abs(Vu)
         Isrc = self.yu * Vu
         scatter_add(ctx.I, self.b1, Isrc, self._uniq)
         scatter_add(ctx.I, self.r, -Isrc, self._uniq)
         I = self.yu * (Vr + Vu - V1) * on
         S = Vu * np.conj(I)
         P = S.real
-        Pdc = series_dc_power(P, p["chi"])
-        conv = self._conv
-        zero = np.zeros_like(P)
-        Ish, Psh, Ploss, lim, dVdc, dxi = zero, zero, zero, zero, zero, zero
+        Pdc = P + p["chi"] * np.abs(P) if self._any_chi else P     # series_dc_power
+        o = ctx.out
         if self._any_conv:
-            x = ctx.x
             err = p["Vdc0"] - Vdc
-            Pref = Pdc + p["kp_dc"] * err + x[..., self.sl(1)]
-            Id = Pref / vr_safe
-            Imax = self._imax
-            Ish = np.where(conv, np.clip(Id, -Imax, Imax), 0.0)
-            lim = (conv & (np.abs(Id) > Imax)).astype(float)
-            scatter_add(ctx.I, self.r[conv], -(Ish * ur)[..., conv], self._uniq)
-            Psh = Ish * vr_abs
-            Ploss = p["Rsh"] * Ish ** 2
-            Vdcs = np.maximum(Vdc, 1e-6)
-            dVdc = np.where(conv, (Psh - Ploss - Pdc) / (p["Cdc"] * Vdcs), 0.0)
-            dxi = np.where(conv & (lim == 0), p["ki_dc"] * err, 0.0)
-        self._f = (dVdc, dxi)
+            Id = (Pdc + p["kp_dc"] * err + ctx.x[..., self.sl(1)]) / vr_safe
+            over = np.abs(Id) > self._imax
+            if over.any():
+                Id = np.clip(Id, -self._imax, self._imax)
+            if not self._all_conv:
+                Id = np.where(conv, Id, 0.0)
+                over = over & conv
+            scatter_add(ctx.I, self.r[conv], -(Id * ur)[..., conv], self._uniq)
+            Psh = Id * vr_abs
+            Ploss = p["Rsh"] * Id ** 2
+            Vdcs = Vdc if (Vdc > 1e-6).all() else np.maximum(Vdc, 1e-6)
+            dVdc = (Psh - Ploss - Pdc) / (p["Cdc"] * Vdcs)
+            dxi = np.where(over, 0.0, p["ki_dc"] * err)
+            if not self._all_conv:
+                dVdc = np.where(conv, dVdc, 0.0)
+                dxi = np.where(conv, dxi, 0.0)
+            self._f = (dVdc, dxi)
+            o["UPQC.P_shunt"], o["UPQC.S_shunt"] = Psh, np.abs(Psh)
+            o["UPQC.I_shunt"], o["UPQC.P_loss"], o["UPQC.limited"] = Id, Ploss, over * 1.0
+        else:
+            zero = np.zeros_like(P)
+            self._f = (zero, zero)
+            o["UPQC.P_shunt"] = o["UPQC.S_shunt"] = o["UPQC.I_shunt"] = zero
+            o["UPQC.P_loss"] = o["UPQC.limited"] = zero
         if self._any_red:
             red = self.reduced
             scatter_add(ctx.sig["gti_p_series"], self.gti_i[red], Pdc[..., red], self._uniq_g)
         rot = Vu * np.conj(ur)
-        o = ctx.out
-        o["UPQC.Vuq"], o["UPQC.Vup"], o["UPQC.Vu"] = rot.real, rot.imag, np.abs(Vu)
-        o["UPQC.I"], o["UPQC.P_series"], o["UPQC.Q_series"] = np.abs(I), P, S.imag
-        o["UPQC.S_series"], o["UPQC.P_dc"] = np.abs(Vu) * np.abs(I), Pdc
-        o["UPQC.P_shunt"], o["UPQC.S_shunt"] = Psh, np.abs(Psh)
-        o["UPQC.I_shunt"], o["UPQC.P_loss"], o["UPQC.limited"] = Ish, Ploss, lim
+        Iabs = np.abs(I)
+        o["UPQC.Vuq"], o["UPQC.Vup"], o["UPQC.Vu"] = rot.real, rot.imag, mag
+        o["UPQC.I"], o["UPQC.P_series"], o["UPQC.Q_series"] = Iabs, P, S.imag
+        o["UPQC.S_series"], o["UPQC.P_dc"] = mag * Iabs, Pdc
         o["UPQC.P_line"] = ((Vr + Vu) * np.conj(I)).real
 
     def finish(self, ctx):
