@@ -210,7 +210,7 @@ class UPQC(Component):
         I = self.yu * (Vr + Vu - V1) * on
         S = Vu * np.conj(I)
         P = S.real
-        Pdc = P + p["chi"] * np.abs(P) if self._any_chi else P     # series_dc_power
+        Pdc = series_dc_power(P, p["chi"]) if self._any_chi else P
         o = ctx.out
         if self._any_conv:
             err = p["Vdc0"] - Vdc
