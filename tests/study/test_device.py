@@ -9,7 +9,7 @@ import pytest
 
 from weakgrid.game.errors import ParameterError
 from weakgrid.study.build import build_setup
-from weakgrid.study.device import power_metrics, upqc_params
+from weakgrid.study.device import power_metrics, s_rating_mva, upqc_params
 from weakgrid.study.maps import DEVICE_MARK, plot_map
 from weakgrid.study.studyfile import read_study_dict, set_path, study_from_dict
 from weakgrid.study.sweep_maps import device_power_flags
@@ -47,6 +47,9 @@ def test_device_parameters_from_the_study():
     assert upqc_params(d, "reduced", 100.0)["chi"] == 0.05
     del d["upqc"]["s_rating"]                                 # no rating: no limit
     assert upqc_params(d, "conventional", 100.0)["Imax"] == 0.0
+    # an inserted UPQC's converter rating is its default
+    assert s_rating_mva({"insert": {"sn_mva": 40.0}}) == 40.0
+    assert s_rating_mva({"s_rating": 30.0, "insert": {"sn_mva": 40.0}}) == 30.0
 
 
 def test_built_setup_carries_the_device():
