@@ -35,8 +35,9 @@ def gti_upqc_sg_case(p_gti=50.0):
     return {"baseMVA": 100.0, "bus": bus, "gen": gen, "branch": branch}
 
 
-def build_gti_upqc_sg(structure="conventional", mode="energy", p_gti=50.0):
-    """System with a GTI + UPQC + an SG (GENROU + SEXS + HYGOV + IEEEST); set up."""
+def build_gti_upqc_sg(structure="conventional", mode="energy", p_gti=50.0, upqc=None):
+    """System with a GTI + UPQC + an SG (GENROU + SEXS + HYGOV + IEEEST); set up.
+    ``upqc``: further UPQC parameters (chi, Cdc, Imax, Rsh, ...)."""
     from weakgrid.sim.gti import GTI
     from weakgrid.sim.system import System
     from weakgrid.sim.upqc import UPQC
@@ -54,7 +55,8 @@ def build_gti_upqc_sg(structure="conventional", mode="energy", p_gti=50.0):
     gti = s.add_component(GTI())
     gti.add_gti("PV", gen=0, ref_bus=2, mode=mode, C=0.05, Vc0=1.0, chi=0.02, B=20.0, ks_max=1.5, tau=2.0)
     up = s.add_component(UPQC())
-    up.add_upqc("U", branch=0, structure=structure, gti="PV" if structure == "reduced" else None, Vmax=0.2)
+    up.add_upqc("U", branch=0, structure=structure, gti="PV" if structure == "reduced" else None, Vmax=0.2,
+                **(upqc or {}))
     s.setup()
     return s
 

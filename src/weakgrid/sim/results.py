@@ -199,7 +199,7 @@ class _Recorder:
         fac = []
         bus_kv = {f"bus{bid}": net.base_kv[i] for i, bid in enumerate(net.bus_ids)}
         for n, k in zip(names, kinds):
-            if k == "power":
+            if k in ("power", "apparent"):
                 fac.append(sys.Sb)
             elif k == "angle":
                 fac.append(180 / math.pi)

@@ -21,7 +21,7 @@ One Parquet table, one row per recorded instant:
 Metadata
 --------
 * per field (Parquet field metadata, bytes): ``unit`` (the per-unit label, e.g.
-  ``"pu (Sb)"``), ``kind`` (``power``, ``voltage``, ``speed``, ``angle``,
+  ``"pu (Sb)"``), ``kind`` (``power``, ``apparent`` (power, SI MVA), ``voltage``, ``speed``, ``angle``,
   ``current``, ``energy``, ``pu``, ``time``), ``si_unit`` (``"MW"``), ``si_factor``
   (SI value = pu value × factor) and ``base`` (the per-unit base in words:
   ``"Sb = 100 MVA"``, ``"bus base 230 kV"``, ``"f = 60 Hz"``);
@@ -51,7 +51,8 @@ META_KEY = b"weakgrid.run"
 SAMPLE_PREFIX = "sample."
 
 # unit kind -> (pu label, SI label); the single table (results.py imports it)
-UNIT_LABELS = {"pu": ("pu", "pu"), "power": ("pu (Sb)", "MW"), "voltage": ("pu", "kV"),
+UNIT_LABELS = {"pu": ("pu", "pu"), "power": ("pu (Sb)", "MW"), "apparent": ("pu (Sb)", "MVA"),
+               "voltage": ("pu", "kV"),
                "angle": ("rad", "deg"), "speed": ("pu", "rad/s"),
                "current": ("pu (Sb)", "kA"), "time": ("s", "s"), "energy": ("pu·s", "MJ")}
 
@@ -59,7 +60,7 @@ UNIT_LABELS = {"pu": ("pu", "pu"), "power": ("pu (Sb)", "MW"), "voltage": ("pu",
 def base_text(kind: str, si_factor: float) -> str:
     """The per-unit base of a signal of unit ``kind`` whose SI factor is ``si_factor``."""
     f = float(si_factor)
-    if kind == "power":
+    if kind in ("power", "apparent"):
         return f"Sb = {f:g} MVA"
     if kind == "energy":
         return f"Sb = {f:g} MVA (1 pu·s = {f:g} MJ)"

@@ -1,21 +1,40 @@
-"""UPQC series branch: an ideal series voltage source inside a network branch.
+"""UPQC: a series voltage source inside a network branch and (conventional structure) a shunt
+converter with a dc link.
 
 The UPQC sits in branch ``branch`` of the case (from-bus = shunt bus ``r``,
 to-bus = bus 1, series impedance ``Zu = R + jX`` of that branch = the series
-transformer leakage). The network keeps the branch impedance; the source adds::
+transformer leakage). The network keeps the branch impedance; the series converter adds::
 
     Vu = (Vuq + j*Vup) * exp(j*theta_r),   |Vu| <= Vmax  (scaled down on the limit)
     I  = (Vr + Vu - V1)/Zu                   branch current r -> 1
     injections: +Vu/Zu at bus 1, -Vu/Zu at bus r           (Norton equivalent of Vu)
-    P_series = Re(Vu * conj(I)),  Q_series = Im(Vu * conj(I))
+    P_series = Re(Vu * conj(I)),  Q_series = Im(Vu * conj(I)),  S_series = |Vu|*|I|
 
 ``Vuq`` is in phase with the shunt-bus voltage, ``Vup`` in quadrature (the
-paper's u = [u1, u2] = [Vup, Vuq]). Where the series real power comes from:
+paper's u = [u1, u2] = [Vup, Vuq]). The series converter's losses follow the paper's (15):
+the power it draws from its dc side is ``(1 + chi)*P_series`` while it delivers power
+(``P_series >= 0``); a loss is never a source, so while it absorbs power it returns
+``(1 - chi)*|P_series|`` (together: ``P_dc = P_series + chi*|P_series|``).
 
-* ``structure="conventional"``: drawn from bus r by the shunt converter
-  (a constant-power injection ``-P_series`` at bus r);
+Where the series converter's dc power ``P_dc`` comes from:
+
+* ``structure="conventional"``: the shunt converter at bus r and the dc-link capacitor
+  between the two converters (states ``Vdc``, ``xi_dc``)::
+
+      Cdc*Vdc*dVdc/dt = P_shunt - P_loss - P_dc           (energy Cdc*Vdc^2/2, pu·s on Sb)
+      P_ref   = P_dc + kp_dc*(Vdc0 - Vdc) + xi_dc           (feed-forward + dc-voltage PI)
+      d(xi_dc)/dt = ki_dc*(Vdc0 - Vdc)                       (held while the current limit binds)
+      I_shunt = clip(P_ref/|Vr|, -Imax, Imax)                 (active current, in phase with Vr)
+      P_shunt = I_shunt*|Vr|,  P_loss = Rsh*I_shunt^2,  S_shunt = |I_shunt|*|Vr|
+
+  The shunt converter draws ``I_shunt*Vr/|Vr|`` from bus r (no reactive current). The series
+  voltage the link can carry shrinks with it: ``|Vu| <= Vmax*min(1, Vdc/Vdc0)`` (the
+  converter's modulation limit), so a link drained while the current limit binds lowers
+  ``|Vu|`` and with it the series power, rather than running below zero. With
+  ``chi = Rsh = 0`` and the limit not reached, ``P_shunt = P_series`` at every instant and the
+  dc link stays at ``Vdc0``: the lossless constant-power draw of the ideal model.
 * ``structure="reduced"``: drawn from the dc link of GTI ``gti``, entering its
-  balance ``C*Vc*dVc/dt = Pin - Pe - P_series``.
+  balance ``C*Vc*dVc/dt = Pin - Pe - P_dc`` (the UPQC's own dc-link states stay constant).
 
 The inputs ``Vup``, ``Vuq`` [pu] are held values set by a digital controller
 (:mod:`weakgrid.sim.controllers`) or directly via :meth:`set_input`.
@@ -43,15 +62,40 @@ def rating_clip(u, Vmax):
     return u * np.minimum(1.0, Vmax / np.where(mag > 0, mag, 1.0))[..., None]
 
 
+def series_dc_power(P, chi):
+    """The series converter's dc-side power [pu on Sb] for its ac power ``P`` (to the line):
+    ``P + chi*|P|`` — the paper's ``(1 + chi)*P`` while it delivers power (15), and a loss
+    (never a gain) while it absorbs power."""
+    return P + chi * np.abs(P)
+
+
 class UPQC(Component):
-    """Vectorized UPQC series branches; add instances with :meth:`add_upqc`."""
+    """Vectorized UPQCs (series converter, and the shunt converter with its dc link in the
+    conventional structure); add instances with :meth:`add_upqc`."""
 
     kind = "device"
     order = 3
-    params = (Param("Vmax", 0.2, "pu", "series voltage rating |Vu|max", "pos"),)
-    states = ()
-    outputs = ("Vup", "Vuq", "Vu", "I", "P_series", "Q_series", "P_shunt", "P_line")
-    units = {"P_series": "power", "Q_series": "power", "P_shunt": "power", "P_line": "power", "I": "current"}
+    params = (
+        Param("Vmax", 0.2, "pu", "series voltage rating |Vu|max", "pos"),
+        Param("chi", 0.0, "pu", "series-converter loss factor chi of (15): P_dc = (1+chi)*P_series "
+              "while delivering power", "nonneg"),
+        Param("Cdc", 0.01, "pu·s (Sb)", "dc-link capacitance (energy Cdc*Vdc^2/2 in pu·s; "
+              "conventional structure)", "pos"),
+        Param("Vdc0", 1.0, "pu", "dc-link voltage set-point", "pos"),
+        Param("kp_dc", 1.0, "pu/pu", "dc-voltage loop proportional gain (shunt P_ref per pu of "
+              "Vdc0 - Vdc)", "nonneg"),
+        Param("ki_dc", 10.0, "pu/(pu·s)", "dc-voltage loop integral gain", "nonneg"),
+        Param("Imax", 0.0, "pu (Sb)", "shunt-converter current limit (active current "
+              "magnitude; 0: no limit)", "nonneg"),
+        Param("Rsh", 0.0, "pu (Sb)", "shunt-converter loss resistance: P_loss = Rsh*I_shunt^2",
+              "nonneg"),
+    )
+    states = ("Vdc", "xi_dc")
+    outputs = ("Vup", "Vuq", "Vu", "I", "P_series", "Q_series", "S_series", "P_dc", "P_shunt",
+               "S_shunt", "I_shunt", "P_loss", "P_line", "limited")
+    units = {"P_series": "power", "Q_series": "power", "S_series": "apparent", "P_dc": "power",
+             "P_shunt": "power", "S_shunt": "apparent", "P_loss": "power", "P_line": "power",
+             "I": "current", "I_shunt": "current", "Vdc": "pu", "xi_dc": "power"}
 
     def add_upqc(self, name, branch, structure="conventional", gti=None, **params):
         """Add a UPQC in 0-based branch row ``branch`` (from-bus = shunt bus r).
@@ -61,6 +105,8 @@ class UPQC(Component):
         structure : {"conventional", "reduced"}
         gti : str, optional
             Name of the GTI whose dc link feeds the series converter (reduced structure).
+        **params
+            Values of :attr:`params` (system base).
         """
         el = f"UPQC '{name}'"
         if structure not in ("conventional", "reduced"):
@@ -104,6 +150,9 @@ class UPQC(Component):
         self._any_conv = bool(self._conv.any())
         self._any_red = bool(self.reduced.any())
         self._uniq = len(set(self.r.tolist()) | set(self.b1.tolist())) == 2 * n
+        self._all_conv = bool(self._conv.all())
+        self._any_chi = bool((self.p["chi"] > 0).any())
+        self._imax = np.where(self.p["Imax"] > 0, self.p["Imax"], np.inf)
         self._uniq_g = len(set(self.gti_i[self.reduced].tolist())) == int(self.reduced.sum())
 
     def set_input(self, name, Vup, Vuq):
@@ -112,11 +161,16 @@ class UPQC(Component):
         self.u_p[i] = Vup
         self.u_q[i] = Vuq
 
+    def init(self, system, x, sig):
+        x[self.sl(0)] = self.p["Vdc0"]
+        x[self.sl(1)] = 0.0
+
     def pattern(self, system):
         groups = []
         gti = system.components.get("GTI")
         for i in range(self.n):
-            cols = system.bus_vars(self.r[i]) + system.bus_vars(self.b1[i])
+            own = self.instance_states(i)
+            cols = system.bus_vars(self.r[i]) + system.bus_vars(self.b1[i]) + own
             rows = list(cols)
             if self.reduced[i]:
                 rows.append(gti.idx("Vc")[self.gti_i[i]])
@@ -125,37 +179,76 @@ class UPQC(Component):
 
     def compute(self, ctx):
         on = ctx.system.branch_status[self.branch]
+        p = self.p
         Vr = ctx.V[..., self.r]
         V1 = ctx.V[..., self.b1]
         vr_abs = np.abs(Vr)
         if (vr_abs > 1e-6).all():      # fast path (same values as the guarded expressions)
             ur = Vr / vr_abs
-            Vr_safe = Vr
+            vr_safe = vr_abs
         else:
             ur = np.where(vr_abs > 1e-9, Vr / np.where(vr_abs > 1e-9, vr_abs, 1.0), 1.0)
-            Vr_safe = np.where(vr_abs > 1e-6, Vr, 1e-6)
+            vr_safe = np.maximum(vr_abs, 1e-6)
         Vu = (self.u_q + 1j * self.u_p) * ur
         mag = np.abs(Vu)
-        Vmax = self.p["Vmax"]
+        Vmax = p["Vmax"]
+        conv = self._conv
+        if self._any_conv:   # the series voltage the dc link can carry: Vmax at Vdc >= Vdc0
+            Vdc = ctx.x[..., self.sl(0)]
+            low = Vdc < p["Vdc0"]
+            if low.any():
+                Vmax = np.where(conv & low, Vmax * np.maximum(Vdc, 0.0) / p["Vdc0"], Vmax)
         if (mag > Vmax).any():
             Vu = Vu * np.where(mag > Vmax, Vmax / np.where(mag > 0, mag, 1.0), 1.0)
+            mag = np.abs(Vu)
         if not on.all():
             Vu = np.where(on, Vu, 0.0)
+            mag = np.abs(Vu)
         Isrc = self.yu * Vu
         scatter_add(ctx.I, self.b1, Isrc, self._uniq)
         scatter_add(ctx.I, self.r, -Isrc, self._uniq)
         I = self.yu * (Vr + Vu - V1) * on
         S = Vu * np.conj(I)
         P = S.real
-        conv = self._conv
+        Pdc = series_dc_power(P, p["chi"]) if self._any_chi else P
+        o = ctx.out
         if self._any_conv:
-            scatter_add(ctx.I, self.r[conv], -(P[..., conv] / np.conj(Vr_safe[..., conv])), self._uniq)
+            err = p["Vdc0"] - Vdc
+            Id = (Pdc + p["kp_dc"] * err + ctx.x[..., self.sl(1)]) / vr_safe
+            over = np.abs(Id) > self._imax
+            if over.any():
+                Id = np.clip(Id, -self._imax, self._imax)
+            if not self._all_conv:
+                Id = np.where(conv, Id, 0.0)
+                over = over & conv
+            scatter_add(ctx.I, self.r[conv], -(Id * ur)[..., conv], self._uniq)
+            Psh = Id * vr_abs
+            Ploss = p["Rsh"] * Id ** 2
+            Vdcs = Vdc if (Vdc > 1e-6).all() else np.maximum(Vdc, 1e-6)
+            dVdc = (Psh - Ploss - Pdc) / (p["Cdc"] * Vdcs)
+            dxi = np.where(over, 0.0, p["ki_dc"] * err)
+            if not self._all_conv:
+                dVdc = np.where(conv, dVdc, 0.0)
+                dxi = np.where(conv, dxi, 0.0)
+            self._f = (dVdc, dxi)
+            o["UPQC.P_shunt"], o["UPQC.S_shunt"] = Psh, np.abs(Psh)
+            o["UPQC.I_shunt"], o["UPQC.P_loss"], o["UPQC.limited"] = Id, Ploss, over * 1.0
+        else:
+            zero = np.zeros_like(P)
+            self._f = (zero, zero)
+            o["UPQC.P_shunt"] = o["UPQC.S_shunt"] = o["UPQC.I_shunt"] = zero
+            o["UPQC.P_loss"] = o["UPQC.limited"] = zero
         if self._any_red:
             red = self.reduced
-            scatter_add(ctx.sig["gti_p_series"], self.gti_i[red], P[..., red], self._uniq_g)
+            scatter_add(ctx.sig["gti_p_series"], self.gti_i[red], Pdc[..., red], self._uniq_g)
         rot = Vu * np.conj(ur)
-        o = ctx.out
-        o["UPQC.Vuq"], o["UPQC.Vup"], o["UPQC.Vu"] = rot.real, rot.imag, np.abs(Vu)
-        o["UPQC.I"], o["UPQC.P_series"], o["UPQC.Q_series"] = np.abs(I), P, S.imag
-        o["UPQC.P_shunt"] = np.where(conv, P, 0.0)
+        Iabs = np.abs(I)
+        o["UPQC.Vuq"], o["UPQC.Vup"], o["UPQC.Vu"] = rot.real, rot.imag, mag
+        o["UPQC.I"], o["UPQC.P_series"], o["UPQC.Q_series"] = Iabs, P, S.imag
+        o["UPQC.S_series"], o["UPQC.P_dc"] = mag * Iabs, Pdc
         o["UPQC.P_line"] = ((Vr + Vu) * np.conj(I)).real
+
+    def finish(self, ctx):
+        dVdc, dxi = self._f
+        ctx.f[..., self.sl(0)] = dVdc
+        ctx.f[..., self.sl(1)] = dxi

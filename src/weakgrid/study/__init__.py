@@ -7,6 +7,7 @@ module             what
 =================  ===========================================================================
 ``studyfile``      reading and validating study files; dotted paths (``upqc.rating``)
 ``build``          the study's grid for the simulator at a load level / UPQC structure
+``device``         the UPQC as a device: its power rating, losses, dc link; its power metrics
 ``controllers``    the controller registry (kind → builder), HJI training on the design model
 ``runner``         one (scenario, controller) run and its metrics
 ``engine``         every run of one or more studies, the mode check, files and report

@@ -63,6 +63,7 @@ from ..sim.gti import GTI
 from ..sim.network import BR_R, BR_X, F_BUS, GEN_BUS, T_BUS, Network
 from ..sim.system import System
 from ..sim.upqc import UPQC
+from .device import s_rating_mva, upqc_params
 
 __all__ = ["Setup", "build_setup", "baseline_machine", "VARIANTS"]
 
@@ -106,6 +107,10 @@ class Setup:
     branch_names: dict = field(default_factory=dict)
     measure_signals: object = None
     state_map: object = None
+    #: the UPQC converters' rating [MVA] (None: not given) and the line's apparent power
+    #: |V_r|·|I_line| at the operating point [MVA] (:mod:`weakgrid.study.device`)
+    s_rating_mva: float | None = None
+    line_mva: float = float("nan")
 
     def bus(self, ref, where="bus") -> int:
         """Simulator bus number of a bus reference (the source's number or name; a pandapower
@@ -768,7 +773,8 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
                                  "controlled machine is an SG: use 'conventional'")
         u = s.add_component(UPQC())
         u.add_upqc(up["name"], branch=k_up, structure=upqc,
-                   gti=ctl_name if upqc == "reduced" else None, Vmax=up["rating"])
+                   gti=ctl_name if upqc == "reduced" else None,
+                   **upqc_params(d, upqc, float(net.Sb)))
         upqc_name = up["name"]
     with _data_warnings_once():
         s.setup()
@@ -779,6 +785,7 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
     yu = 1.0 / complex(net.branch[k_up, BR_R], net.branch[k_up, BR_X])
     I = yu * (net.pf.V[r] - net.pf.V[b1])
     p_line = abs(float((net.pf.V[r] * np.conj(I)).real)) * net.Sb
+    s_line = float(abs(net.pf.V[r]) * abs(I)) * float(net.Sb)
     if upqc_name:
         _plausible_rating(up, load, abs(net.pf.V[r]), abs(I), float(net.Sb))
     if der.machine == "gti":
@@ -800,9 +807,14 @@ def build_setup(study, load: str | None = None, upqc: str | None = None,
     if upqc_name:
         signals.update(vup=f"{upqc_name}.Vup", vuq=f"{upqc_name}.Vuq",
                        p_series=f"{upqc_name}.P_series", q_series=f"{upqc_name}.Q_series",
-                       p_line=f"{upqc_name}.P_line", vu=f"{upqc_name}.Vu")
+                       p_line=f"{upqc_name}.P_line", vu=f"{upqc_name}.Vu",
+                       s_series=f"{upqc_name}.S_series")
+        if upqc == "conventional":
+            signals.update(s_shunt=f"{upqc_name}.S_shunt", upqc_vdc=f"{upqc_name}.Vdc",
+                           shunt_limited=f"{upqc_name}.limited")
     return Setup(study=study, load=load, upqc=upqc, variant=variant, system=s,
                  machine=der.machine, source=ctl_name, upqc_name=upqc_name, shunt_bus=r_id,
                  upqc_branch=k_up, measure=measure, design=der.model, derivation=der,
                  line_power_mw=p_line, signals=signals, Sb_mva=float(net.Sb), bus_id=bus_id,
-                 branch_names=br_names, measure_signals=measure_signals, state_map=state_map)
+                 branch_names=br_names, measure_signals=measure_signals, state_map=state_map,
+                 s_rating_mva=s_rating_mva(up) if upqc_name else None, line_mva=s_line)

@@ -5,7 +5,8 @@ one panel per value of a facet field (e.g. the load level), the two swept fields
 on the axes as evenly spaced categories (their values as tick labels), each
 cell coloured by the quantity and labelled with its value, and with the claim's
 verdict in that cell as a mark: ``✓`` holds, ``✗`` does not, ``=`` tie within the
-numerical uncertainty, ``!`` a run failed. A cell without a value shows ``–`` and, instead
+numerical uncertainty, ``!`` a run failed. A cell whose device power went beyond the UPQC's
+rating or the line's power carries a marker in its corner (:data:`DEVICE_MARK`). A cell without a value shows ``–`` and, instead
 of a verdict, why (a ``note``: a run failed, no settling, …). The setting the paper (or the
 shipped study) uses is outlined.
 """
@@ -16,9 +17,14 @@ import math
 
 import numpy as np
 
-__all__ = ["plot_map", "VERDICT_MARKS"]
+__all__ = ["plot_map", "VERDICT_MARKS", "DEVICE_MARK"]
 
 VERDICT_MARKS = {"holds": "✓", "not": "✗", "tie": "=", "failed": "!", None: ""}
+#: corner marker of a cell whose UPQC power exceeded its rating ("rating") or the line's
+#: power ("line"), and its legend
+DEVICE_MARK = {"rating": "S>", "line": "S>L", "rating+line": "S>L"}
+DEVICE_LEGEND = ("corner S>: the UPQC's peak device power above its rating (s_rating), "
+                 "S>L: above the line's power")
 
 
 def _fmt(v):
@@ -33,7 +39,7 @@ def _fmt(v):
 def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
              note: str | None = None, facet: str | None = None, mark=None, title: str = "", value_label: str = "",
              x_label: str = "", y_label: str = "", cmap: str = "RdBu_r", center=None,
-             mark_label: str = "the paper's setting", path=None):
+             mark_label: str = "the paper's setting", path=None, device: str | None = None):
     """Draw (and optionally save) a map of ``value`` over fields ``x`` and ``y``.
 
     Parameters
@@ -60,6 +66,10 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
         difference); default: no centring.
     path : str or Path, optional
         Where to save the figure (PNG or SVG, atomically).
+    device : str, optional
+        Column of ``"rating"``, ``"line"``, ``"rating+line"`` or ``""`` per cell: where the
+        UPQC's peak power exceeded its rating or the line's power, a corner marker
+        (:data:`DEVICE_MARK`).
 
     Returns
     -------
@@ -85,11 +95,13 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
                                                      1.4 + 0.55 * len(ys)),
                            squeeze=False, layout="constrained")
     im = None
+    any_device = [False]
     for ax, fv in zip(axes[0], facets):
         sub = table if fv is None else table[table[facet] == fv]
         Z = np.full((len(ys), len(xs)), np.nan)
         V = [["" for _ in xs] for _ in ys]
         N = [["" for _ in xs] for _ in ys]
+        D = {}
         for (xv, yv), grp in sub.groupby([x, y], sort=False):
             i, j = ys.index(yv), xs.index(xv)
             Z[i, j] = float(np.nanmean(grp[value].astype(float))) if \
@@ -99,6 +111,8 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
                 V[i][j] = VERDICT_MARKS.get(None if v0 is None or v0 != v0 else v0, "?")
             if note is not None and note in grp and isinstance(grp[note].iloc[0], str):
                 N[i][j] = grp[note].iloc[0]
+            if device is not None and device in grp:
+                D[(i, j)] = DEVICE_MARK.get(str(grp[device].iloc[0] or ""), "")
         im = ax.pcolormesh(np.arange(len(xs) + 1) - 0.5, np.arange(len(ys) + 1) - 0.5,
                            np.ma.masked_invalid(Z), cmap=cmap, norm=norm,
                            vmin=None if norm else vmin, vmax=None if norm else vmax,
@@ -118,6 +132,12 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
                 ax.text(j, i, txt, ha="center", va="center",
                         fontsize=8 if txt.count("\n") < 2 else 6,
                         color="white" if dark else "black")
+        for (i, j), dm in D.items():
+            if dm:
+                ax.text(j + 0.45, i + 0.42, dm, ha="right", va="top", fontsize=6,
+                        color="black", bbox=dict(boxstyle="round,pad=0.1", fc="orange",
+                                                 ec="none", alpha=0.9))
+                any_device[0] = True
         if mark is not None and mark[0] in xs and mark[1] in ys:
             j, i = xs.index(mark[0]), ys.index(mark[1])
             ax.add_patch(Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, lw=2.5,
@@ -142,6 +162,8 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
         legend += ("; " if legend else "") + ("✓ holds  ✗ does not  = tie (within the "
                                               "numerical uncertainty)  ! a run failed  "
                                               "– no value (why, in the cell)")
+    if any_device[0]:
+        legend += ("; " if legend else "") + DEVICE_LEGEND
     if title or legend:
         import textwrap
 

@@ -27,6 +27,12 @@ COLUMNS = [
     ("vu_rms_pu", "|Vu| rms [pu]"), ("vu_rating_reached", "rating reached"),
     ("p_series_peak_mw", "P_series peak [MW]"),
     ("p_series_peak_pct_line", "P_series peak [% line]"),
+    ("s_series_peak_pct_rating", "S_series peak [% s_rating]"),
+    ("s_series_peak_pct_line", "S_series peak [% line]"),
+    ("s_shunt_peak_pct_rating", "S_shunt peak [% s_rating]"),
+    ("shunt_limit_reached", "shunt current limit reached"),
+    ("device_over_rating", "device power > s_rating"),
+    ("device_over_line", "device power > line"),
     ("design_load", "controllers designed at (load)"),
     ("clip_fraction", "post-fault samples clipped by the rating [–]"),
     ("u_demanded_peak_pu", "demanded |u| peak [pu]"), ("u_applied_peak_pu", "applied |u| peak [pu]"),
@@ -46,7 +52,9 @@ TOPICS = {
     "Control effort": ("control_cost", "control_cost_demanded", "running_cost_18",
                        "u_demanded_peak_pu", "u_applied_peak_pu", "clip_fraction"),
     "Device": ("vu_peak_pu", "vu_rms_pu", "vu_rating_reached", "p_series_peak_mw",
-               "p_series_peak_pct_line", "omega_reach", "extrapolation"),
+               "p_series_peak_pct_line", "s_series_peak_pct_rating", "s_series_peak_pct_line",
+               "s_shunt_peak_pct_rating", "shunt_limit_reached", "device_over_rating",
+               "device_over_line", "omega_reach", "extrapolation"),
 }
 
 # which way is better, per metric, declared once ("lower" or "higher"): the "who did best"
@@ -63,7 +71,8 @@ EFFORT = ("control_cost", "vu_peak_pu")
 # the sweep table's metrics (of those a run measures), when any run has them
 SWEEP_METRICS = ("speed_peak_dev_pu", "speed_settling_s", "speed_verdict", "vdc_peak_dev_pu",
                  "vdc_settling_s", "control_cost", "vu_peak_pu", "u_demanded_peak_pu",
-                 "clip_fraction", "omega_reach")
+                 "clip_fraction", "omega_reach", "s_series_peak_pct_rating",
+                 "device_over_rating", "device_over_line")
 
 
 def sweep_html(entry: dict) -> str:

@@ -15,6 +15,7 @@ from ..sim.network import F_BUS, T_BUS
 from ..sim.upqc import rating_clip
 from .build import build_setup
 from .controllers import controller_variant, make_controller
+from .device import power_metrics
 from .failure import failure_text
 from .metrics import backswing, control_cost, itae, running_cost, settling_time, stability_verdict
 
@@ -391,6 +392,9 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
         metrics["p_series_peak_pct_line"] = 100 * pk / abs(setup.line_power_mw) \
             if setup.line_power_mw else float("nan")
     metrics["line_power_mw"] = setup.line_power_mw
+    if setup.upqc_name:
+        metrics.update(power_metrics(series, post, setup.Sb_mva, setup.s_rating_mva,
+                                     setup.line_mva))
     metrics.update(_protocol_metrics(study, tk, uk, xk, vmax, after))
     if ctl is not None and len(tk):   # Fig. 10/13: J(x(t)) of (30), running cost with -γ²w'Pw
         J, rcw = value_along(ctl, xa, ua)

@@ -16,7 +16,9 @@ Tables (defaults in brackets)::
     [[dynamics.generator]]  name, bus, machine = {model, …}, exciter/governor/pss [none]
     [[dynamics.gti]]        name, bus, C, Vc0, chi, B, ks_max, tau, mode ["energy"]
     [machine]     name (the controlled GTI or SG)
-    [upqc]        name ["UPQC"], branch | insert, structure ["conventional"], rating [0.2]
+    [upqc]        name ["UPQC"], branch | insert, structure ["conventional"], rating [0.2],
+                  s_rating [MVA; insert.sn_mva], chi [reduced: the GTI's chi, else 0],
+                  h_dc [0.01 s], t_dc [0.02 s], r_shunt [0 pu on s_rating]
     [design]      T, settings (a preset giving Q, R, P, γ, Ω, mesh, basis, initial policy)
                   [cost], [mesh], [basis], [initial_policy], [solver] (override the preset)
     [controllers] compare [["hji", "lqr", "pss-only"]], [controllers.NAME] options
@@ -411,7 +413,8 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         raise ParameterError("machine.name", m["name"], f"no generator or GTI of that name in "
                              f"[dynamics]; choose one of {names}")
     up = _need(d, "upqc", "study file", dict)
-    _keys(up, {"name", "branch", "side", "insert", "structure", "rating"}, "upqc")
+    _keys(up, {"name", "branch", "side", "insert", "structure", "rating"} | DEVICE_FIELDS,
+          "upqc")
     _choice(up, "side", "upqc", ("from", "to"), "from")
     up.setdefault("name", "UPQC")
     up["structure"] = _choice(up, "structure", "upqc", STRUCTURES, "conventional")
@@ -421,6 +424,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                              "pu (the line's nominal voltage) is more than the series "
                              "transformer and the line can carry; give the UPQC's largest "
                              "series-voltage magnitude in pu, at most 1.0 (typically 0.1-0.5)")
+    _device_fields(up)
     if ("branch" in up) == ("insert" in up):
         raise ParameterError("upqc.branch", up.get("branch"), "give either upqc.branch (an "
                              "existing series branch, from = shunt bus) or upqc.insert (a new "
@@ -546,6 +550,33 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
 
     validate_sweep(d, st)
     return st
+
+
+# the UPQC as a physical device (weakgrid.sim.upqc): power rating, losses, dc link
+DEVICE_FIELDS = {"s_rating", "chi", "h_dc", "t_dc", "r_shunt"}
+
+
+def _device_fields(up: dict) -> None:
+    """Check the ``[upqc]`` device fields (defaults are filled in by the build, which knows the
+    structure and the controlled GTI): ``s_rating`` [MVA] > 0, ``chi`` ≥ 0, ``h_dc`` [s] > 0,
+    ``t_dc`` [s] > 0, ``r_shunt`` [pu on s_rating] ≥ 0."""
+    fixes = {
+        "s_rating": ("> 0", "the converters' apparent-power rating in MVA (series and shunt "
+                     "each), e.g. the series transformer's rating"),
+        "chi": ("≥ 0", "the series converter's loss factor χ of (15), e.g. 0.02"),
+        "h_dc": ("> 0", "the dc-link energy at its set-point in seconds of s_rating, e.g. 0.01"),
+        "t_dc": ("> 0", "the dc-voltage loop's time constant in s, e.g. 0.02"),
+        "r_shunt": ("≥ 0", "the shunt converter's loss resistance in pu on s_rating, e.g. 0.01"),
+    }
+    for k, (rule, what) in fixes.items():
+        if k not in up:
+            continue
+        v = up[k]
+        ok = not isinstance(v, bool) and isinstance(v, (int, float)) and v == v \
+            and abs(v) != float("inf") and (v > 0 if rule == "> 0" else v >= 0)
+        if not ok:
+            raise ParameterError(f"upqc.{k}", v, f"must be a finite number {rule}: {what}")
+        up[k] = float(v)
 
 
 MAX_RATING = 1.0   # pu: the largest series-voltage rating a UPQC can have (the line's voltage)

@@ -218,6 +218,31 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def device_power_flags(cells: pd.DataFrame, table: pd.DataFrame, spec: dict,
+                       axes) -> pd.DataFrame:
+    """``cells`` (from :func:`map_cells`) with a column ``device_over``: ``"rating"`` where a
+    run of the cell (controller ``a`` or ``b``, full step) drew a peak converter power above
+    the UPQC's ``s_rating`` (metric ``device_over_rating``), ``"line"`` where above the line's
+    apparent power (``device_over_line``), ``"rating+line"`` for both, ``""`` otherwise (also
+    when the sweep's runs carry no such metric: a UPQC without ``s_rating``, an old table)."""
+    if cells.empty:
+        return cells.assign(device_over=pd.Series(dtype=str))
+    x, y, facet = _axes_of(spec, axes)
+    keys = [k for k in (x, y, facet) if k is not None]
+    dtf = table["dt_factor"] if "dt_factor" in table else pd.Series(1.0, index=table.index)
+    who = [c for c in (spec.get("a"), spec.get("b")) if c]
+    runs = table[(dtf == 1.0) & table["controller"].isin(who)]
+    flags = {}
+    for cell, grp in runs.groupby(keys, sort=False):
+        cell = cell if isinstance(cell, tuple) else (cell,)
+        over = [w for w, col in (("rating", "device_over_rating"), ("line", "device_over_line"))
+                if col in grp and grp[col].fillna(False).astype(bool).any()]
+        flags[cell] = "+".join(over)
+    out = cells.copy()
+    out["device_over"] = [flags.get(tuple(r[k] for k in keys), "") for _, r in out.iterrows()]
+    return out
+
+
 def _short(path):
     names = {"upqc.rating": "UPQC rating [pu]", "controller": "controller"}
     if path in names:
@@ -241,7 +266,7 @@ def draw_maps(study, table, folder, quick=False) -> list[dict]:
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     for spec in sw.get("maps", []):
-        cells = map_cells(table, spec, axes)
+        cells = device_power_flags(map_cells(table, spec, axes), table, spec, axes)
         x, y, facet = _axes_of(spec, axes)
         mark = (get_path(study.data, x), get_path(study.data, y)) if x and y else None
         path = folder / f"map-{study.name}-{spec.get('id', spec['claim'])}.png"
@@ -253,7 +278,7 @@ def draw_maps(study, table, folder, quick=False) -> list[dict]:
         fshort = facet.split(".")[-1] if facet else None
         shown = cells.rename(columns={facet: fshort}) if facet else cells
         fig = plot_map(shown, x, y, "value", verdict="verdict", note="note", facet=fshort,
-                       mark=mark,
+                       mark=mark, device="device_over",
                        title=f"{spec['claim']}: {spec.get('title', '')}",
                        value_label=spec.get("label", spec.get("metric", "")),
                        x_label=_short(x), y_label=_short(y),
