@@ -53,7 +53,7 @@ TOP = {"study", "grid", "dynamics", "machine", "upqc", "design", "controllers", 
        "report", "figures", "claims", "sweep", "simulation"}
 GRID_KINDS = ("inline", "pandapower", "matpower", "andes", "psse")
 STRUCTURES = ("conventional", "reduced")
-EVENT_KINDS = ("fault", "line_trip", "load_step")
+EVENT_KINDS = ("fault", "line_trip", "load_step", "gen_trip")
 
 
 # --------------------------------------------------------------------------- dotted paths
@@ -510,7 +510,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         evs = sc.setdefault("events", [])
         for j, ev in enumerate(evs):
             _event(ev, f"{w}.events.{j}", sc["t_end"])
-        _events_together(evs, w, up)
+        _events_together(evs, w, up, m["name"])
         # bypass: default = the fault windows, computed when used (so that it follows the
         # faults when a field is changed later), see Study.scenarios
         for j, b in enumerate(sc.get("bypass", [])):
@@ -635,9 +635,9 @@ def _file_controllers(d, study, g, machine):
                                  f"{ours.upper()}; train one for this study (`weakgrid design`)")
 
 
-def _events_together(evs, w, up):
+def _events_together(evs, w, up, machine=None):
     """Events of one scenario: no two faults at one bus at the same time, no trip of the
-    UPQC's own branch."""
+    UPQC's own branch, no trip of the controlled ``machine``."""
     faults = sorted((ev["t_on"], ev["t_off"], j, ev["bus"]) for j, ev in enumerate(evs)
                     if ev["kind"] == "fault")
     for a, (t0, t1, j, bus) in enumerate(faults):
@@ -650,6 +650,10 @@ def _events_together(evs, w, up):
     own = {v for v in (up.get("branch"), (up.get("insert") or {}).get("name"), up.get("name"))
            if isinstance(v, (str, int)) and not isinstance(v, bool)}
     for j, ev in enumerate(evs):
+        if ev["kind"] == "gen_trip" and ev["machine"] == machine:
+            raise ParameterError(f"{w}.events.{j}.machine", ev["machine"], "is the study's "
+                                 "controlled machine (machine.name): its controller would act "
+                                 "on a disconnected unit; trip another machine")
         if ev["kind"] == "line_trip" and (ev["branch"] == up.get("branch") or (
                 isinstance(ev["branch"], (str, int)) and ev["branch"] in own)):
             raise ParameterError(f"{w}.events.{j}.branch", ev["branch"], "is the UPQC's own "
@@ -680,6 +684,13 @@ def _event(ev, w, t_end):
     elif kind == "line_trip":
         _keys(ev, {"kind", "branch", "t", "close"}, w)
         _need(ev, "branch", w, (int, str, dict))
+        _num(ev, "t", w, nonneg=True)
+        if ev["t"] >= t_end:
+            raise ParameterError(f"{w}.t", ev["t"], f"after the run's end (t_end = {t_end}); "
+                                 "give t < t_end")
+    elif kind == "gen_trip":
+        _keys(ev, {"kind", "machine", "t"}, w)
+        _need(ev, "machine", w, str)
         _num(ev, "t", w, nonneg=True)
         if ev["t"] >= t_end:
             raise ParameterError(f"{w}.t", ev["t"], f"after the run's end (t_end = {t_end}); "
