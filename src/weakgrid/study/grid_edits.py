@@ -33,19 +33,16 @@ from __future__ import annotations
 import numpy as np
 
 from ..game.errors import ParameterError
+from .fields import table
 
 __all__ = ["EDITS", "FIELDS", "validate_edits", "apply_case_edits", "has_edits"]
 
 #: the edit tables, in the order they are applied
 EDITS = ("add_bus", "sgen_to_gen", "add_impedance", "add_gen")
 
-#: per edit: (required fields, optional fields)
-FIELDS = {
-    "add_bus": ({"name", "vn_kv"}, {"number"}),
-    "sgen_to_gen": ({"name"}, {"bus", "vm_pu", "scale"}),
-    "add_impedance": ({"from", "to", "r_pu", "x_pu", "sn_mva"}, {"name", "b", "tap"}),
-    "add_gen": ({"name", "bus"}, {"p_mw", "vm_pu", "sn_mva", "slack"}),
-}
+#: per edit: (required fields, optional fields), from :mod:`weakgrid.study.fields`
+FIELDS = {k: ({f.name for f in table(f"grid.{k}").fields if f.required},
+              {f.name for f in table(f"grid.{k}").fields if not f.required}) for k in EDITS}
 
 
 def has_edits(g: dict) -> bool:

@@ -44,16 +44,18 @@ from pathlib import Path
 from ..dotted import get_path as _get, set_path as _set
 from ..fileio import check_file_name, safe_name
 from ..game.errors import ParameterError
+from . import fields as F
 from .grid_edits import EDITS, validate_edits
 
 __all__ = ["Study", "load_study", "apply_overrides", "study_from_dict", "get_path", "set_path", "shipped_studies",
            "read_study_dict", "event_end", "EVENT_KINDS"]
 
-TOP = {"study", "grid", "dynamics", "machine", "upqc", "design", "controllers", "scenarios",
-       "report", "figures", "claims", "sweep", "simulation"}
-GRID_KINDS = ("inline", "pandapower", "matpower", "andes", "psse")
-STRUCTURES = ("conventional", "reduced")
-EVENT_KINDS = ("fault", "line_trip", "load_step", "gen_trip")
+# the tables, their fields and defaults: weakgrid.study.fields (the one source of the
+# validation here, the reference page and the JSON Schema)
+TOP = set(F.TOP)
+GRID_KINDS = F.GRID_KINDS
+STRUCTURES = F.STRUCTURES
+EVENT_KINDS = F.EVENT_KINDS
 
 
 # --------------------------------------------------------------------------- dotted paths
@@ -341,15 +343,15 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
     d = copy.deepcopy(d)
     _keys(d, TOP, "study file")
     st = d.setdefault("study", {})
-    _keys(st, {"name", "title", "reproduce", "notes", "description"}, "study")
+    _keys(st, F.keys("study"), "study")
     if "name" in st:
         check_file_name(st["name"], "study.name")
     st.setdefault("name", safe_name(Path(source).stem if source else "study", "study"))
-    st.setdefault("title", "")
-    st.setdefault("reproduce", False)
-    st.setdefault("notes", [])
+    for k in ("title", "reproduce", "notes"):
+        st.setdefault(k, F.default("study", k))
     g = _need(d, "grid", "study file", dict)
     _choice(g, "kind", "grid", GRID_KINDS)
+    _keys(g, F.grid_keys(g["kind"]) | set(EDITS), "grid")   # edits: validate_edits says more
     if g["kind"] == "inline":
         for k in ("bus", "branch", "gen"):
             _need(g, k, "grid", list)
@@ -369,7 +371,6 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                                  '"from_json"; else network names a function of '
                                  "pandapower.networks")
     elif g["kind"] == "psse":
-        _keys(g, {"kind", "raw", "dyr", "f_hz", *EDITS}, "grid")
         for k in ("raw", "dyr"):
             if k in g or k == "raw":
                 v = _need(g, k, "grid", str)
@@ -385,11 +386,11 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         check_file_name(level, f"grid.loads.{level}")
     validate_edits(g, _load_levels(g))
     dyn = d.setdefault("dynamics", {})
-    _keys(dyn, {"generator", "gti"}, "dynamics")
+    _keys(dyn, F.keys("dynamics"), "dynamics")
     names = []
     for i, gen in enumerate(dyn.setdefault("generator", [])):
         w = f"dynamics.generator.{i}"
-        _keys(gen, {"name", "bus", "machine", "exciter", "governor", "pss"}, w)
+        _keys(gen, F.keys("dynamics.generator"), w)
         names.append(_need(gen, "name", w, str))
         _need(gen, "bus", w, (int, str))
         _need(_need(gen, "machine", w, dict), "model", f"{w}.machine", str)
@@ -398,24 +399,24 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                 _need(_need(gen, part, w, dict), "model", f"{w}.{part}", str)
     for i, gt in enumerate(dyn.setdefault("gti", [])):
         w = f"dynamics.gti.{i}"
-        _keys(gt, {"name", "bus", "mode", "ref_bus", "C", "Vc0", "chi", "B", "ks_max", "tau",
-                   "kp_p", "ki_p", "kd_p", "kp_q", "ki_q", "kd_q", "Td", "kp_v", "ki_v"}, w)
+        _keys(gt, F.keys("dynamics.gti"), w)
         names.append(_need(gt, "name", w, str))
         _need(gt, "bus", w, (int, str))
-        _choice(gt, "mode", w, ("energy", "pq"), "energy")
+        _choice(gt, "mode", w, ("energy", "pq"), F.default("dynamics.gti", "mode"))
         for k in ("C", "B", "tau", "Vc0"):
             _num(gt, k, w, positive=k != "tau")
     m = _need(d, "machine", "study file", dict)
-    _keys(m, {"name"}, "machine")
+    _keys(m, F.keys("machine"), "machine")
     if _need(m, "name", "machine", str) not in names and g["kind"] not in ("andes", "psse"):
         raise ParameterError("machine.name", m["name"], f"no generator or GTI of that name in "
                              f"[dynamics]; choose one of {names}")
     up = _need(d, "upqc", "study file", dict)
-    _keys(up, {"name", "branch", "side", "insert", "structure", "rating"}, "upqc")
-    _choice(up, "side", "upqc", ("from", "to"), "from")
-    up.setdefault("name", "UPQC")
-    up["structure"] = _choice(up, "structure", "upqc", STRUCTURES, "conventional")
-    up["rating"] = _num(up, "rating", "upqc", 0.2, positive=True)
+    _keys(up, F.keys("upqc"), "upqc")
+    _choice(up, "side", "upqc", ("from", "to"), F.default("upqc", "side"))
+    up.setdefault("name", F.default("upqc", "name"))
+    up["structure"] = _choice(up, "structure", "upqc", STRUCTURES,
+                              F.default("upqc", "structure"))
+    up["rating"] = _num(up, "rating", "upqc", F.default("upqc", "rating"), positive=True)
     if up["rating"] > MAX_RATING:
         raise ParameterError("upqc.rating", up["rating"], f"a series voltage above {MAX_RATING:g} "
                              "pu (the line's nominal voltage) is more than the series "
@@ -427,16 +428,14 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                              "series branch put into an existing branch)")
     if "insert" in up:
         ins = up["insert"]
-        _keys(ins, {"element", "index", "name", "branch", "side", "r", "x", "sn_mva"},
-              "upqc.insert")
+        _keys(ins, F.keys("upqc.insert"), "upqc.insert")
         _choice(ins, "side", "upqc.insert", ("from", "to"))
         _num(ins, "x", "upqc.insert", positive=True)
-        ins.setdefault("r", 0.0)
+        ins.setdefault("r", F.default("upqc.insert", "r"))
     ds = _need(d, "design", "study file", dict)
-    _keys(ds, {"T", "settings", "cost", "mesh", "basis", "initial_policy", "solver", "load"},
-          "design")
+    _keys(ds, F.keys("design"), "design")
     _num(ds, "T", "design", positive=True)
-    ds.setdefault("settings", "case1-paper")
+    ds.setdefault("settings", F.default("design", "settings"))
     from ..models import preset_names
 
     if ds["settings"] not in preset_names():
@@ -445,7 +444,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                              f"{preset_names()}")
     sim = d.get("simulation")
     if sim is not None:
-        _keys(sim, {"dt", "tol", "record", "notes"}, "simulation")
+        _keys(sim, F.keys("simulation"), "simulation")
         rec = sim.get("record")
         if rec is not None and not (isinstance(rec, list) and rec and all(
                 isinstance(r, str) and r.strip() for r in rec)):
@@ -465,7 +464,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                                      "between 1e-13 and 1e-4 pu (omit it for the simulator's "
                                      "default, scaled with the step)")
     ct = d.setdefault("controllers", {})
-    ct.setdefault("compare", ["hji", "lqr", "pss-only"])
+    ct.setdefault("compare", F.default("controllers", "compare"))
     from .controllers import CONTROLLER_KINDS
 
     if not isinstance(ct["compare"], list) or not ct["compare"]:
@@ -482,8 +481,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
     loads = Study(d, source, base_dir).loads
     for i, sc in enumerate(scs):
         w = f"scenarios.{i}"
-        _keys(sc, {"id", "load", "upqc", "t_end", "controllers", "events", "bypass", "quick",
-                   "description", "design_load"}, w)
+        _keys(sc, F.keys("scenarios"), w)
         sid = check_file_name(_need(sc, "id", w, str), f"{w}.id")
         if sid in seen:
             raise ParameterError(f"{w}.id", sid, "scenario ids must be unique")
@@ -519,7 +517,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                                      "t_start < t_end (s)")
         q = sc.get("quick")
         if q:
-            _keys(q, {"t_end", "controllers"}, f"{w}.quick")
+            _keys(q, F.keys("scenarios.quick"), f"{w}.quick")
             if "t_end" in q:
                 _num(q, "t_end", f"{w}.quick", positive=True)
             for c in q.get("controllers", []):
@@ -527,8 +525,8 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                     raise ParameterError(f"{w}.quick.controllers", c, f"not among the "
                                          f"scenario's controllers {sc['controllers']}")
     rp = d.setdefault("report", {})
-    _keys(rp, {"speed_of", "notes"}, "report")
-    rp.setdefault("notes", [])
+    _keys(rp, F.keys("report"), "report")
+    rp.setdefault("notes", F.default("report", "notes"))
     gens = [gen["name"] for gen in dyn["generator"]]
     if rp.get("speed_of") and g["kind"] not in ("andes", "psse") and rp["speed_of"] not in gens:
         raise ParameterError("report.speed_of", rp["speed_of"], f"no synchronous machine of "
@@ -545,7 +543,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
 
 
 MAX_RATING = 1.0   # pu: the largest series-voltage rating a UPQC can have (the line's voltage)
-FIGURE_KEYS = {"id", "title", "label", "panels", "runs"}
+FIGURE_KEYS = F.keys("figures")
 
 
 def _load_levels(g) -> list:
@@ -602,7 +600,7 @@ def _claims(d):
         for k in ("id", "paper", "rule"):
             _need(c, k, w, str)
         params = inspect.signature(RULES[judge]).parameters
-        _keys(c, {"id", "case", "paper", "rule", "judge"} | (set(params) - {"m"}), w)
+        _keys(c, F.keys("claims") | (set(params) - {"m"}), w)
         for k, p in params.items():
             if k != "m" and p.default is inspect.Parameter.empty and k not in c:
                 raise ParameterError(f"{w}.{k}", None, f"missing; the judge '{judge}' needs it")
@@ -664,7 +662,7 @@ def _events_together(evs, w, up, machine=None):
 def _event(ev, w, t_end):
     kind = _choice(ev, "kind", w, EVENT_KINDS)
     if kind == "fault":
-        _keys(ev, {"kind", "bus", "t_on", "t_off", "duration", "rf", "xf"}, w)
+        _keys(ev, F.keys("events.fault"), w)
         _need(ev, "bus", w, (int, str))
         t_on = _num(ev, "t_on", w, nonneg=True)
         if "duration" in ev and "t_off" in ev:
@@ -677,33 +675,33 @@ def _event(ev, w, t_end):
         if not t_on < t_off <= t_end:
             raise ParameterError(f"{w}.t_off", t_off, f"need t_on ({t_on}) < t_off ≤ t_end "
                                  f"({t_end})")
-        ev["rf"] = _num(ev, "rf", w, 0.0, nonneg=True)
-        ev["xf"] = _num(ev, "xf", w, 1e-3, nonneg=True)
+        ev["rf"] = _num(ev, "rf", w, F.default("events.fault", "rf"), nonneg=True)
+        ev["xf"] = _num(ev, "xf", w, F.default("events.fault", "xf"), nonneg=True)
         if ev["rf"] == 0 and ev["xf"] == 0:
             raise ParameterError(f"{w}.xf", 0.0, "a fault needs a non-zero impedance (rf or xf)")
     elif kind == "line_trip":
-        _keys(ev, {"kind", "branch", "t", "close"}, w)
+        _keys(ev, F.keys("events.line_trip"), w)
         _need(ev, "branch", w, (int, str, dict))
         _num(ev, "t", w, nonneg=True)
         if ev["t"] >= t_end:
             raise ParameterError(f"{w}.t", ev["t"], f"after the run's end (t_end = {t_end}); "
                                  "give t < t_end")
     elif kind == "gen_trip":
-        _keys(ev, {"kind", "machine", "t"}, w)
+        _keys(ev, F.keys("events.gen_trip"), w)
         _need(ev, "machine", w, str)
         _num(ev, "t", w, nonneg=True)
         if ev["t"] >= t_end:
             raise ParameterError(f"{w}.t", ev["t"], f"after the run's end (t_end = {t_end}); "
                                  "give t < t_end")
     else:
-        _keys(ev, {"kind", "bus", "t", "dP", "dQ"}, w)
+        _keys(ev, F.keys("events.load_step"), w)
         _need(ev, "bus", w, (int, str))
         _num(ev, "t", w, nonneg=True)
         if ev["t"] >= t_end:
             raise ParameterError(f"{w}.t", ev["t"], f"after the run's end (t_end = {t_end}); "
                                  "give t < t_end")
-        ev["dP"] = _num(ev, "dP", w, 0.0)
-        ev["dQ"] = _num(ev, "dQ", w, 0.0)
+        ev["dP"] = _num(ev, "dP", w, F.default("events.load_step", "dP"))
+        ev["dQ"] = _num(ev, "dQ", w, F.default("events.load_step", "dQ"))
 
 
 def _inline_grid(g):
