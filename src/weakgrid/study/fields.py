@@ -20,7 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 __all__ = ["Field", "Table", "TABLES", "NO_DEFAULT", "keys", "default", "table", "choices_of",
-           "EVENT_TABLES", "grid_keys"]
+           "EVENT_TABLES", "grid_keys", "Said"]
 
 
 class _NoDefault:
@@ -29,6 +29,10 @@ class _NoDefault:
 
 
 NO_DEFAULT = _NoDefault()
+
+
+class Said(str):
+    """A default described in words (it depends on the rest of the study), not a value."""
 
 S = {"type": "string"}
 N = {"type": "number"}
@@ -64,6 +68,8 @@ class Field:
         Allowed values (a callable: read from a registry when asked).
     kinds : tuple
         ``[grid]`` only: the grid kinds the field belongs to (empty: every kind).
+    required_for : tuple
+        ``[grid]`` only: the grid kinds that require it.
     """
 
     name: str
@@ -74,6 +80,7 @@ class Field:
     required: bool = False
     choices: object = ()
     kinds: tuple = ()
+    required_for: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -148,7 +155,7 @@ def _add(t: Table) -> None:
 # ------------------------------------------------------------------------------ [study]
 _add(Table("study", "What the study is.", (
     Field("name", S, "The study's name (a file-name-safe word: it names output files).",
-          default="the file's stem"),
+          default=Said("the file's stem")),
     Field("title", S, "A title for the report.", default=""),
     Field("reproduce", B, "Part of `weakgrid reproduce` (the paper's studies).", default=False),
     Field("notes", LS, "Paragraphs of the study's own notes (in the report).", default=[]),
@@ -162,7 +169,7 @@ _add(Table("grid", "The grid: where it comes from (`kind`) and how it is edited.
     Field("kind", S, "Where the grid comes from.", required=True, choices=GRID_KINDS),
     Field("network", S, "A function of `pandapower.networks` (e.g. `case9`, "
           "`create_cigre_network_mv`), or `from_json` with `file`.", kinds=("pandapower",),
-          required=True),
+          required_for=("pandapower",)),
     Field("kwargs", T, "Keyword arguments of the `pandapower.networks` function.",
           kinds=("pandapower",)),
     Field("keep_buses", S, "A regular expression: the buses (by name) kept, the others "
@@ -172,9 +179,9 @@ _add(Table("grid", "The grid: where it comes from (`kind`) and how it is edited.
     Field("file", S, "The case file, relative to the study file: MATPOWER `.m`; ANDES "
           "`.xlsx`/`.json`/`.raw` or `andes:` + a path in ANDES's stock cases; pandapower: the "
           "`.json` of `pandapower.to_json` (with `network = \"from_json\"`).",
-          kinds=("pandapower", "matpower", "andes")),
+          kinds=("pandapower", "matpower", "andes"), required_for=("matpower", "andes")),
     Field("raw", S, "The PSS/E `.raw` file (v29-35), relative to the study file.",
-          kinds=("psse",), required=True),
+          kinds=("psse",), required_for=("psse",)),
     Field("dyr", S, "The PSS/E dynamic data (`.dyr`), relative to the study file (ANDES: "
           "`andes:` + a stock case path too); the machines and controls then come from it.",
           kinds=("psse", "andes")),
@@ -187,11 +194,12 @@ _add(Table("grid", "The grid: where it comes from (`kind`) and how it is edited.
     Field("f_hz", {**N, "exclusiveMinimum": 0}, "Nominal frequency (inline: default 60).",
           unit="Hz"),
     Field("bus", {"type": "array", "items": T}, "`[[grid.bus]]` `id`, `name`, `type` (1 PQ, "
-          "2 PV, 3 slack), `base_kv`.", kinds=("inline",), required=True),
+          "2 PV, 3 slack), `base_kv`.", kinds=("inline",), required_for=("inline",)),
     Field("branch", {"type": "array", "items": T}, "`[[grid.branch]]` `name`, `from`, `to`, "
-          "`r`, `x`, `b`, `tap`, `shift` (pu on `Sb_mva`).", kinds=("inline",), required=True),
+          "`r`, `x`, `b`, `tap`, `shift` (pu on `Sb_mva`).", kinds=("inline",),
+          required_for=("inline",)),
     Field("gen", {"type": "array", "items": T}, "`[[grid.gen]]` `name`, `bus`, `P_mw`, "
-          "`Q_mvar`, `V_set`, `Mbase`.", kinds=("inline",), required=True),
+          "`Q_mvar`, `V_set`, `Mbase`.", kinds=("inline",), required_for=("inline",)),
     Field("add_bus", _EDIT_LIST, "Grid edit: `[[grid.add_bus]]` (below).",
           kinds=GRID_KINDS[1:]),
     Field("sgen_to_gen", _EDIT_LIST, "Grid edit: `[[grid.sgen_to_gen]]` (below; not "
@@ -208,7 +216,7 @@ _add(Table("grid.add_bus", "A new PQ bus without load (grid edits, applied in th
     Field("name", S, "The new bus's name (refer to it by this name).", required=True),
     Field("vn_kv", {**N, "exclusiveMinimum": 0}, "Its nominal voltage.", unit="kV",
           required=True),
-    Field("number", {**I, "minimum": 1}, "Its number.", default="one above the grid's largest"),
+    Field("number", {**I, "minimum": 1}, "Its number.", default=Said("one above the grid's largest")),
 ), array=True, example='[[grid.add_bus]]\nname = "PV"\nvn_kv = 135.0'))
 
 _add(Table("grid.sgen_to_gen", "A static generator becomes a voltage-controlled generator "
@@ -216,7 +224,7 @@ _add(Table("grid.sgen_to_gen", "A static generator becomes a voltage-controlled 
            "ANDES/PSS/E grids a generator without a dynamic model (`PV_<idx>`, "
            "`PVSource_<bus>_<id>`).", (
     Field("name", S, "The static generator's name.", required=True),
-    Field("bus", REF, "Move it to this bus.", default="its own bus"),
+    Field("bus", REF, "Move it to this bus.", default=Said("its own bus")),
     Field("vm_pu", {**N, "exclusiveMinimum": 0.5, "exclusiveMaximum": 1.5},
           "Its voltage set point.", unit="pu", default=1.0),
     Field("scale", N, "Scale its power.", default=1.0),
@@ -226,7 +234,7 @@ _add(Table("grid.add_impedance", "A new series branch (a line, or a transformer 
            "a pi model with the ideal transformer at the `from` end (MATPOWER's and PSS/E's "
            "convention; pandapower: a transformer for `tap` ≠ 1 and two shunts for `b`).", (
     Field("name", S, "The branch's name (a UPQC's `branch` can name it).",
-          default="impedance <index>"),
+          default=Said("impedance <index>")),
     Field("from", REF, "From bus (the tap's end).", required=True),
     Field("to", REF, "To bus.", required=True),
     Field("r_pu", N, "Series resistance.", unit="pu on sn_mva", required=True),
@@ -251,7 +259,7 @@ _add(Table("grid.add_gen", "A new generator row of the power flow (its bus becom
     Field("vm_pu", {**N, "exclusiveMinimum": 0.5, "exclusiveMaximum": 1.5},
           "Its voltage set point.", unit="pu", default=1.0),
     Field("sn_mva", {**N, "exclusiveMinimum": 0}, "Its rating.", unit="MVA",
-          default="the system base"),
+          default=Said("the system base")),
     Field("slack", B, "It is the slack.", default=False),
 ), array=True, example='[[grid.add_gen]]\nname = "PV"\nbus = "PV"\np_mw = 30.0'))
 
@@ -345,7 +353,7 @@ _add(Table("design", "The design of the controllers (the design model (10) and t
     Field("initial_policy", T, "Override the preset's initial policy."),
     Field("solver", T, "Override the preset's solver settings."),
     Field("load", S, "The load level the controllers are designed at.",
-          default="the first level"),
+          default=Said("the first level")),
 ), example='[design]\nT = 1.0e-3\nsettings = "case2-paper"'))
 
 _add(Table("controllers", "The controllers compared; `[controllers.NAME]` tables give a "
@@ -361,17 +369,17 @@ _add(Table("scenarios", "A scenario: an operating point and its events; run once
            "controller (run id = `<id>-<controller>`).", (
     Field("id", S, "Its id (a file-name-safe word).", required=True),
     Field("description", S, "Free text."),
-    Field("load", S, "The load level.", default="the first level"),
-    Field("upqc", S, "The UPQC structure.", default="upqc.structure", choices=STRUCTURES),
+    Field("load", S, "The load level.", default=Said("the first level")),
+    Field("upqc", S, "The UPQC structure.", default=Said("upqc.structure"), choices=STRUCTURES),
     Field("design_load", S, "The load the controllers are designed at.",
-          default="the scenario's load"),
+          default=Said("the scenario's load")),
     Field("t_end", _POS, "Simulated time.", unit="s", required=True),
     Field("controllers", LS, "The controllers run (among `controllers.compare`).",
-          default="controllers.compare"),
+          default=Said("controllers.compare")),
     Field("events", {"type": "array"}, "The events (inline tables, below, by `kind`).",
           default=[]),
     Field("bypass", {"type": "array", "items": LN}, "Windows `[t_start, t_end]` [s] in which "
-          "the UPQC is bypassed.", unit="s", default="the fault windows"),
+          "the UPQC is bypassed.", unit="s", default=Said("the fault windows")),
     Field("quick", T, "`--quick` settings: `{t_end, controllers}`; a scenario without is "
           "left out of a quick run."),
 ), array=True, example='[[scenarios]]\nid = "fault-r"\nt_end = 5.0\nevents = [{ kind = '
@@ -379,9 +387,9 @@ _add(Table("scenarios", "A scenario: an operating point and its events; run once
                        'quick = { t_end = 3.0, controllers = ["lqr", "pss-only"] }'))
 
 _add(Table("scenarios.quick", "A scenario's `--quick` settings.", (
-    Field("t_end", _POS, "Simulated time.", unit="s", default="the scenario's"),
+    Field("t_end", _POS, "Simulated time.", unit="s", default=Said("the scenario's")),
     Field("controllers", LS, "The controllers run (among the scenario's).",
-          default="the scenario's"),
+          default=Said("the scenario's")),
 )))
 
 _add(Table("events.fault", "`kind = \"fault\"`: a three-phase fault to ground through "
@@ -427,7 +435,7 @@ EVENT_TABLES = {k: f"events.{k}" for k in EVENT_KINDS}
 # ------------------------------------------------------------------------------ report, figures, claims
 _add(Table("report", "The report.", (
     Field("speed_of", S, "The synchronous machine whose speed is drawn and measured (`\"\"`: "
-          "none).", default="the controlled SG, else the first generator"),
+          "none).", default=Said("the controlled SG, else the first generator")),
     Field("notes", LS, "The study's own protocol paragraphs.", default=[]),
 ), example='[report]\nspeed_of = "G3"'))
 
@@ -476,8 +484,8 @@ _add(Table("sweep", "A sweep: axes over any study field × scenarios × controll
           "0.3]`, `\"scenarios.ID.events.0.duration\" = [...]`).", required=True),
     Field("mode", S, "Every combination, or the axes zipped.", default="product",
           choices=("product", "points")),
-    Field("scenarios", LS, "The scenarios swept.", default="every scenario"),
-    Field("controllers", LS, "The controllers swept.", default="each scenario's"),
+    Field("scenarios", LS, "The scenarios swept.", default=Said("every scenario")),
+    Field("controllers", LS, "The controllers swept.", default=Said("each scenario's")),
     Field("t_end", _POS, "Simulated time of every run.", unit="s"),
     Field("design_load", S, "Controllers designed at this load."),
     Field("signals", LS, "Signals kept per run."),
@@ -490,15 +498,16 @@ _add(Table("sweep", "A sweep: axes over any study field × scenarios × controll
 
 _add(Table("sweep.maps", "A map of a sweep for a claim.", (
     Field("claim", S, "The claim's id.", required=True),
-    Field("id", S, "Its id (a file name).", default="the claim's id"),
+    Field("id", S, "Its id (a file name).", default=Said("the claim's id")),
     Field("title", S, "Its title."),
     Field("kind", S, "What it draws.", required=True, choices=_map_kinds),
     Field("metric", S, "The metric."),
     Field("metrics", LS, "Metrics (several)."),
     Field("a", S, "Controller a."),
     Field("b", S, "Controller b."),
-    Field("holds_below", N, "The claim holds where the ratio is below this."),
-    Field("holds_within", N, "The claim holds where the value is within this."),
+    Field("holds_below", N, "kind = ratio: the claim holds where a/b ≤ this.", default=1.0),
+    Field("holds_within", {**LN, "minItems": 2, "maxItems": 2}, "kind = value: the claim "
+          "holds where the value is within `[lo, hi]`."),
     Field("label", S, "Its label."),
     Field("x", S, "Swept path on the x axis."),
     Field("y", S, "Swept path on the y axis."),
@@ -506,11 +515,11 @@ _add(Table("sweep.maps", "A map of a sweep for a claim.", (
 ), array=True))
 
 _add(Table("simulation", "Numerical settings of every run of the study.", (
-    Field("dt", _POS, "Integration step (≤ design.T).", unit="s", default="design.T"),
+    Field("dt", _POS, "Integration step (≤ design.T).", unit="s", default=Said("design.T")),
     Field("tol", {**N, "minimum": 1e-13, "maximum": 1e-4}, "Newton tolerance.", unit="pu",
-          default="the simulator's default for dt"),
+          default=Said("the simulator's default for dt")),
     Field("record", {**LS, "minItems": 1}, "Signal names or fnmatch patterns the run files "
-          "keep (the figures' signals always).", default="every signal"),
+          "keep (the figures' signals always).", default=Said("every signal")),
     Field("notes", LS, "Notes on the settings."),
 ), example='[simulation]\nrecord = ["*.omega", "bus*.v"]'))
 
@@ -541,7 +550,7 @@ def default(path: str, name: str):
     """The default of field ``name`` of table ``path`` (a fresh copy of a list)."""
     for f in TABLES[path].fields:
         if f.name == name:
-            if f.default is NO_DEFAULT:
+            if f.default is NO_DEFAULT or isinstance(f.default, Said):
                 raise KeyError(f"{path}.{name} has no default")
             return list(f.default) if isinstance(f.default, list) else f.default
     raise KeyError(f"{path}.{name}")

@@ -22,7 +22,8 @@ the UPQC is inserted and before the power flow, so a new generator is in the pow
   ``[[dynamics.generator]]`` or ``[[dynamics.gti]]`` (a GTI and its dc link) at that bus.
 
 Buses are referred to as anywhere in a study file: the source's number or name (and names
-given by ``add_bus``); an unknown bus is refused with a list of valid ones.
+given by ``add_bus``); an unknown bus is refused with a list of valid ones. Every field with
+its type, unit and default: ``docs/study-file-reference.md`` (:mod:`weakgrid.study.fields`).
 The pandapower kind applies them with pandapower's own ``create_*`` functions
 (:func:`weakgrid.study.build._pandapower_net`); MATPOWER, ANDES and PSS/E grids here, on the
 simulator's MATPOWER-layout tables (:func:`apply_case_edits`).

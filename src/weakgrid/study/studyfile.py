@@ -6,31 +6,11 @@ dotted path (:func:`get_path`, :func:`set_path`): ``upqc.rating``, ``design.T``,
 ``scenarios.c1-high-conv.events.0.xf`` (a list element by its ``id``, or by index). The shipped
 studies live in ``weakgrid/data/studies/`` and can be named instead of a path.
 
-Tables (defaults in brackets)::
-
-    [study]       name, title [""], reproduce [false] (part of `weakgrid reproduce`), notes [[]]
-    [grid]        kind = "inline" | "pandapower" | "matpower" | "andes" | "psse"; see
-                  weakgrid.study.build (psse: raw, dyr [none], paths relative to the study file;
-                  pandapower: network = "from_json" with file); edits add_bus, sgen_to_gen,
-                  add_impedance, add_gen on every kind but inline: weakgrid.study.grid_edits
-    [[dynamics.generator]]  name, bus, machine = {model, …}, exciter/governor/pss [none]
-    [[dynamics.gti]]        name, bus, C, Vc0, chi, B, ks_max, tau, mode ["energy"]
-    [machine]     name (the controlled GTI or SG)
-    [upqc]        name ["UPQC"], branch | insert, structure ["conventional"], rating [0.2]
-    [design]      T, settings (a preset giving Q, R, P, γ, Ω, mesh, basis, initial policy)
-                  [cost], [mesh], [basis], [initial_policy], [solver] (override the preset)
-    [controllers] compare [["hji", "lqr", "pss-only"]], [controllers.NAME] options
-    [[scenarios]] id, load, upqc, t_end, controllers, events, bypass, quick,
-                  design_load [the scenario's load: the controllers designed there]
-    [report]      speed_of [the controlled SG, else the first generator; "" for none], notes
-    [[figures]]   id, title, panels, runs = [[run id, label]]  [one figure per scenario]
-    [[claims]]    id, case, paper, rule, judge (weakgrid.study.claims.RULES), parameters
-    [sweep]       axes over study fields, mode, scenarios, controllers, maps (weakgrid.study.sweep)
-    [simulation]  dt [design.T] (integration step, s), tol [the simulator's default for dt,
-                  weakgrid.sim.integrate.default_tol] (Newton tolerance, pu): numerical
-                  settings of every run of the study (weakgrid.study.runner.sim_settings);
-                  record [every signal] (signal names or fnmatch patterns the run files
-                  keep, e.g. ["*.omega", "bus*.v"]; the figures' signals are always kept)
+The tables and fields (type, unit, default, allowed values) are declared once, in
+:mod:`weakgrid.study.fields`, which this validation takes its keys and defaults from; the
+reference page ``docs/study-file-reference.md`` and the JSON Schema
+``weakgrid/data/study.schema.json`` (``weakgrid schema``) are rendered from it
+(:mod:`weakgrid.study.reference`).
 """
 
 from __future__ import annotations
