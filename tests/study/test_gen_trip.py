@@ -54,3 +54,20 @@ def test_unknown_machine_is_refused_with_the_units():
 def test_gen_trip_described():
     assert describe_event({"kind": "gen_trip", "machine": "G2", "t": 1.5}) == \
         "machine G2 trips (disconnected with its controls) at t = 1.5 s"
+
+
+def test_protocol_names_the_inserted_branch():
+    """An insert given by branch (ANDES, MATPOWER, PSS/E) is named in the protocol (it read
+    "inserted in  (series reactance …)" before)."""
+    from weakgrid.study.protocol import protocol_of
+
+    d, _ = read_study_dict("ieee9-sg-upqc")
+    text = " ".join(protocol_of(study_from_dict(d)))
+    assert "inserted in line 3 at its to end (series reactance x = 0.02 pu)" in text
+    d["grid"] = {"kind": "andes", "file": "andes:ieee39/ieee39_full.xlsx"}
+    d["dynamics"] = {}
+    d["machine"] = {"name": "GENROU_3"}
+    d["report"] = {"speed_of": "GENROU_3"}
+    d["upqc"]["insert"] = {"branch": "Line_37", "side": "from", "x": 0.01}
+    text = " ".join(protocol_of(study_from_dict(d)))
+    assert "inserted in Line_37 at its from end (series reactance x = 0.01 pu)" in text

@@ -528,8 +528,14 @@ def _andes_network(study, g, up, load):
     ins = up.get("insert")
     ref = str(ins.get("branch", ins.get("index")) if ins else up["branch"])
     if ref not in names:
+        br = system.network.branch
+        ends = {str(b): int(v) for b, v in system.andes_bus_id.items()}
+        nums = {v: b for b, v in ends.items()}
+        listed = [f"{n} ({nums.get(int(br[k, 0]), int(br[k, 0]))}-"
+                  f"{nums.get(int(br[k, 1]), int(br[k, 1]))})" for n, k in names.items()]
         raise ParameterError("upqc.insert.branch" if ins else "upqc.branch", ref,
-                             f"no ANDES Line with that idx; choose one of {list(names)}")
+                             f"no ANDES Line with that idx; choose one of (its buses): "
+                             f"{', '.join(listed)}")
     if ins:     # a new bus and series branch (pu on the system base), appended to the tables
         net = system.network
         case, k_up, _, _ = insert_upqc_matpower(net.case, names[ref], ins["side"],

@@ -91,7 +91,8 @@ def protocol_of(study, quick: bool = False) -> list[str]:
               else "") + "."]
     if up:
         ins = up.get("insert") or {}
-        where = (f", inserted in {ins.get('element', '')} {ins.get('index', '')} "
+        into = " ".join(str(ins[k]) for k in ("element", "index", "branch", "name") if k in ins)
+        where = (f", inserted in {into or 'its branch'} at its {ins.get('side', 'from')} end "
                  f"(series reactance x = {ins['x']:g} pu)" if ins and "x" in ins else "")
         name = up.get("name", "UPQC")
         out.append(f"{'UPQC' if name == 'UPQC' else f'UPQC {name}'}: "
