@@ -66,4 +66,4 @@ def test_quick_run_end_to_end(name, tmp_path):
     for sc in st.scenarios(quick=True):
         assert sc["id"] in html
     # no hji in these quick runs: no design recorded, said in words (was an empty table)
-    assert "<h2>Design models derived from the grids</h2><p>None recorded" in html
+    assert "<h2>Design models derived from the grids</h2>\n<p>None recorded" in html
