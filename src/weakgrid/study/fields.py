@@ -234,7 +234,7 @@ _add(Table("grid.add_impedance", "A new series branch (a line, or a transformer 
            "a pi model with the ideal transformer at the `from` end (MATPOWER's and PSS/E's "
            "convention; pandapower: a transformer for `tap` ≠ 1 and two shunts for `b`).", (
     Field("name", S, "The branch's name (a UPQC's `branch` can name it).",
-          default=Said("impedance <index>")),
+          default=Said("\"impedance J\", J its position in the list")),
     Field("from", REF, "From bus (the tap's end).", required=True),
     Field("to", REF, "To bus.", required=True),
     Field("r_pu", N, "Series resistance.", unit="pu on sn_mva", required=True),
