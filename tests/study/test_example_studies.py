@@ -6,6 +6,7 @@ before the first event), and `weakgrid run --quick` runs each end to end."""
 import numpy as np
 import pandas as pd
 import pytest
+from shipped import skip_without_andes
 from test_baselines import pre_event_drift, worst
 
 from weakgrid.cli.main import main
@@ -23,9 +24,7 @@ TRAINED = ("hji", "hji-bounded", "file")   # trained controllers: the slow test 
 
 
 def _example(name):
-    marks = EXAMPLES[name]
-    if pytest.mark.andes in marks:
-        pytest.importorskip("andes")
+    skip_without_andes(name)
     return load_study(name)
 
 
