@@ -70,6 +70,8 @@ class Field:
         ``[grid]`` only: the grid kinds the field belongs to (empty: every kind).
     required_for : tuple
         ``[grid]`` only: the grid kinds that require it.
+    more : str
+        Values allowed beside ``choices`` (said in words; the schema then lists none).
     """
 
     name: str
@@ -81,6 +83,7 @@ class Field:
     choices: object = ()
     kinds: tuple = ()
     required_for: tuple = ()
+    more: str = ""
 
 
 @dataclass(frozen=True)
@@ -107,7 +110,7 @@ def _presets():
 def _controller_kinds():
     from .controllers import CONTROLLER_KINDS
 
-    return tuple(sorted(CONTROLLER_KINDS)) + ("file",)
+    return tuple(sorted(CONTROLLER_KINDS))
 
 
 def _panels():
@@ -361,7 +364,7 @@ _add(Table("controllers", "The controllers compared; `[controllers.NAME]` tables
            "lqr; `u_bound` for hji-bounded; `path` for kind = \"file\").", (
     Field("compare", {**LS, "minItems": 1}, "The controllers of every scenario (a kind, or a "
           "name with a `[controllers.NAME]` table).", default=["hji", "lqr", "pss-only"],
-          choices=_controller_kinds),
+          choices=_controller_kinds, more="a NAME with a [controllers.NAME] table"),
 ), open=True, extra=T, example='[controllers]\ncompare = ["hji", "lqr", "pss-only", "none"]'))
 
 # ------------------------------------------------------------------------------ scenarios

@@ -22,12 +22,13 @@ SCHEMA_ID = "https://weakgrid.invalid/study.schema.json"
 def _field_schema(f: Field) -> dict:
     s = dict(f.schema)
     ch = choices_of(f)
-    if ch:
+    if ch and not f.more:
         if s.get("type") == "array":
             s["items"] = {**s.get("items", {}), "enum": list(ch)}
         else:
             s["enum"] = list(ch)
     s["description"] = f.doc + (f" [{f.unit}]" if f.unit else "") + (
+        f" One of {', '.join(ch)}, or {f.more}." if ch and f.more else "") + (
         f" Default: {f.default}." if isinstance(f.default, Said) else "")
     if f.default is not NO_DEFAULT and not isinstance(f.default, Said):
         s["default"] = f.default
@@ -139,7 +140,8 @@ def _default(f: Field) -> str:
 
 def _allowed(f: Field) -> str:
     ch = choices_of(f)
-    parts = [", ".join(f"`{c}`" for c in ch)] if ch else []
+    parts = [", ".join(f"`{c}`" for c in ch) + (f", or {f.more}" if f.more else "")] if ch \
+        else []
     if _range(f):
         parts.append(_range(f))
     return "; ".join(parts) or "—"
