@@ -50,3 +50,14 @@ def test_kundur_upqc_inserted_into_a_line():
     # G3 now sees its transformer and the series transformer in series: a path over 2 branches
     x_tr = float(net.branch[s.branch_names["Line_13"], 3])
     assert s.derivation.twoport.B == pytest.approx(1 / (gm.p["xd1"][i] + x_tr + 0.01), rel=1e-9)
+
+
+def test_unknown_line_is_refused_with_its_buses():
+    """A newcomer picking the UPQC's branch needs the Lines' buses, not only their idx."""
+    pytest.importorskip("andes")
+    from weakgrid.game.errors import ParameterError
+
+    d = kundur_study()
+    d["upqc"] = {"insert": {"branch": "Line_99", "side": "to", "x": 0.01}, "rating": 0.1}
+    with pytest.raises(ParameterError, match=r"upqc.insert.branch.*Line_99.*Line_13 \(3-9\)"):
+        build_setup(study_from_dict(d))

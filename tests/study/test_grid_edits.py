@@ -216,3 +216,75 @@ def test_psse_generator_without_dynamic_data_becomes_a_gti():
     s, t, p = run_fault(pv_study(grid, "GENBUS"), base_dir=DATA / "psse_reader", p_mw=27.0)
     assert "PVSource" not in s.system.components
     assert_responds(t, p, 0.27)
+
+
+# ---------------------------------------------------------------- add_impedance: b and tap
+STUB = {"r_pu": 0.0, "x_pu": 0.2, "b": 0.3, "tap": 1.05, "sn_mva": 50.0}
+
+
+def stub_voltage(grid, at, generators=(), base_dir=None, upqc_branch="PV link", **stub):
+    """The power-flow voltage [pu] of a dead-end bus "stub" fed from ``at`` through an added
+    branch (``STUB`` changed by ``stub``), and of ``at``: the oracle of a lossless pi model with
+    its ratio at the from end is |V_stub| = |V_at| / (tap·(1 − x·b/2)) (the to-end shunt's
+    charging current through x; x·b is the same on any base)."""
+    z = dict(STUB, **stub)
+    grid = dict(grid, add_bus=grid["add_bus"] + [{"name": "stub", "vn_kv": grid["add_bus"][0]
+                                                   ["vn_kv"]}],
+                add_impedance=grid["add_impedance"] + [dict(z, name="stub link", **{
+                    "from": at, "to": "stub"})])
+    s = build_setup(study_from_dict(pv_study(grid, at, generators, upqc_branch),
+                                    base_dir=base_dir))
+    net = s.system.network
+    v = np.abs(net.pf.V)
+    return v[net.index_of(s.bus("stub"))], v[net.index_of(s.bus(at))], z
+
+
+def expected(v_at, z):
+    return v_at / (z.get("tap", 1.0) * (1.0 - z["x_pu"] * z.get("b", 0.0) / 2.0))
+
+
+@pytest.mark.parametrize("stub", [{}, {"tap": 1.0}, {"b": 0.0}])
+def test_matpower_branch_with_shunt_and_tap(stub):
+    grid = {"kind": "matpower", "file": "matpower/case9.m", **pv_edits(5, 345.0)}
+    gens = [{"name": f"G{b}", "bus": b, "machine": {
+        "model": "GENCLS", "Sn": 100.0, "fn": 60.0, "M": 10.0 if b > 1 else 1e4, "D": 0.0,
+        "ra": 0.0, "xd1": 0.06}} for b in (1, 2, 3)]
+    v, v_at, z = stub_voltage(grid, 5, gens, base_dir=DATA, **stub)
+    assert v == pytest.approx(expected(v_at, z), rel=1e-6)
+    assert abs(v - v_at) > 0.01          # the oracle is not trivially met
+
+
+def test_psse_branch_with_shunt_and_tap():
+    grid = {"kind": "psse", "raw": "raw/PSS2A__OMIB.raw", "dyr": "OMIB_GENCLS.dyr",
+            **pv_edits("GENBUS", 24.0)}
+    v, v_at, z = stub_voltage(grid, "GENBUS", base_dir=DATA / "psse_reader")
+    assert v == pytest.approx(expected(v_at, z), rel=1e-6)
+
+
+@pytest.mark.andes
+def test_andes_branch_with_shunt_and_tap():
+    pytest.importorskip("andes")
+    grid = {"kind": "andes", "file": "andes:ieee14/ieee14.raw",
+            "dyr": "andes:ieee14/ieee14.dyr", **pv_edits(14, 13.8)}
+    v, v_at, z = stub_voltage(grid, 14)
+    assert v == pytest.approx(expected(v_at, z), rel=1e-6)
+
+
+@pytest.mark.parametrize("stub", [{}, {"tap": 1.0}])
+def test_pandapower_branch_with_shunt_and_tap(stub):
+    """pandapower: an impedance element, or a transformer for tap ≠ 1, and two shunts."""
+    grid = {"kind": "pandapower", "network": "case9", **pv_edits("5", 345.0)}
+    gens = [{"name": f"G{b}", "bus": str(b), "machine": {
+        "model": "GENCLS", "Sn": 100.0, "fn": 60.0, "M": 10.0 if b > 1 else 1e4, "D": 0.0,
+        "ra": 0.0, "xd1": 0.06}} for b in (1, 2, 3)]
+    v, v_at, z = stub_voltage(grid, "5", gens, upqc_branch={"from": "5", "to": "PV"}, **stub)
+    assert v == pytest.approx(expected(v_at, z), rel=1e-6)
+
+
+@pytest.mark.parametrize("bad, text", [({"tap": 0.0}, "must be > 0"), ({"tap": 2.0}, "0.5 .. 1.5"),
+                                       ({"b": "x"}, "finite number")])
+def test_add_impedance_b_tap_validation(bad, text):
+    grid = {"kind": "matpower", "file": "matpower/case9.m", **pv_edits(5, 345.0)}
+    grid["add_impedance"][0].update(bad)
+    with pytest.raises(ParameterError, match=rf"grid.add_impedance.0.{list(bad)[0]}.*{text}"):
+        study_from_dict(pv_study(grid, 5), base_dir=DATA)

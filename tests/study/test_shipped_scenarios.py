@@ -7,14 +7,16 @@ never showed it.
 """
 
 import pytest
+from shipped import shipped_params, skip_without_andes
 
 from weakgrid.study.build import build_setup
 from weakgrid.study.runner import Run, make_events
-from weakgrid.study.studyfile import load_study, shipped_studies
+from weakgrid.study.studyfile import load_study
 
 
-@pytest.mark.parametrize("name", shipped_studies())
+@pytest.mark.parametrize("name", shipped_params())
 def test_every_scenario_builds_its_events(name):
+    skip_without_andes(name)
     st = load_study(name)
     setups = {}
     for sc in st.scenarios(False):

@@ -29,11 +29,13 @@ from . import export, gamma, reproduce, simulate, train, verify
 from . import design, modes, run  # studies
 from . import sweep  # sweeps of studies
 from . import plot  # run files
+from . import schema  # the study file's schema and reference
 
 SUBCOMMANDS = [train, gamma, verify, export, simulate, reproduce]
 SUBCOMMANDS += [design, run, modes]
 SUBCOMMANDS += [sweep]
 SUBCOMMANDS += [plot]
+SUBCOMMANDS += [schema]
 
 EXIT_OK, EXIT_INPUT, EXIT_RUN, EXIT_BUG, EXIT_INTERRUPT = 0, 2, 3, 4, 130
 

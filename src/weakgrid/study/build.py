@@ -295,9 +295,8 @@ def _pandapower_edits(g, load, net):
             net.sgen.drop(hit, inplace=True)
         for j, z in enumerate(g.get("add_impedance", [])):
             w = f"grid.add_impedance.{j}"
-            pp.create_impedance(net, bref(z["from"], f"{w}.from"), bref(z["to"], f"{w}.to"),
-                                rft_pu=z["r_pu"], xft_pu=z["x_pu"], sn_mva=z["sn_mva"],
-                                name=z.get("name", f"impedance {j}"))
+            _pandapower_impedance(net, z, bref(z["from"], f"{w}.from"),
+                                  bref(z["to"], f"{w}.to"), z.get("name", f"impedance {j}"))
         for j, ge in enumerate(g.get("add_gen", [])):
             w = f"grid.add_gen.{j}"
             kw = {"slack": True} if ge.get("slack") else {}
@@ -307,6 +306,30 @@ def _pandapower_edits(g, load, net):
                           p_mw=per_level(ge.get("p_mw", 0.0), load, f"{w}.p_mw"),
                           vm_pu=ge.get("vm_pu", 1.0), name=ge["name"], **kw)
     return net, bus_of, bref
+
+
+def _pandapower_impedance(net, z, f, t, name):
+    """``[[grid.add_impedance]]`` on a pandapower network: pandapower's ``impedance`` element
+    at ratio 1, else a two-winding transformer whose rated voltages give the off-nominal ratio
+    ``tap`` at the ``from`` end (``vn_hv_kv = tap·vn(from)``, the impedance referred to the
+    ``to`` end: MATPOWER's model); the shunt susceptance ``b`` [pu on ``sn_mva``] as two
+    shunts, ``b/2`` at the ``to`` bus and ``b/2/tap²`` at the ``from`` bus (the pi model's
+    shunt behind the ideal transformer)."""
+    import pandapower as pp
+
+    sn, r, x = float(z["sn_mva"]), float(z["r_pu"]), float(z["x_pu"])
+    tap, b = float(z.get("tap", 1.0)), float(z.get("b", 0.0))
+    if tap == 1.0:
+        pp.create_impedance(net, f, t, rft_pu=r, xft_pu=x, sn_mva=sn, name=name)
+    else:
+        vf, vt = float(net.bus.vn_kv.at[f]), float(net.bus.vn_kv.at[t])
+        pp.create_transformer_from_parameters(
+            net, f, t, sn_mva=sn, vn_hv_kv=tap * vf, vn_lv_kv=vt, vkr_percent=100.0 * r,
+            vk_percent=100.0 * math.hypot(r, x), pfe_kw=0.0, i0_percent=0.0, name=name)
+    if b:
+        # pandapower's shunt: q_mvar consumed at 1 pu (a capacitive b > 0 is q < 0)
+        pp.create_shunt(net, t, q_mvar=-b / 2 * sn, name=f"{name} (b/2, to)")
+        pp.create_shunt(net, f, q_mvar=-b / 2 / tap ** 2 * sn, name=f"{name} (b/2, from)")
 
 
 # ----------------------------------------------------------------------------- setup
@@ -510,8 +533,14 @@ def _andes_network(study, g, up, load):
     ins = up.get("insert")
     ref = str(ins.get("branch", ins.get("index")) if ins else up["branch"])
     if ref not in names:
+        br = system.network.branch
+        ends = {str(b): int(v) for b, v in system.andes_bus_id.items()}
+        nums = {v: b for b, v in ends.items()}
+        listed = [f"{n} ({nums.get(int(br[k, 0]), int(br[k, 0]))}-"
+                  f"{nums.get(int(br[k, 1]), int(br[k, 1]))})" for n, k in names.items()]
         raise ParameterError("upqc.insert.branch" if ins else "upqc.branch", ref,
-                             f"no ANDES Line with that idx; choose one of {list(names)}")
+                             f"no ANDES Line with that idx; choose one of (its buses): "
+                             f"{', '.join(listed)}")
     if ins:     # a new bus and series branch (pu on the system base), appended to the tables
         net = system.network
         case, k_up, _, _ = insert_upqc_matpower(net.case, names[ref], ins["side"],

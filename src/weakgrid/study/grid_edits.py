@@ -12,14 +12,18 @@ the UPQC is inserted and before the power flow, so a new generator is in the pow
   ``PV_<idx>`` / ``PVSource_<bus>_<id>``; an unknown name is refused with the list);
   MATPOWER cases have none (every generator gets its dynamics from the study);
 * ``[[grid.add_impedance]]`` ``name``, ``from``, ``to``, ``r_pu``, ``x_pu``, ``sn_mva``
-  (the base of ``r_pu``, ``x_pu``) — a series branch (a line, a transformer at nominal ratio);
+  (the base of ``r_pu``, ``x_pu``, ``b``), ``b`` [0] (total shunt susceptance of the branch's
+  pi model, pu on ``sn_mva``, half at each end), ``tap`` [1] (off-nominal ratio, an ideal
+  transformer at the ``from`` end: MATPOWER's and PSS/E's convention) — a series branch (a line,
+  a transformer);
 * ``[[grid.add_gen]]`` ``name``, ``bus``, ``p_mw`` (a number or a table per load level),
   ``vm_pu`` [1.0], ``sn_mva`` (optional: its rating), ``slack`` [false] — a generator row of
   the power flow (its bus becomes voltage-controlled); its dynamics come from
   ``[[dynamics.generator]]`` or ``[[dynamics.gti]]`` (a GTI and its dc link) at that bus.
 
 Buses are referred to as anywhere in a study file: the source's number or name (and names
-given by ``add_bus``); an unknown bus is refused with a list of valid ones.
+given by ``add_bus``); an unknown bus is refused with a list of valid ones. Every field with
+its type, unit and default: ``docs/study-file-reference.md`` (:mod:`weakgrid.study.fields`).
 The pandapower kind applies them with pandapower's own ``create_*`` functions
 (:func:`weakgrid.study.build._pandapower_net`); MATPOWER, ANDES and PSS/E grids here, on the
 simulator's MATPOWER-layout tables (:func:`apply_case_edits`).
@@ -30,19 +34,16 @@ from __future__ import annotations
 import numpy as np
 
 from ..game.errors import ParameterError
+from .fields import table
 
 __all__ = ["EDITS", "FIELDS", "validate_edits", "apply_case_edits", "has_edits"]
 
 #: the edit tables, in the order they are applied
 EDITS = ("add_bus", "sgen_to_gen", "add_impedance", "add_gen")
 
-#: per edit: (required fields, optional fields)
-FIELDS = {
-    "add_bus": ({"name", "vn_kv"}, {"number"}),
-    "sgen_to_gen": ({"name"}, {"bus", "vm_pu", "scale"}),
-    "add_impedance": ({"from", "to", "r_pu", "x_pu", "sn_mva"}, {"name"}),
-    "add_gen": ({"name", "bus"}, {"p_mw", "vm_pu", "sn_mva", "slack"}),
-}
+#: per edit: (required fields, optional fields), from :mod:`weakgrid.study.fields`
+FIELDS = {k: ({f.name for f in table(f"grid.{k}").fields if f.required},
+              {f.name for f in table(f"grid.{k}").fields if not f.required}) for k in EDITS}
 
 
 def has_edits(g: dict) -> bool:
@@ -100,9 +101,14 @@ def validate_edits(g: dict, levels=()) -> None:
             for f in ("vn_kv", "sn_mva"):
                 if f in e:
                     _number(e, f, w, positive=True)
-            for f in ("r_pu", "x_pu", "vm_pu", "scale"):
+            for f in ("r_pu", "x_pu", "vm_pu", "scale", "b"):
                 if f in e:
                     _number(e, f, w)
+            if "tap" in e:
+                _number(e, "tap", w, positive=True)
+                if not 0.5 <= e["tap"] <= 1.5:
+                    raise ParameterError(f"{w}.tap", e["tap"], "an off-nominal ratio in pu "
+                                         "(0.5 .. 1.5; 1 for none)")
             if key == "add_impedance" and e["r_pu"] == 0 and e["x_pu"] == 0:
                 raise ParameterError(f"{w}.x_pu", 0.0, "a branch needs a non-zero impedance")
             if "vm_pu" in e and not 0.5 < e["vm_pu"] < 1.5:
@@ -187,7 +193,9 @@ def apply_case_edits(case: dict, g: dict, load: str, bus_ref) -> tuple[dict, dic
             raise ParameterError(f"{w}.to", z["to"], "the same bus as 'from'")
         k = Sb / float(z["sn_mva"])                   # pu on sn_mva -> pu on the system base
         row = np.zeros(br.shape[1])
-        row[:5] = [f, t, float(z["r_pu"]) * k, float(z["x_pu"]) * k, 0.0]
+        row[:5] = [f, t, float(z["r_pu"]) * k, float(z["x_pu"]) * k, float(z.get("b", 0.0)) / k]
+        tap = float(z.get("tap", 1.0))
+        row[8] = 0.0 if tap == 1.0 else tap            # MATPOWER: 0 = a line (ratio 1)
         row[10] = 1
         if br.shape[1] > 12:
             row[11], row[12] = -360, 360

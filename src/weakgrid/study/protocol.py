@@ -53,6 +53,9 @@ def describe_event(ev: dict) -> str:
         br = f"{b['from']}–{b['to']}" if isinstance(b, dict) else str(b)
         return (f"branch {br} {'closes' if ev.get('close') else 'opens'} at t = "
                 f"{_t(ev['t'])}")
+    if kind == "gen_trip":
+        return (f"machine {ev['machine']} trips (disconnected with its controls) at t = "
+                f"{_t(ev['t'])}")
     if kind == "load_step":
         return (f"load step at {_bus(ev['bus'])} at t = {_t(ev['t'])}: ΔP = "
                 f"{float(ev.get('dP', 0.0)):g} MW, ΔQ = {float(ev.get('dQ', 0.0)):g} Mvar")
@@ -88,7 +91,8 @@ def protocol_of(study, quick: bool = False) -> list[str]:
               else "") + "."]
     if up:
         ins = up.get("insert") or {}
-        where = (f", inserted in {ins.get('element', '')} {ins.get('index', '')} "
+        into = " ".join(str(ins[k]) for k in ("element", "index", "branch", "name") if k in ins)
+        where = (f", inserted in {into or 'its branch'} at its {ins.get('side', 'from')} end "
                  f"(series reactance x = {ins['x']:g} pu)" if ins and "x" in ins else "")
         name = up.get("name", "UPQC")
         out.append(f"{'UPQC' if name == 'UPQC' else f'UPQC {name}'}: "

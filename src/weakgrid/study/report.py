@@ -313,12 +313,18 @@ def write_html(path, *, claims, metrics, figures, designs, meta, notes=None, map
             ("Vr_bar", "V̄r [pu]"), ("phi_s0", "ϕs0 [rad]"),
             ("preset", "settings preset (T, a, V̄r, ϕs0)"),
             ("modes", "design-model mode vs full grid's mode"), ("training", "HJI training")]
-    parts.append("<h2>Design models derived from the grids</h2><div class='scroll'><table><tr>" +
-                 "".join(f"<th>{e(lbl)}</th>" for _, lbl in cols) + "</tr>")
-    for d in designs:
-        parts.append("<tr>" + "".join(f"<td>{e(str(d.get(k, '')))}</td>" for k, _ in cols)
-                     + "</tr>")
-    parts.append("</table></div>")
+    parts.append("<h2>Design models derived from the grids</h2>")
+    if designs:
+        parts.append("<div class='scroll'><table><tr>" +
+                     "".join(f"<th>{e(lbl)}</th>" for _, lbl in cols) + "</tr>")
+        for d in designs:
+            parts.append("<tr>" + "".join(f"<td>{e(str(d.get(k, '')))}</td>" for k, _ in cols)
+                         + "</tr>")
+        parts.append("</table></div>")
+    else:       # recorded with the HJI training: a run without hji trains nothing
+        parts.append("<p>None recorded: no controller of this run was trained (the design "
+                     "model, its mode check and the HJI training are recorded when a run "
+                     "compares hji; <code>weakgrid design STUDY</code> prints them).</p>")
     for d in designs:
         der = d.get("derivation")
         if not der:

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..game.errors import ParameterError
 from ..sim.controllers import DigitalController, UPQCTarget
-from ..sim.events import Fault, LineTrip, LoadStep
+from ..sim.events import Fault, GeneratorTrip, LineTrip, LoadStep
 from ..sim.integrate import simulate
 from ..sim.network import F_BUS, T_BUS
 from ..sim.upqc import rating_clip
@@ -221,10 +221,27 @@ def make_events(setup, run: Run):
                                      "branch: tripping it disconnects the UPQC; trip another "
                                      "branch")
             out.append(LineTrip(row, e["t"], close=bool(e.get("close", False))))
+        elif e["kind"] == "gen_trip":
+            out.append(GeneratorTrip(unit_row(setup.system, e["machine"], f"{w}.machine"),
+                                     e["t"]))
         else:
             _plausible_step(setup, e, w)
             out.append(LoadStep(setup.bus(e["bus"], f"{w}.bus"), e["t"], e["dP"], e["dQ"]))
     return out
+
+
+def unit_row(system, name, where) -> int:
+    """The gen-table row (0-based) of the machine or converter ``name`` of ``system`` (a
+    study's ``[[dynamics.generator]]``/``[[dynamics.gti]]`` name, or an imported grid's:
+    ANDES ``GENROU_3``, PSS/E ``GENROU_<bus>_<id>``); an unknown name is refused with the
+    list."""
+    rows = {c.names[i]: int(lk["gen"]) for c in system.components.values()
+            if c.kind in ("machine", "device") for i, lk in enumerate(c.links)
+            if lk.get("gen") is not None}
+    if name not in rows:
+        raise ParameterError(where, name, f"no machine or converter of that name in this grid; "
+                             f"its units: {sorted(rows)}")
+    return rows[name]
 
 
 def _end(fault) -> float:

@@ -6,33 +6,11 @@ dotted path (:func:`get_path`, :func:`set_path`): ``upqc.rating``, ``design.T``,
 ``scenarios.c1-high-conv.events.0.xf`` (a list element by its ``id``, or by index). The shipped
 studies live in ``weakgrid/data/studies/`` and can be named instead of a path.
 
-Tables (defaults in brackets)::
-
-    [study]       name, title [""], reproduce [false] (part of `weakgrid reproduce`), notes [[]]
-    [grid]        kind = "inline" | "pandapower" | "matpower" | "andes" | "psse"; see
-                  weakgrid.study.build (psse: raw, dyr [none], paths relative to the study file;
-                  pandapower: network = "from_json" with file); edits add_bus, sgen_to_gen,
-                  add_impedance, add_gen on every kind but inline: weakgrid.study.grid_edits
-    [[dynamics.generator]]  name, bus, machine = {model, …}, exciter/governor/pss [none]
-    [[dynamics.gti]]        name, bus, C, Vc0, chi, B, ks_max, tau, mode ["energy"]
-    [machine]     name (the controlled GTI or SG)
-    [upqc]        name ["UPQC"], branch | insert, structure ["conventional"], rating [0.2],
-                  s_rating [MVA; insert.sn_mva], chi [reduced: the GTI's chi, else 0],
-                  h_dc [0.01 s], t_dc [0.02 s], r_shunt [0 pu on s_rating]
-    [design]      T, settings (a preset giving Q, R, P, γ, Ω, mesh, basis, initial policy)
-                  [cost], [mesh], [basis], [initial_policy], [solver] (override the preset)
-    [controllers] compare [["hji", "lqr", "pss-only"]], [controllers.NAME] options
-    [[scenarios]] id, load, upqc, t_end, controllers, events, bypass, quick,
-                  design_load [the scenario's load: the controllers designed there]
-    [report]      speed_of [the controlled SG, else the first generator; "" for none], notes
-    [[figures]]   id, title, panels, runs = [[run id, label]]  [one figure per scenario]
-    [[claims]]    id, case, paper, rule, judge (weakgrid.study.claims.RULES), parameters
-    [sweep]       axes over study fields, mode, scenarios, controllers, maps (weakgrid.study.sweep)
-    [simulation]  dt [design.T] (integration step, s), tol [the simulator's default for dt,
-                  weakgrid.sim.integrate.default_tol] (Newton tolerance, pu): numerical
-                  settings of every run of the study (weakgrid.study.runner.sim_settings);
-                  record [every signal] (signal names or fnmatch patterns the run files
-                  keep, e.g. ["*.omega", "bus*.v"]; the figures' signals are always kept)
+The tables and fields (type, unit, default, allowed values) are declared once, in
+:mod:`weakgrid.study.fields`, which this validation takes its keys and defaults from; the
+reference page ``docs/study-file-reference.md`` and the JSON Schema
+``weakgrid/data/study.schema.json`` (``weakgrid schema``) are rendered from it
+(:mod:`weakgrid.study.reference`).
 """
 
 from __future__ import annotations
@@ -46,16 +24,18 @@ from pathlib import Path
 from ..dotted import get_path as _get, set_path as _set
 from ..fileio import check_file_name, safe_name
 from ..game.errors import ParameterError
+from . import fields as F
 from .grid_edits import EDITS, validate_edits
 
 __all__ = ["Study", "load_study", "apply_overrides", "study_from_dict", "get_path", "set_path", "shipped_studies",
            "read_study_dict", "event_end", "EVENT_KINDS"]
 
-TOP = {"study", "grid", "dynamics", "machine", "upqc", "design", "controllers", "scenarios",
-       "report", "figures", "claims", "sweep", "simulation"}
-GRID_KINDS = ("inline", "pandapower", "matpower", "andes", "psse")
-STRUCTURES = ("conventional", "reduced")
-EVENT_KINDS = ("fault", "line_trip", "load_step")
+# the tables, their fields and defaults: weakgrid.study.fields (the one source of the
+# validation here, the reference page and the JSON Schema)
+TOP = set(F.TOP)
+GRID_KINDS = F.GRID_KINDS
+STRUCTURES = F.STRUCTURES
+EVENT_KINDS = F.EVENT_KINDS
 
 
 # --------------------------------------------------------------------------- dotted paths
@@ -343,15 +323,15 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
     d = copy.deepcopy(d)
     _keys(d, TOP, "study file")
     st = d.setdefault("study", {})
-    _keys(st, {"name", "title", "reproduce", "notes", "description"}, "study")
+    _keys(st, F.keys("study"), "study")
     if "name" in st:
         check_file_name(st["name"], "study.name")
     st.setdefault("name", safe_name(Path(source).stem if source else "study", "study"))
-    st.setdefault("title", "")
-    st.setdefault("reproduce", False)
-    st.setdefault("notes", [])
+    for k in ("title", "reproduce", "notes"):
+        st.setdefault(k, F.default("study", k))
     g = _need(d, "grid", "study file", dict)
     _choice(g, "kind", "grid", GRID_KINDS)
+    _keys(g, F.grid_keys(g["kind"]) | set(EDITS), "grid")   # edits: validate_edits says more
     if g["kind"] == "inline":
         for k in ("bus", "branch", "gen"):
             _need(g, k, "grid", list)
@@ -371,7 +351,6 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                                  '"from_json"; else network names a function of '
                                  "pandapower.networks")
     elif g["kind"] == "psse":
-        _keys(g, {"kind", "raw", "dyr", "f_hz", *EDITS}, "grid")
         for k in ("raw", "dyr"):
             if k in g or k == "raw":
                 v = _need(g, k, "grid", str)
@@ -387,11 +366,11 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         check_file_name(level, f"grid.loads.{level}")
     validate_edits(g, _load_levels(g))
     dyn = d.setdefault("dynamics", {})
-    _keys(dyn, {"generator", "gti"}, "dynamics")
+    _keys(dyn, F.keys("dynamics"), "dynamics")
     names = []
     for i, gen in enumerate(dyn.setdefault("generator", [])):
         w = f"dynamics.generator.{i}"
-        _keys(gen, {"name", "bus", "machine", "exciter", "governor", "pss"}, w)
+        _keys(gen, F.keys("dynamics.generator"), w)
         names.append(_need(gen, "name", w, str))
         _need(gen, "bus", w, (int, str))
         _need(_need(gen, "machine", w, dict), "model", f"{w}.machine", str)
@@ -400,25 +379,24 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                 _need(_need(gen, part, w, dict), "model", f"{w}.{part}", str)
     for i, gt in enumerate(dyn.setdefault("gti", [])):
         w = f"dynamics.gti.{i}"
-        _keys(gt, {"name", "bus", "mode", "ref_bus", "C", "Vc0", "chi", "B", "ks_max", "tau",
-                   "kp_p", "ki_p", "kd_p", "kp_q", "ki_q", "kd_q", "Td", "kp_v", "ki_v"}, w)
+        _keys(gt, F.keys("dynamics.gti"), w)
         names.append(_need(gt, "name", w, str))
         _need(gt, "bus", w, (int, str))
-        _choice(gt, "mode", w, ("energy", "pq"), "energy")
+        _choice(gt, "mode", w, ("energy", "pq"), F.default("dynamics.gti", "mode"))
         for k in ("C", "B", "tau", "Vc0"):
             _num(gt, k, w, positive=k != "tau")
     m = _need(d, "machine", "study file", dict)
-    _keys(m, {"name"}, "machine")
+    _keys(m, F.keys("machine"), "machine")
     if _need(m, "name", "machine", str) not in names and g["kind"] not in ("andes", "psse"):
         raise ParameterError("machine.name", m["name"], f"no generator or GTI of that name in "
                              f"[dynamics]; choose one of {names}")
     up = _need(d, "upqc", "study file", dict)
-    _keys(up, {"name", "branch", "side", "insert", "structure", "rating"} | DEVICE_FIELDS,
-          "upqc")
-    _choice(up, "side", "upqc", ("from", "to"), "from")
-    up.setdefault("name", "UPQC")
-    up["structure"] = _choice(up, "structure", "upqc", STRUCTURES, "conventional")
-    up["rating"] = _num(up, "rating", "upqc", 0.2, positive=True)
+    _keys(up, F.keys("upqc"), "upqc")
+    _choice(up, "side", "upqc", ("from", "to"), F.default("upqc", "side"))
+    up.setdefault("name", F.default("upqc", "name"))
+    up["structure"] = _choice(up, "structure", "upqc", STRUCTURES,
+                              F.default("upqc", "structure"))
+    up["rating"] = _num(up, "rating", "upqc", F.default("upqc", "rating"), positive=True)
     if up["rating"] > MAX_RATING:
         raise ParameterError("upqc.rating", up["rating"], f"a series voltage above {MAX_RATING:g} "
                              "pu (the line's nominal voltage) is more than the series "
@@ -431,20 +409,18 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                              "series branch put into an existing branch)")
     if "insert" in up:
         ins = up["insert"]
-        _keys(ins, {"element", "index", "name", "branch", "side", "r", "x", "sn_mva"},
-              "upqc.insert")
+        _keys(ins, F.keys("upqc.insert"), "upqc.insert")
         _choice(ins, "side", "upqc.insert", ("from", "to"))
         _num(ins, "x", "upqc.insert", positive=True)
-        ins.setdefault("r", 0.0)
+        ins.setdefault("r", F.default("upqc.insert", "r"))
     ds = _need(d, "design", "study file", dict)
-    _keys(ds, {"T", "settings", "cost", "mesh", "basis", "initial_policy", "solver", "load",
-               "grid_model"}, "design")
+    _keys(ds, F.keys("design"), "design")
     _num(ds, "T", "design", positive=True)
     from ..design.derive import GRID_MODELS
 
     _choice(ds, "grid_model", "design", GRID_MODELS, default="paper")   # not set: the key of
     # every cached run stays as it was
-    ds.setdefault("settings", "case1-paper")
+    ds.setdefault("settings", F.default("design", "settings"))
     from ..models import preset_names
 
     if ds["settings"] not in preset_names():
@@ -453,7 +429,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                              f"{preset_names()}")
     sim = d.get("simulation")
     if sim is not None:
-        _keys(sim, {"dt", "tol", "record", "notes"}, "simulation")
+        _keys(sim, F.keys("simulation"), "simulation")
         rec = sim.get("record")
         if rec is not None and not (isinstance(rec, list) and rec and all(
                 isinstance(r, str) and r.strip() for r in rec)):
@@ -473,7 +449,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                                      "between 1e-13 and 1e-4 pu (omit it for the simulator's "
                                      "default, scaled with the step)")
     ct = d.setdefault("controllers", {})
-    ct.setdefault("compare", ["hji", "lqr", "pss-only"])
+    ct.setdefault("compare", F.default("controllers", "compare"))
     from .controllers import CONTROLLER_KINDS
 
     if not isinstance(ct["compare"], list) or not ct["compare"]:
@@ -490,8 +466,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
     loads = Study(d, source, base_dir).loads
     for i, sc in enumerate(scs):
         w = f"scenarios.{i}"
-        _keys(sc, {"id", "load", "upqc", "t_end", "controllers", "events", "bypass", "quick",
-                   "description", "design_load"}, w)
+        _keys(sc, F.keys("scenarios"), w)
         sid = check_file_name(_need(sc, "id", w, str), f"{w}.id")
         if sid in seen:
             raise ParameterError(f"{w}.id", sid, "scenario ids must be unique")
@@ -518,7 +493,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
         evs = sc.setdefault("events", [])
         for j, ev in enumerate(evs):
             _event(ev, f"{w}.events.{j}", sc["t_end"])
-        _events_together(evs, w, up)
+        _events_together(evs, w, up, m["name"])
         # bypass: default = the fault windows, computed when used (so that it follows the
         # faults when a field is changed later), see Study.scenarios
         for j, b in enumerate(sc.get("bypass", [])):
@@ -527,7 +502,7 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                                      "t_start < t_end (s)")
         q = sc.get("quick")
         if q:
-            _keys(q, {"t_end", "controllers"}, f"{w}.quick")
+            _keys(q, F.keys("scenarios.quick"), f"{w}.quick")
             if "t_end" in q:
                 _num(q, "t_end", f"{w}.quick", positive=True)
             for c in q.get("controllers", []):
@@ -535,8 +510,8 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                     raise ParameterError(f"{w}.quick.controllers", c, f"not among the "
                                          f"scenario's controllers {sc['controllers']}")
     rp = d.setdefault("report", {})
-    _keys(rp, {"speed_of", "notes"}, "report")
-    rp.setdefault("notes", [])
+    _keys(rp, F.keys("report"), "report")
+    rp.setdefault("notes", F.default("report", "notes"))
     gens = [gen["name"] for gen in dyn["generator"]]
     if rp.get("speed_of") and g["kind"] not in ("andes", "psse") and rp["speed_of"] not in gens:
         raise ParameterError("report.speed_of", rp["speed_of"], f"no synchronous machine of "
@@ -553,7 +528,6 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
 
 
 # the UPQC as a physical device (weakgrid.sim.upqc): power rating, losses, dc link
-DEVICE_FIELDS = {"s_rating", "chi", "h_dc", "t_dc", "r_shunt"}
 
 
 def _device_fields(up: dict) -> None:
@@ -580,7 +554,7 @@ def _device_fields(up: dict) -> None:
 
 
 MAX_RATING = 1.0   # pu: the largest series-voltage rating a UPQC can have (the line's voltage)
-FIGURE_KEYS = {"id", "title", "label", "panels", "runs"}
+FIGURE_KEYS = F.keys("figures")
 
 
 def _load_levels(g) -> list:
@@ -637,7 +611,7 @@ def _claims(d):
         for k in ("id", "paper", "rule"):
             _need(c, k, w, str)
         params = inspect.signature(RULES[judge]).parameters
-        _keys(c, {"id", "case", "paper", "rule", "judge"} | (set(params) - {"m"}), w)
+        _keys(c, F.keys("claims") | (set(params) - {"m"}), w)
         for k, p in params.items():
             if k != "m" and p.default is inspect.Parameter.empty and k not in c:
                 raise ParameterError(f"{w}.{k}", None, f"missing; the judge '{judge}' needs it")
@@ -670,9 +644,9 @@ def _file_controllers(d, study, g, machine):
                                  f"{ours.upper()}; train one for this study (`weakgrid design`)")
 
 
-def _events_together(evs, w, up):
+def _events_together(evs, w, up, machine=None):
     """Events of one scenario: no two faults at one bus at the same time, no trip of the
-    UPQC's own branch."""
+    UPQC's own branch, no trip of the controlled ``machine``."""
     faults = sorted((ev["t_on"], ev["t_off"], j, ev["bus"]) for j, ev in enumerate(evs)
                     if ev["kind"] == "fault")
     for a, (t0, t1, j, bus) in enumerate(faults):
@@ -685,6 +659,10 @@ def _events_together(evs, w, up):
     own = {v for v in (up.get("branch"), (up.get("insert") or {}).get("name"), up.get("name"))
            if isinstance(v, (str, int)) and not isinstance(v, bool)}
     for j, ev in enumerate(evs):
+        if ev["kind"] == "gen_trip" and ev["machine"] == machine:
+            raise ParameterError(f"{w}.events.{j}.machine", ev["machine"], "is the study's "
+                                 "controlled machine (machine.name): its controller would act "
+                                 "on a disconnected unit; trip another machine")
         if ev["kind"] == "line_trip" and (ev["branch"] == up.get("branch") or (
                 isinstance(ev["branch"], (str, int)) and ev["branch"] in own)):
             raise ParameterError(f"{w}.events.{j}.branch", ev["branch"], "is the UPQC's own "
@@ -695,7 +673,7 @@ def _events_together(evs, w, up):
 def _event(ev, w, t_end):
     kind = _choice(ev, "kind", w, EVENT_KINDS)
     if kind == "fault":
-        _keys(ev, {"kind", "bus", "t_on", "t_off", "duration", "rf", "xf"}, w)
+        _keys(ev, F.keys("events.fault"), w)
         _need(ev, "bus", w, (int, str))
         t_on = _num(ev, "t_on", w, nonneg=True)
         if "duration" in ev and "t_off" in ev:
@@ -708,26 +686,33 @@ def _event(ev, w, t_end):
         if not t_on < t_off <= t_end:
             raise ParameterError(f"{w}.t_off", t_off, f"need t_on ({t_on}) < t_off ≤ t_end "
                                  f"({t_end})")
-        ev["rf"] = _num(ev, "rf", w, 0.0, nonneg=True)
-        ev["xf"] = _num(ev, "xf", w, 1e-3, nonneg=True)
+        ev["rf"] = _num(ev, "rf", w, F.default("events.fault", "rf"), nonneg=True)
+        ev["xf"] = _num(ev, "xf", w, F.default("events.fault", "xf"), nonneg=True)
         if ev["rf"] == 0 and ev["xf"] == 0:
             raise ParameterError(f"{w}.xf", 0.0, "a fault needs a non-zero impedance (rf or xf)")
     elif kind == "line_trip":
-        _keys(ev, {"kind", "branch", "t", "close"}, w)
+        _keys(ev, F.keys("events.line_trip"), w)
         _need(ev, "branch", w, (int, str, dict))
         _num(ev, "t", w, nonneg=True)
         if ev["t"] >= t_end:
             raise ParameterError(f"{w}.t", ev["t"], f"after the run's end (t_end = {t_end}); "
                                  "give t < t_end")
+    elif kind == "gen_trip":
+        _keys(ev, F.keys("events.gen_trip"), w)
+        _need(ev, "machine", w, str)
+        _num(ev, "t", w, nonneg=True)
+        if ev["t"] >= t_end:
+            raise ParameterError(f"{w}.t", ev["t"], f"after the run's end (t_end = {t_end}); "
+                                 "give t < t_end")
     else:
-        _keys(ev, {"kind", "bus", "t", "dP", "dQ"}, w)
+        _keys(ev, F.keys("events.load_step"), w)
         _need(ev, "bus", w, (int, str))
         _num(ev, "t", w, nonneg=True)
         if ev["t"] >= t_end:
             raise ParameterError(f"{w}.t", ev["t"], f"after the run's end (t_end = {t_end}); "
                                  "give t < t_end")
-        ev["dP"] = _num(ev, "dP", w, 0.0)
-        ev["dQ"] = _num(ev, "dQ", w, 0.0)
+        ev["dP"] = _num(ev, "dP", w, F.default("events.load_step", "dP"))
+        ev["dQ"] = _num(ev, "dQ", w, F.default("events.load_step", "dQ"))
 
 
 def _inline_grid(g):

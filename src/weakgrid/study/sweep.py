@@ -36,12 +36,12 @@ import pandas as pd
 from ..game.errors import ParameterError
 from ..sweep import Point, canonical_json, expand, run_sweep
 from .studyfile import get_path, set_path, study_from_dict
+from .fields import keys
 
 __all__ = ["SWEEP_KEYS", "validate_sweep", "sweep_points", "describe_sweep", "run_point",
            "run_study_sweep", "claim_sweep_outputs"]
 
-SWEEP_KEYS = {"axes", "mode", "scenarios", "controllers", "t_end", "design_load", "signals",
-              "quick", "maps", "dt_check"}
+SWEEP_KEYS = keys("sweep")      # the fields: weakgrid.study.fields
 
 _TRAINED: dict = {}     # per worker process: design key -> trained GameController
 _DESIGNS: dict = {}     # per worker process: (grid data, load, structure) -> design model (10)
@@ -116,8 +116,7 @@ def validate_sweep(d: dict, study) -> None:
                                  "a swept field (a path of [sweep.axes])")
 
 
-MAP_KEYS = {"claim", "id", "title", "kind", "metric", "metrics", "a", "b", "holds_below",
-            "holds_within", "label", "x", "y", "facet"}
+MAP_KEYS = keys("sweep.maps")
 
 
 def _maps(sw, d):
