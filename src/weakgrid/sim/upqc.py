@@ -46,6 +46,9 @@ def rating_clip(u, Vmax):
 class UPQC(Component):
     """Vectorized UPQC series branches; add instances with :meth:`add_upqc`."""
 
+    #: the series-voltage commands [pu] a controller holds: per member in a batch
+    batch_inputs = ("u_p", "u_q")
+
     kind = "device"
     order = 3
     params = (Param("Vmax", 0.2, "pu", "series voltage rating |Vu|max", "pos"),)
