@@ -171,3 +171,48 @@ def test_a_member_with_a_device_event_is_refused_by_the_batch_simulator():
     s = _system(0.0)
     with pytest.raises(DataError, match="GeneratorTrip"):
         BatchSimulator(s, [{"events": [GeneratorTrip(0, 0.5)]}])
+
+
+class _VectorPolicy:
+    """The feedback of ``_K`` on arrays: ``(n,)`` → ``(2,)`` and ``(B, n)`` → ``(B, 2)``; counts its calls."""
+
+    def __init__(self):
+        self.calls = 0
+
+    def __call__(self, m):
+        self.calls += 1
+        m = np.asarray(m, dtype=float)
+        return np.stack([np.clip(-0.5 * m[..., 0] - 2.0 * m[..., 1], -0.15, 0.15),
+                         np.clip(-0.2 * m[..., 1], -0.1, 0.1)], axis=-1)
+
+
+def test_a_batched_policy_is_called_once_per_sample_for_the_whole_batch():
+    s = build_gti_upqc_sg("reduced")
+    tf = 0.6
+
+    def scen(K, batched):
+        return [{"events": [Fault(3, 0.2, 0.25, xf=x)],
+                 "controllers": [DigitalController(K, DT, gti_design_states("PV"), UPQCTarget("U"),
+                                                   enable=[(0.25, tf)], batched=batched)]}
+                for x in (0.05, 0.08, 0.1)]
+    alone = [_alone(s, sc, tf, dt=DT, tol=1e-6) for sc in scen(_K, False)]
+    K = _VectorPolicy()
+    got = simulate_batch(s, scen(K, True), tf, dt=DT, tol=1e-6)
+    n_samples = len([t for t in np.arange(0.25, tf - 1e-9, DT)])    # active samples in [0.25, tf)
+    assert n_samples - 1 <= K.calls <= n_samples + 1                 # not 3x: one call per instant
+    for a, b in zip(alone, got):
+        assert a.ok and b.ok
+        _same(a, b)
+
+
+def test_a_batched_policy_returning_the_wrong_rows_fails_its_members_as_a_controller_error():
+    s = build_gti_upqc_sg("reduced")
+
+    def K(m):   # one row whatever the batch
+        return np.zeros((1, 2))
+    sc = [{"controllers": [DigitalController(K, DT, gti_design_states("PV"), UPQCTarget("U"), batched=True,
+                                             enable=[(0.05, 1.0)])]} for _ in range(2)]
+    got = simulate_batch(s, sc, 0.1, dt=DT, tol=1e-6)
+    assert all(r.failure is not None and r.failure.cause == "controller" for r in got)
+    assert all(r.failure.t == pytest.approx(0.05) and r.t[-1] == pytest.approx(0.05) for r in got)
+    assert "1 rows for 2" in str(got[0].failure)

@@ -30,7 +30,7 @@ from its one-by-one run by the step error, not by round-off).
 
 The array code uses the namespace ``xp`` (NumPy) so that an array-API backend could replace
 it for large batches; the linear solves stay per member (LAPACK through
-:mod:`weakgrid.sim.linsolve`, exactly the one-by-one factorization).
+:mod:`weakgrid.sim.linsolve`, exactly the one-by-one factorization and solve).
 
 Scope: dense networks (``nb <= system.DENSE_NETWORK_MAX``), members that share every device
 parameter (events and controllers differ), events that change the network (:class:`Fault`,
@@ -128,6 +128,9 @@ class _BatchRecorder:
     def finish(self, B, failures, stats):
         """One :class:`Results` per member ``0..B-1``."""
         rec = self.rec
+        if not rec._layout_done:    # nothing recorded (every member failed at t = 0)
+            return [Results(xp.zeros(0), [], xp.zeros((0, 0)), [], [], failure=failures[k], stats=stats[k])
+                    for k in range(B)]
         if self.blocks:
             T = xp.concatenate([xp.full(len(m), t) for t, m, _ in self.blocks])
             K = xp.concatenate([m for _, m, _ in self.blocks])
@@ -177,12 +180,6 @@ class BatchSimulator:
         One per member: ``{"events": [...], "controllers": [...]}`` (both optional), the
         arguments of :meth:`Simulator.run`. Event and controller objects must not be shared
         between members (they hold per-run state).
-    solves : {"lu", "inverse"}
-        The chord solves of the Newton iterations: each member's LU factors, one LAPACK call
-        per member and iteration, the arithmetic of its run alone (default); or the inverse of
-        each member's chord matrix (computed once per factorization) applied to the whole
-        batch as one product: fewer Python calls, trajectories equal to round-off only (a
-        Newton iteration count may then differ by one where an update lands at the tolerance).
     **sim_kw
         Keyword arguments of :class:`Simulator` (``dt``, ``tol``, ``max_iter``,
         ``max_angle_spread``, ``save_every``, ``record``; ``linear_solver`` must be dense).
@@ -195,10 +192,7 @@ class BatchSimulator:
         Batched steps taken.
     """
 
-    def __init__(self, system, scenarios, solves="lu", **sim_kw):
-        if solves not in ("lu", "inverse"):
-            raise DataError("simulate_batch", "solves", solves, 'use "lu" or "inverse"')
-        self.solves = solves
+    def __init__(self, system, scenarios, **sim_kw):
         if not system.is_setup:
             system.setup()
         why = batch_unsupported(system)
@@ -234,7 +228,6 @@ class BatchSimulator:
         self._ynet = [None] * self.B
         self.timing = dict.fromkeys(TIMED, 0.0)
         self.steps = 0
-        self._inv = {}
 
     # ------------------------------------------------------------- evaluations
     def _bind_inputs(self, rows, rep=1):
@@ -327,21 +320,10 @@ class BatchSimulator:
             live = keep
         return done
 
-    def _inverse(self, k, lu):
-        """The inverse of member ``k``'s chord matrix from its factorization ``lu`` (computed
-        once per factorization): the batch applies all members' solves as one product."""
-        got = self._inv.get(k)
-        if got is None or got[0] is not lu:
-            t0 = time.perf_counter()
-            got = self._inv[k] = (lu, xp.asarray(lu.solve(np.eye(self.N))))
-            self.timing["lu"] += time.perf_counter() - t0
-        return got[1]
-
-    def _solve(self, INV, lus, idx, R):
-        """Chord solves ``M_j x = R[i]`` for ``j = idx[i]``: each member's LU (LAPACK ``getrs``,
-        the one-by-one arithmetic) or, with ``solves="inverse"``, one batched product."""
-        if INV is not None:
-            return xp.matmul(INV[idx], R[..., None])[..., 0]
+    def _solve(self, lus, idx, R):
+        """Chord solves ``M_j x = R[i]`` for ``j = idx[i]`` with each member's LU factors (LAPACK
+        ``getrs``: the arithmetic of its run alone; a batched product with the inverses was
+        slower here — more refreshes, a factorization's inverse per refresh — and not exact)."""
         out = xp.empty(R.shape)
         for i, j in enumerate(idx):
             out[i] = lus[j].solve(R[i])
@@ -353,15 +335,11 @@ class BatchSimulator:
         converged members and the set of those that did not converge."""
         nx, N = self.nx, self.N
         n = len(rows)
-        inv = self.solves == "inverse"
-        INV = xp.empty((n, N, N)) if inv else None
         lus = []
         FZ = LV = None             # rows held at a limit (mask) and their values
         for j, k in enumerate(rows):
             sim = self.sims[k]
             lus.append(self._lu(k, h))
-            if inv:
-                INV[j] = self._inverse(k, lus[j])
             if sim.frozen.any():
                 if FZ is None:
                     FZ, LV = xp.zeros((n, N), dtype=bool), xp.zeros((n, N))
@@ -374,7 +352,7 @@ class BatchSimulator:
         Rp[:, :nx] = -h * Fn
         if FZ is not None:
             Rp = xp.where(FZ, Zn - LV, Rp)
-        Zp = Zn - self._solve(INV, lus, range(n), Rp)
+        Zp = Zn - self._solve(lus, range(n), Rp)
         Z = Zp.copy()
         refresh = []
         for j, k in enumerate(rows):
@@ -393,9 +371,7 @@ class BatchSimulator:
             self.refresh_jacobian(t1, Z[refresh], [rows[j] for j in refresh])
             for j in refresh:
                 lus[j] = self._lu(rows[j], h)
-                if inv:
-                    INV[j] = self._inverse(rows[j], lus[j])
-            P = Zn[refresh] - self._solve(INV, lus, refresh, Rp[refresh])
+            P = Zn[refresh] - self._solve(lus, refresh, Rp[refresh])
             for i, j in enumerate(refresh):
                 self.sims[rows[j]]._pred = P[i]
         hh = 0.5 * h
@@ -411,7 +387,7 @@ class BatchSimulator:
             R[:, :nx] = Z[live, :nx] - C[live] - hh * f
             if FZ is not None:
                 R = xp.where(FZ[live], Z[live] - LV[live], R)
-            dz = self._solve(INV, lus, live.tolist(), R)
+            dz = self._solve(lus, live.tolist(), R)
             nrm = xp.abs(dz).max(axis=1)
             bad = ~xp.isfinite(nrm)
             conv = nrm < self.sims[rows[0]].tol
@@ -689,20 +665,50 @@ class BatchSimulator:
                 fail(k, exc)
 
     def _sample(self, t, rows, ctls, fail):
-        """Take the due samples of members ``rows``; ``{k: changed}``."""
+        """Take the due samples of members ``rows``; ``{k: changed}``. The ``j``-th controllers
+        of the members that share one ``K`` declared ``batched`` are evaluated by one call of
+        ``K`` on the stacked measurements; the others one by one (:meth:`DigitalController.sample`)."""
         t0 = time.perf_counter()
-        changed = {}
-        for k in rows:
-            sim = self.sims[k]
-            ch = False
-            try:
-                for c in ctls[k]:
-                    if c.due(t):
-                        ch |= c.sample(sim, t, sim.z)
-            except SimulationError as exc:
-                fail(k, exc)
-                continue
-            changed[k] = ch
+        changed = {k: False for k in rows}
+        for j in range(max((len(ctls[k]) for k in rows), default=0)):
+            groups = {}
+            for k in rows:
+                if k not in changed or j >= len(ctls[k]):
+                    continue
+                c = ctls[k][j]
+                if not c.due(t):
+                    continue
+                sim = self.sims[k]
+                try:
+                    if getattr(c, "batched", False):
+                        m = c.measurement(sim, t)
+                        if m is not None:
+                            groups.setdefault(id(c.K), []).append((k, c, m))
+                            continue
+                        changed[k] |= c.hold(t, c.bypass)
+                    else:
+                        changed[k] |= c.sample(sim, t, sim.z)
+                except SimulationError as exc:
+                    fail(k, exc)
+                    del changed[k]
+            for members in groups.values():
+                c0 = members[0][1]
+                try:
+                    U = xp.asarray(c0.K(xp.stack([xp.asarray(m, dtype=float) for _, _, m in members])),
+                                   dtype=float)
+                    if U.shape[0] != len(members):
+                        raise ValueError(f"a batched policy returned {U.shape[0]} rows for {len(members)}")
+                except Exception as exc:
+                    for k, c, _ in members:
+                        fail(k, SimulationError(t, "controller", f"'{c.name}' raised {exc!r}"))
+                        del changed[k]
+                    continue
+                for (k, c, m), u in zip(members, U):
+                    try:
+                        changed[k] |= c.hold(t, u, m)
+                    except SimulationError as exc:
+                        fail(k, exc)
+                        del changed[k]
         self.timing["events"] += time.perf_counter() - t0
         return changed
 
@@ -756,7 +762,7 @@ def breakpoint_key(scenario, dt):
 
 
 def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failure="return",
-                   stats=None, solves="lu", **sim_kw) -> list[Results]:
+                   stats=None, **sim_kw) -> list[Results]:
     """Simulate ``scenarios`` of one grid in batches; one :class:`Results` per scenario, in order.
 
     Parameters
@@ -777,8 +783,6 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
     on_failure : {"return", "raise"}
         A member's failure is in its ``Results.failure``; ``"raise"`` raises the first one after
         every member has run.
-    solves : {"lu", "inverse"}
-        See :class:`BatchSimulator`.
     stats : dict, optional
         Filled with ``batches``, ``rerun`` (members re-run one by one), ``alone`` (members run
         one by one from the start) and ``timing`` (summed :attr:`BatchSimulator.timing`).
@@ -821,7 +825,7 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
     for members in groups.values():
         for a in range(0, len(members), batch_size):
             part = members[a:a + batch_size]
-            bs = BatchSimulator(system, [scenarios[i] for i in part], solves=solves, **sim_kw)
+            bs = BatchSimulator(system, [scenarios[i] for i in part], **sim_kw)
             res, rerun = bs.run(t_end)
             st["batches"] += 1
             for key, v in bs.timing.items():
