@@ -568,7 +568,8 @@ class BatchSimulator:
                 for k in act:
                     self.sims[k].t = tb
             own = [k for k in act if hit and abs(nb_k[k] - tb) <= eps * max(1.0, abs(tb)) * 10]
-            plain = [k for k in act if k not in own]
+            own_set = set(own)
+            plain = [k for k in act if k not in own_set]
             if plain and nstep % self.sims[plain[0]].save_every == 0:
                 self._record(self.t, plain, recs, ctx, act)
             if own:
@@ -633,9 +634,7 @@ class BatchSimulator:
             return None
         Z = xp.stack([self.sims[k].z for k in act])
         F, ctx = self.residual(self.t, Z, act)
-        self._pos = {k: j for j, k in enumerate(act)}
-        for j, k in enumerate(act):
-            self.sims[k]._ctx = _RowCtx(ctx, j, self.sims[k].sys)
+        self._pos = {k: j for j, k in enumerate(act)}   # a member's view is made when it is read
         self._ctx = ctx
         return ctx
 
@@ -679,6 +678,7 @@ class BatchSimulator:
                 if not c.due(t):
                     continue
                 sim = self.sims[k]
+                sim._ctx = _RowCtx(self._ctx, self._pos[k], sim.sys)   # what the measurement reads
                 try:
                     if getattr(c, "batched", False):
                         m = c.measurement(sim, t)
