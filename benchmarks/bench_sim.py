@@ -17,9 +17,10 @@
 5. Batched simulation (:mod:`weakgrid.sim.batch`): the 100 fault scenarios of 2. with their
    clearing times on the 5-ms step grid (so that every member takes the steps of its run alone;
    batched and one-by-one results are equal, ``tests/sim/test_batch.py``), run by
-   ``simulate_batch`` at batch sizes 1, 10, 25, 50, 100 in one process (the two UPQC structures
-   are two grids: a batch holds members of one grid, so 100 means two batches of 50); medians of
-   ``repeats``; batch size 1 on the first ``n_alone`` scenarios only (its rate is per scenario).
+   ``simulate_batch`` at batch sizes 1, 10, 25, 50, 100 in one process, interleaved (the two UPQC
+   structures are two grids: a batch holds members of one grid, so 100 means two batches of 50);
+   medians of ``repeats``; batch size 1 on the first ``n_alone`` scenarios only (its rate is per
+   scenario).
    Scenarios/s and the cost per batched step broken down (residual, Jacobian, LU, Newton
    update, recording, events/samples); then the controlled run of 3. alone and 10 of them (fault
    impedances 0.05-0.14 pu) in one batch, the same breakdown. One process, one core.
@@ -191,29 +192,32 @@ def batched(n=100, sizes=(1, 10, 25, 50, 100), repeats=3, n_alone=10, tf=5.0):
 
     grids = {st: build_gti_upqc_sg(st) for st in ("conventional", "reduced")}
     print(f"== batched: {n} fault scenarios (clearing on the 5-ms grid), GTI + UPQC + SG, {tf:g} s, dt 5 ms ==")
-    rates = {}
-    for b in sizes:
-        m = n_alone if b == 1 else n
-        walls, st_all = [], None
-        for _ in range(repeats):
+    walls = {b: [] for b in sizes}
+    st_all = {}
+    for _ in range(repeats):      # interleaved: load drift hits every batch size alike
+        for b in sizes:
+            m = n_alone if b == 1 else n
             scen = _fault_scenarios(m)
+            st_b = st_all[b] = {"batches": 0, "rerun": 0, "timing": {}}
             t0 = time.perf_counter()
-            st_all = {"batches": 0, "rerun": 0, "steps": 0, "timing": {}}
             for grid in grids:
                 st = {}
                 sc = [s for g, s in scen if g == grid]
                 simulate_batch(grids[grid], sc, tf, dt=5e-3, tol=1e-6, batch_size=b, stats=st)
-                st_all["batches"] += st["batches"]
-                st_all["rerun"] += st["rerun"]
+                st_b["batches"] += st["batches"]
+                st_b["rerun"] += st["rerun"]
                 for k, v in st["timing"].items():
-                    st_all["timing"][k] = st_all["timing"].get(k, 0.0) + v
-            walls.append(time.perf_counter() - t0)
-        w = statistics.median(walls)
+                    st_b["timing"][k] = st_b["timing"].get(k, 0.0) + v
+            walls[b].append(time.perf_counter() - t0)
+    rates = {}
+    for b in sizes:
+        m = n_alone if b == 1 else n
+        w = statistics.median(walls[b])
         rates[b] = m / w
-        steps = st_all["batches"] * round(tf / 5e-3)   # batched steps (about: a batch steps 1000 times)
+        steps = st_all[b]["batches"] * round(tf / 5e-3)   # batched steps (a batch steps tf/dt times)
         print(f"batch {b:3d}: {m} scenarios median {w:.2f} s -> {m / w:.2f} scenarios/s "
-              f"({st_all['batches']} batches, {st_all['rerun']} re-run alone)  per batched step: "
-              f"{_breakdown(st_all['timing'], steps)}")
+              f"({st_all[b]['batches']} batches, {st_all[b]['rerun']} re-run alone)  per batched step "
+              f"(last repeat): {_breakdown(st_all[b]['timing'], steps)}")
     for b in sizes[1:]:
         print(f"speed-up batch {b} vs 1: {rates[b] / rates[1]:.1f}x")
 
@@ -247,6 +251,9 @@ def batched_controlled(tf=5.0, n_batch=10):
 
 
 if __name__ == "__main__":
+    if sys.argv[1:2] == ["batched-quick"]:     # interleaved 1 / 50 / 100 only (a loaded machine)
+        batched(sizes=(1, 50, 100), n_alone=5)
+        sys.exit()
     which = sys.argv[1:] or ["kundur", "scenarios", "controlled", "recording", "batched", "batched_controlled"]
     for w in which:
         globals()[w]()
