@@ -14,7 +14,18 @@
    in the same run, interleaved: the controlled run of 3. and the fault scenarios of 2. (20 of
    them); medians of ``n`` repeats and their ratio (goal: all / selective ≤ 1.10).
 
-Run:  PYTHONPATH=src python benchmarks/bench_sim.py [kundur] [scenarios] [controlled] [recording]
+5. Batched simulation (:mod:`weakgrid.sim.batch`): the 100 fault scenarios of 2. with their
+   clearing times on the 5-ms step grid (so that every member takes the steps of its run alone;
+   batched and one-by-one results are equal, ``tests/sim/test_batch.py``), run by
+   ``simulate_batch`` at batch sizes 1, 10, 25, 50, 100 in one process, interleaved (the two UPQC
+   structures are two grids: a batch holds members of one grid, so 100 means two batches of 50);
+   medians of ``repeats``; batch size 1 on the first ``n_alone`` scenarios only (its rate is per
+   scenario).
+   Scenarios/s and the cost per batched step broken down (residual, Jacobian, LU, Newton
+   update, recording, events/samples); then the controlled run of 3. alone and 10 of them (fault
+   impedances 0.05-0.14 pu) in one batch, the same breakdown. One process, one core.
+
+Run:  PYTHONPATH=src python benchmarks/bench_sim.py [kundur] [scenarios] [controlled] [recording] [batched]
 """
 
 from __future__ import annotations
@@ -156,7 +167,93 @@ def recording(n=5, tf=5.0, n_scen=20):
               f"({shape[(case, 'selective')]})  all/selective {a / b:.3f}")
 
 
+def _fault_scenarios(n, dt=5e-3):
+    """The scenarios of :func:`scenarios`, clearing times rounded onto the step grid."""
+    from weakgrid.sim.events import Fault
+
+    rng = np.random.default_rng(0)
+    out = []
+    for k in range(n):
+        bus = int(rng.integers(1, 4))
+        toff = 0.2 + round(float(rng.uniform(0.03, 0.15)) / dt) * dt
+        xf = float(rng.uniform(0.02, 0.2))
+        out.append(("reduced" if k % 2 else "conventional", {"events": [Fault(bus, 0.2, toff, xf=xf)]}))
+    return out
+
+
+def _breakdown(timing, steps):
+    return "  ".join(f"{k} {v / max(steps, 1) * 1e3:.3f}" for k, v in timing.items()) + " [ms/step]"
+
+
+def batched(n=100, sizes=(1, 10, 25, 50, 100), repeats=3, n_alone=10, tf=5.0):
+    from sim_cases import build_gti_upqc_sg
+
+    from weakgrid.sim.batch import simulate_batch
+
+    grids = {st: build_gti_upqc_sg(st) for st in ("conventional", "reduced")}
+    print(f"== batched: {n} fault scenarios (clearing on the 5-ms grid), GTI + UPQC + SG, {tf:g} s, dt 5 ms ==")
+    walls = {b: [] for b in sizes}
+    st_all = {}
+    for _ in range(repeats):      # interleaved: load drift hits every batch size alike
+        for b in sizes:
+            m = n_alone if b == 1 else n
+            scen = _fault_scenarios(m)
+            st_b = st_all[b] = {"batches": 0, "rerun": 0, "timing": {}}
+            t0 = time.perf_counter()
+            for grid in grids:
+                st = {}
+                sc = [s for g, s in scen if g == grid]
+                simulate_batch(grids[grid], sc, tf, dt=5e-3, tol=1e-6, batch_size=b, stats=st)
+                st_b["batches"] += st["batches"]
+                st_b["rerun"] += st["rerun"]
+                for k, v in st["timing"].items():
+                    st_b["timing"][k] = st_b["timing"].get(k, 0.0) + v
+            walls[b].append(time.perf_counter() - t0)
+    rates = {}
+    for b in sizes:
+        m = n_alone if b == 1 else n
+        w = statistics.median(walls[b])
+        rates[b] = m / w
+        steps = st_all[b]["batches"] * round(tf / 5e-3)   # batched steps (a batch steps tf/dt times)
+        print(f"batch {b:3d}: {m} scenarios median {w:.2f} s -> {m / w:.2f} scenarios/s "
+              f"({st_all[b]['batches']} batches, {st_all[b]['rerun']} re-run alone)  per batched step "
+              f"(last repeat): {_breakdown(st_all[b]['timing'], steps)}")
+    for b in sizes[1:]:
+        print(f"speed-up batch {b} vs 1: {rates[b] / rates[1]:.1f}x")
+
+
+def batched_controlled(tf=5.0, n_batch=10):
+    from sim_cases import build_gti_upqc_sg
+
+    from weakgrid.sim.batch import BatchSimulator
+    from weakgrid.sim.controllers import DigitalController, UPQCTarget, gti_design_states
+    from weakgrid.sim.events import Fault
+
+    def K(m):   # the policy of controlled(), on arrays: one call for the whole batch
+        m = np.asarray(m, dtype=float)
+        return np.stack([np.clip(-0.5 * m[..., 0] - 2.0 * m[..., 1], -0.15, 0.15),
+                         np.clip(-0.2 * m[..., 1], -0.1, 0.1)], axis=-1)
+
+    s = build_gti_upqc_sg("reduced")
+    print(f"== batched DigitalController T = 1 ms, {tf:g} s, dt 1 ms ==")
+    for B in (1, n_batch):
+        sc = [{"events": [Fault(3, 0.2, 0.25, xf=0.05 + 0.01 * k)],
+               "controllers": [DigitalController(K, 1e-3, gti_design_states("PV"), UPQCTarget("U"),
+                                                 enable=[(0.25, tf)], batched=True)]} for k in range(B)]
+        bs = BatchSimulator(s, sc, dt=1e-3)
+        t0 = time.perf_counter()
+        res, rerun = bs.run(tf)
+        w = time.perf_counter() - t0
+        ok = sum(r is not None and r.ok for r in res)
+        print(f"{B:3d} run(s) in one batch: {w:.2f} s, {w / B:.2f} s per run, {ok}/{B} completed, "
+              f"{len(rerun)} re-run alone; {bs.steps} steps, {_breakdown(bs.timing, bs.steps)}")
+        print(f"    member 0 stats {res[0].stats if res[0] is not None else None}")
+
+
 if __name__ == "__main__":
-    which = sys.argv[1:] or ["kundur", "scenarios", "controlled", "recording"]
+    if sys.argv[1:2] == ["batched-quick"]:     # interleaved 1 / 50 / 100 only (a loaded machine)
+        batched(sizes=(1, 50, 100), n_alone=5)
+        sys.exit()
+    which = sys.argv[1:] or ["kundur", "scenarios", "controlled", "recording", "batched", "batched_controlled"]
     for w in which:
         globals()[w]()

@@ -117,6 +117,10 @@ class Component:
     #: the model injects current and can be disconnected by a generator trip
     #: (:class:`~weakgrid.sim.events.GeneratorTrip`): its injection goes through :meth:`connected`
     disconnectable: bool = False
+    #: attributes a run changes from outside (a controller's held output, e.g. UPQC ``u_p``):
+    #: arrays over the instances that the batch simulator (:mod:`weakgrid.sim.batch`) holds per
+    #: member, with a leading batch axis when the members are evaluated together
+    batch_inputs: tuple[str, ...] = ()
     #: outputs that record zero once an instance is disconnected (its power and currents)
     injection_outputs: tuple[str, ...] = ()
     #: per instance 1.0 (connected) or 0.0 (disconnected by a generator trip); None: all connected

@@ -141,13 +141,20 @@ class DigitalController:
         Used in error messages.
     t0 : float
         First sampling instant [s].
+    batched : bool
+        ``K`` also takes a ``(B, n)`` array of ``B`` measurement vectors and returns the
+        ``(B, target.size)`` outputs (a trained network evaluated row-wise, a linear feedback on
+        arrays): the batch simulator (:mod:`weakgrid.sim.batch`) then calls it once for all the
+        members it samples at an instant that share this ``K``.
     """
 
-    def __init__(self, K, T, measure, target, enable=None, bypass=None, name="controller", t0=0.0):
+    def __init__(self, K, T, measure, target, enable=None, bypass=None, name="controller", t0=0.0,
+                 batched=False):
         if not (T > 0 and math.isfinite(T)):
             raise DataError(f"DigitalController '{name}'", "T", T, "sampling period must be a positive number of seconds")
         self.K, self.T, self.measure, self.target = K, float(T), measure, target
         self.enable, self.name, self.t0 = enable, name, float(t0)
+        self.batched = bool(batched)
         self.bypass = None if bypass is None else np.asarray(bypass, float)
         self.k = 0
         self.log_t, self.log_u = [], []
@@ -181,18 +188,32 @@ class DigitalController:
 
     def sample(self, sim, t, z):
         """Compute and hold a new output; returns True if it changed."""
-        if self.active(t):
-            m = self.measure(sim, t, z, sim._ctx)
+        m = self.measurement(sim, t)
+        if m is None:
+            return self.hold(t, self.bypass)
+        try:
+            u = self.K(m)
+        except Exception as exc:
+            raise SimulationError(t, "controller", f"'{self.name}' raised {exc!r}") from exc
+        return self.hold(t, u, m)
+
+    def measurement(self, sim, t):
+        """The measurement vector at a sample ``t`` of ``sim``, or None while disabled."""
+        return self.measure(sim, t, sim.z, sim._ctx) if self.active(t) else None
+
+    def hold(self, t, u, m=None):
+        """Check the policy's output ``u`` for measurement ``m`` (None: the bypass) and hold it
+        from sample ``t`` on; returns True if the held output changed. (:meth:`sample` in two
+        halves, so that a batch of members can evaluate ``K`` once for all of them.)"""
+        if m is not None:
             try:
-                u = np.asarray(self.K(m), dtype=float).reshape(-1)
+                u = np.asarray(u, dtype=float).reshape(-1)
             except Exception as exc:
                 raise SimulationError(t, "controller", f"'{self.name}' raised {exc!r}") from exc
             if u.shape != (self.target.size,) or not np.all(np.isfinite(u)):
                 raise SimulationError(t, "controller",
                                       f"'{self.name}' returned {u.tolist()} for measurements {np.asarray(m).tolist()}; "
                                       f"expected {self.target.size} finite values")
-        else:
-            u = self.bypass
         self.k += 1
         old = self.target.get()
         self.log_t.append(t)

@@ -73,6 +73,9 @@ class UPQC(Component):
     """Vectorized UPQCs (series converter, and the shunt converter with its dc link in the
     conventional structure); add instances with :meth:`add_upqc`."""
 
+    #: the series-voltage commands [pu] a controller holds: per member in a batch
+    batch_inputs = ("u_p", "u_q")
+
     kind = "device"
     order = 3
     params = (

@@ -1,0 +1,848 @@
+"""Batched simulation: many scenarios of one grid advanced by one simulator pass.
+
+Every component type is vectorized over its instances and :meth:`System.evaluate` already
+takes a leading batch axis (it is how the coloured finite-difference Jacobian evaluates its
+perturbed points), so a batch of ``B`` *members* — the same grid under different events and
+controllers — is one ``(B, N)`` array of variables evaluated by one call per Newton iteration.
+The Python overhead of a step (the main cost of a small grid) is paid once for the batch.
+
+What each member keeps of its own, so that its trajectory is the one of its one-by-one run
+(:class:`~weakgrid.sim.integrate.Simulator`):
+
+* a :class:`Simulator` of its own (on a copy of the grid: its network, events, held limits,
+  chord matrix and its LU, Jacobian refresh decisions, predictor and statistics) — the
+  batch vectorizes only the residual, the Jacobian's finite differences and the Newton
+  updates, and calls the member's own methods for everything else (its LU, the predictor,
+  the consistent re-solve after a jump when the chord iteration does not converge);
+* its Newton convergence: a member whose update is below ``tol`` is left at the point it
+  evaluated (converged members are not moved by further iterations of the others);
+* its failure: a member that loses synchronism, diverges, or whose re-solve fails stops
+  alone with the failure its one-by-one run reports; a member whose step must be halved
+  (Newton fails even with a fresh Jacobian) leaves the lockstep and is re-run one-by-one
+  (the same code path, so the same result, including a Newton failure).
+
+The members step together: the step ends at the earliest breakpoint of any member (event,
+controller sample). A member's steps are then those of its one-by-one run when the members'
+breakpoints coincide or lie on the step grid (multiples of ``dt``); :func:`simulate_batch`
+groups the members by their breakpoints off that grid so that this always holds
+(``exact=True``), or lets them share steps (``exact=False``: a member's run then differs
+from its one-by-one run by the step error, not by round-off).
+
+The array code uses the namespace ``xp`` (NumPy) so that an array-API backend could replace
+it for large batches; the linear solves stay per member (LAPACK through
+:mod:`weakgrid.sim.linsolve`, exactly the one-by-one factorization and solve).
+
+Scope: dense networks (``nb <= system.DENSE_NETWORK_MAX``), members that share every device
+parameter (events and controllers differ), events that change the network (:class:`Fault`,
+:class:`LineTrip`, :class:`LoadStep`). A member outside it (a :class:`GeneratorTrip`, a model
+whose limits move with the solution or with discrete memory) is run one-by-one by
+:func:`simulate_batch`; the results are the same, only slower.
+"""
+
+from __future__ import annotations
+
+import copy
+import logging
+import math
+import time
+from collections.abc import Mapping
+
+import numpy as np
+
+from .errors import DataError, SimulationError
+from .integrate import Simulator, _held, _output_path
+from .results import Results
+
+xp = np     # the array namespace of the batched arithmetic (array API: swap for another backend)
+
+log = logging.getLogger(__name__)
+
+#: parts of a batched step timed by :attr:`BatchSimulator.timing` [s]
+TIMED = ("residual", "jacobian", "lu", "newton", "record", "events")
+
+
+class _Rows(Mapping):
+    """Row ``k`` of each batched array of a context's ``sig`` / ``out`` dict (read-only view)."""
+
+    __slots__ = ("d", "k")
+
+    def __init__(self, d, k):
+        self.d, self.k = d, k
+
+    def __getitem__(self, key):
+        v = self.d[key]
+        return v[self.k] if np.ndim(v) >= 2 else v
+
+    def __iter__(self):
+        return iter(self.d)
+
+    def __len__(self):
+        return len(self.d)
+
+
+class _RowCtx:
+    """One member's view of a batched evaluation context (what recorders and measurements read)."""
+
+    __slots__ = ("t", "x", "V", "f", "I", "sig", "out", "system")
+
+    def __init__(self, ctx, k, system):
+        self.system = system
+        self.t = ctx.t
+        self.x, self.V, self.f, self.I = ctx.x[k], ctx.V[k], ctx.f[k], ctx.I[k]
+        self.sig, self.out = _Rows(ctx.sig, k), _Rows(ctx.out, k)
+
+
+class _BatchRecorder:
+    """Records every member of a batch: one vectorized row block per recording instant, split
+    into one :class:`Results` per member at the end (same columns as :meth:`Results.recorder`)."""
+
+    def __init__(self, system, record):
+        self.rec = Results.recorder(system, record)   # its layout (names, units, columns)
+        self.sys = system
+        self.blocks = []
+
+    def add(self, t, members, Z, ctx, pos):
+        """Record members ``members`` (their points ``Z``, one row each) whose rows in the
+        batched ``ctx`` are ``pos``."""
+        rec = self.rec
+        if not rec._layout_done:
+            rec._layout(_RowCtx(ctx, pos[0], self.sys))
+            rec._plan()
+        nx, nb = self.sys.nx, self.sys.nb
+        row = xp.empty((len(members), rec._ncol))
+        row[:, :nx] = Z[:, :nx]
+        Vr, Vi = Z[:, nx:nx + nb], Z[:, nx + nb:]
+        bus = row[:, rec._bus]
+        bus[:, 0::4], bus[:, 1::4] = Vr, Vi
+        bus[:, 2::4] = xp.hypot(Vr, Vi)
+        bus[:, 3::4] = xp.arctan2(Vi, Vr)
+        for key, sl in rec._outs:
+            v = ctx.out[key]
+            row[:, sl] = v[pos] if np.ndim(v) >= 2 else v
+        row[:, rec._tm] = ctx.sig["tm"][pos]
+        row[:, rec._vs] = ctx.sig["vs"][pos]
+        if rec.sel is not None:
+            row = row[:, rec.sel]
+        self.blocks.append((t, xp.asarray(members), row))
+
+    def finish(self, B, failures, stats):
+        """One :class:`Results` per member ``0..B-1``."""
+        rec = self.rec
+        if not rec._layout_done:    # nothing recorded (every member failed at t = 0)
+            return [Results(xp.zeros(0), [], xp.zeros((0, 0)), [], [], failure=failures[k], stats=stats[k])
+                    for k in range(B)]
+        if self.blocks:
+            T = xp.concatenate([xp.full(len(m), t) for t, m, _ in self.blocks])
+            K = xp.concatenate([m for _, m, _ in self.blocks])
+            D = xp.concatenate([d for _, _, d in self.blocks])
+            order = xp.argsort(K, kind="stable")
+            T, K, D = T[order], K[order], D[order]
+            cut = xp.searchsorted(K, xp.arange(B + 1))
+        out = []
+        for k in range(B):
+            if self.blocks:
+                a, b = cut[k], cut[k + 1]
+                t, data = T[a:b].copy(), D[a:b].copy()
+            else:
+                t, data = xp.zeros(0), xp.zeros((0, len(rec.names)))
+            out.append(Results(t, list(rec.names), data, list(rec.kinds), list(rec.fac),
+                               failure=failures[k], stats=stats[k]))
+        return out
+
+
+def batch_unsupported(system, events=()) -> str | None:
+    """Why a member with ``events`` on ``system`` cannot join a batch (None if it can)."""
+    from .events import GeneratorTrip, flatten
+    from .system import DENSE_NETWORK_MAX
+
+    if system.nb > DENSE_NETWORK_MAX:
+        return f"sparse network ({system.nb} buses > {DENSE_NETWORK_MAX})"
+    if system._var_lim:
+        return "limits that move with the solution (" + ", ".join(c.type_name for c, _ in system._var_lim) + ")"
+    if system._accepting:
+        return "components with discrete memory (" + ", ".join(c.type_name for c in system._accepting) + ")"
+    if system.disconnected is not None:
+        return "a disconnected unit"
+    if any(isinstance(e, GeneratorTrip) for e in flatten(list(events))):
+        return "a GeneratorTrip event (it changes the devices, not the network)"
+    return None
+
+
+class BatchSimulator:
+    """Advance ``B`` members (copies of one set-up grid, each with its events and controllers)
+    together from ``t = 0`` (see the module docstring).
+
+    Parameters
+    ----------
+    system : System
+        The grid, set up; each member simulates a deep copy (the argument is not changed).
+    scenarios : list of dict
+        One per member: ``{"events": [...], "controllers": [...]}`` (both optional), the
+        arguments of :meth:`Simulator.run`. Event and controller objects must not be shared
+        between members (they hold per-run state).
+    **sim_kw
+        Keyword arguments of :class:`Simulator` (``dt``, ``tol``, ``max_iter``,
+        ``max_angle_spread``, ``save_every``, ``record``; ``linear_solver`` must be dense).
+
+    Attributes
+    ----------
+    timing : dict
+        Wall time [s] spent in each part of the batched steps (:data:`TIMED`).
+    steps : int
+        Batched steps taken.
+    """
+
+    def __init__(self, system, scenarios, **sim_kw):
+        if not system.is_setup:
+            system.setup()
+        why = batch_unsupported(system)
+        if why:
+            raise DataError("simulate_batch", "system", why, "run these scenarios one by one (Simulator.run)")
+        if sim_kw.get("linear_solver", "dense") not in ("dense", "auto"):
+            raise DataError("simulate_batch", "linear_solver", sim_kw["linear_solver"],
+                            'the batch uses the dense solver: leave linear_solver at "auto"')
+        sim_kw = dict(sim_kw, linear_solver="dense")
+        self.sim_kw = sim_kw
+        self.tmpl = copy.deepcopy(system)      # evaluates the devices of every member
+        self.scen = [dict(s) for s in scenarios]
+        self.B = len(self.scen)
+        self.sims = []
+        for sc in self.scen:
+            why = batch_unsupported(system, sc.get("events", ()))
+            if why:
+                raise DataError("simulate_batch", "events", why, "run this scenario one by one (Simulator.run)")
+            self.sims.append(Simulator(copy.deepcopy(system), **sim_kw))
+        self.nx, self.N = system.nx, system.N
+        # controller outputs and other inputs a member changes: one (B, n) array per attribute,
+        # each member's component holding a row view of it (Component.batch_inputs)
+        self._inputs = []
+        for c in self.tmpl.comps:
+            for attr in getattr(c, "batch_inputs", ()):
+                stack = xp.stack([xp.asarray(getattr(s.sys.components[c.type_name], attr), dtype=float)
+                                  for s in self.sims])
+                for k, s in enumerate(self.sims):
+                    setattr(s.sys.components[c.type_name], attr, stack[k])
+                self._inputs.append((c, attr, stack))
+        nb = system.nb
+        self.Y = xp.empty((self.B, 2 * nb, 2 * nb))
+        self._ynet = [None] * self.B
+        self.timing = dict.fromkeys(TIMED, 0.0)
+        self.steps = 0
+
+    # ------------------------------------------------------------- evaluations
+    def _bind_inputs(self, rows, rep=1):
+        for c, attr, stack in self._inputs:
+            a = stack[rows]
+            setattr(c, attr, a if rep == 1 else xp.repeat(a, rep, axis=0))
+
+    def _sync_network(self, rows):
+        for k in rows:
+            s = self.sims[k].sys
+            if self._ynet[k] != s.net_version:
+                self.Y[k] = s.Yr_dense
+                self._ynet[k] = s.net_version
+
+    def residual(self, t, Z, rows):
+        """``F = [f; g]`` of members ``rows`` at the points ``Z`` (one row each) and the context."""
+        t0 = time.perf_counter()
+        nx = self.nx
+        self._bind_inputs(rows)
+        F, ctx = self.tmpl.device_residual(t, Z)
+        F[:, nx:] += xp.matmul(self.Y[rows], Z[:, nx:, None])[..., 0]
+        self.timing["residual"] += time.perf_counter() - t0
+        return F, ctx
+
+    def refresh_jacobian(self, t, Z, rows):
+        """Device Jacobians of members ``rows`` at ``Z`` by coloured differences, all in one
+        evaluation; stored in each member's simulator as its own refresh would."""
+        t0 = time.perf_counter()
+        s = self.tmpl
+        nc, N = s.ncolours, self.N
+        H = 1e-7 * xp.maximum(1.0, xp.abs(Z))
+        P = xp.repeat(Z[:, None, :], nc + 1, axis=1)
+        cols = s._ccols
+        P[:, s.colour[cols] + 1, cols] += H[:, cols]
+        self._bind_inputs(rows, nc + 1)
+        D = s.device_residual(t, P.reshape(-1, N))[0].reshape(len(rows), nc + 1, N)
+        vals = (D[:, s._pcol + 1, s._pr] - D[:, 0, s._pr]) / H[:, s._pc]
+        for j, k in enumerate(rows):
+            sim = self.sims[k]
+            sim._refresh_next = False
+            sim._Jdev = vals[j]
+            sim.linsolver.set_device_jacobian(vals[j])
+            sim.stats["jac"] += 1
+            sim.stats["evals"] += nc + 1
+            sim._lu_key = None
+            sim._alg_key = None
+        self.timing["jacobian"] += time.perf_counter() - t0
+
+    def _lu(self, k, h):
+        t0 = time.perf_counter()
+        lu = self.sims[k]._iteration_lu(h)
+        self.timing["lu"] += time.perf_counter() - t0
+        return lu
+
+    # ------------------------------------------------------------------ solves
+    def _alg_chord(self, t, Z, rows):
+        """Chord iteration on the network variables of members ``rows`` (each member's own
+        algebraic LU), as :meth:`Simulator._alg_chord`; returns ``{k: (z, F)}`` of the
+        members that converged (the others diverged or stalled)."""
+        nx = self.nx
+        done = {}
+        live = list(range(len(rows)))
+        prev = [math.inf] * len(rows)
+        grow = [0] * len(rows)
+        evals = [0] * len(rows)
+        Z = Z.copy()
+        for _ in range(30):
+            if not live:
+                break
+            idx = [rows[j] for j in live]
+            F, _ = self.residual(t, Z[live], idx)
+            keep = []
+            for i, j in enumerate(live):
+                sim = self.sims[rows[j]]
+                evals[j] += 1
+                dy = sim._alg_lu_get().solve(F[i, nx:])
+                nrm = float(xp.max(xp.abs(dy)))
+                if not math.isfinite(nrm):
+                    continue
+                if nrm < sim.tol:
+                    done[rows[j]] = (Z[j].copy(), F[i].copy())
+                    sim.stats["evals"] += evals[j]   # a member that falls back counts its own
+                    continue
+                grow[j] = grow[j] + 1 if nrm > 0.9 * prev[j] else 0
+                if grow[j] >= 2:
+                    continue
+                prev[j] = nrm
+                Z[j, nx:] -= dy
+                keep.append(j)
+            live = keep
+        return done
+
+    def _solve(self, lus, idx, R):
+        """Chord solves ``M_j x = R[i]`` for ``j = idx[i]`` with each member's LU factors (LAPACK
+        ``getrs``: the arithmetic of its run alone; a batched product with the inverses was
+        slower here — more refreshes, a factorization's inverse per refresh — and not exact)."""
+        out = xp.empty(R.shape)
+        for i, j in enumerate(idx):
+            out[i] = lus[j].solve(R[i])
+        return out
+
+    def _newton(self, t1, h, Zn, Fn, rows, guess, corr):
+        """One chord-Newton attempt of the trapezoidal step for members ``rows`` (as
+        :meth:`Simulator._newton`, one member per row). Returns ``{k: (z, nit, f)}`` for the
+        converged members and the set of those that did not converge."""
+        nx, N = self.nx, self.N
+        n = len(rows)
+        lus = []
+        FZ = LV = None             # rows held at a limit (mask) and their values
+        for j, k in enumerate(rows):
+            sim = self.sims[k]
+            lus.append(self._lu(k, h))
+            if sim.frozen.any():
+                if FZ is None:
+                    FZ, LV = xp.zeros((n, N), dtype=bool), xp.zeros((n, N))
+                li = sim.sys.lim_idx
+                fz = sim.frozen != 0
+                FZ[j, li[fz]] = True
+                LV[j, li[fz]] = xp.where(sim.frozen > 0, sim.sys.lim_hi, sim.sys.lim_lo)[fz]
+        # linearly implicit predictor of every member (used by those without a guess)
+        Rp = xp.zeros((n, N))
+        Rp[:, :nx] = -h * Fn
+        if FZ is not None:
+            Rp = xp.where(FZ, Zn - LV, Rp)
+        Zp = Zn - self._solve(lus, range(n), Rp)
+        Z = Zp.copy()
+        refresh = []
+        for j, k in enumerate(rows):
+            sim = self.sims[k]
+            if guess[k] is None:
+                sim._pred = Zp[j].copy()
+                if corr[k] is not None:
+                    Z[j] += corr[k]
+                if sim._refresh_next:
+                    refresh.append(j)
+            else:
+                Z[j] = guess[k]
+        if FZ is not None:
+            Z = xp.where(FZ, LV, Z)
+        if refresh:   # the chord matrix refreshed at the predicted points (all in one evaluation)
+            self.refresh_jacobian(t1, Z[refresh], [rows[j] for j in refresh])
+            for j in refresh:
+                lus[j] = self._lu(rows[j], h)
+            P = Zn[refresh] - self._solve(lus, refresh, Rp[refresh])
+            for i, j in enumerate(refresh):
+                self.sims[rows[j]]._pred = P[i]
+        hh = 0.5 * h
+        C = Zn[:, :nx] + hh * Fn
+        done, failed = {}, set()
+        live = xp.arange(n)
+        max_iter = self.sims[rows[0]].max_iter
+        for it in range(max_iter):
+            F, _ = self.residual(t1, Z[live], [rows[j] for j in live.tolist()])
+            t0 = time.perf_counter()
+            f = F[:, :nx].copy()
+            R = F
+            R[:, :nx] = Z[live, :nx] - C[live] - hh * f
+            if FZ is not None:
+                R = xp.where(FZ[live], Z[live] - LV[live], R)
+            dz = self._solve(lus, live.tolist(), R)
+            nrm = xp.abs(dz).max(axis=1)
+            bad = ~xp.isfinite(nrm)
+            conv = nrm < self.sims[rows[0]].tol
+            for i in xp.nonzero(bad | conv)[0].tolist():
+                j = int(live[i])
+                k = rows[j]
+                st = self.sims[k].stats
+                st["evals"] += it + 1
+                st["newton"] += it + 1
+                if bad[i]:
+                    failed.add(k)
+                else:
+                    done[k] = (Z[j].copy(), it + 1, f[i])
+            go = ~(bad | conv)
+            Z[live[go]] -= dz[go]
+            live = live[go]
+            self.timing["newton"] += time.perf_counter() - t0
+            if not len(live):
+                break
+        for j in live.tolist():
+            k = rows[j]
+            self.sims[k].stats["evals"] += max_iter
+            self.sims[k].stats["newton"] += max_iter
+            failed.add(k)
+        return done, failed
+
+    def _step(self, h, act):
+        """One step ``h`` of every member in ``act`` (as :meth:`Simulator._step`). Returns the
+        members that must leave the lockstep (their step has to be shortened)."""
+        t = self.t
+        zn = {k: self.sims[k].z for k in act}
+        fn = {k: self.sims[k]._f for k in act}
+        guess = dict.fromkeys(act)
+        refreshed = dict.fromkeys(act, False)
+        corr = {}
+        for k in act:
+            sim = self.sims[k]
+            ok = sim._corr is not None and abs(sim._corr_h - h) <= 1e-9 * h
+            corr[k] = sim._corr if ok else None
+        pending = list(act)
+        eject = []
+        while pending:
+            Zn = xp.stack([zn[k] for k in pending])
+            Fn = xp.stack([fn[k] for k in pending])
+            done, failed = self._newton(t + h, h, Zn, Fn, pending, guess, corr)
+            nxt = []
+            fresh = []
+            for k in pending:
+                if k in failed:
+                    if not refreshed[k]:
+                        fresh.append(k)
+                        refreshed[k] = True
+                        guess[k] = corr[k] = None
+                        nxt.append(k)
+                    else:
+                        eject.append(k)
+                    continue
+                z, nit, f1 = done[k]
+                sim = self.sims[k]
+                li = sim.sys.lim_idx
+                if len(li):
+                    s = sim.sys
+                    xl = z[li]
+                    new_hi = (sim.frozen == 0) & (xl > s.lim_hi + 1e-9)
+                    new_lo = (sim.frozen == 0) & (xl < s.lim_lo - 1e-9)
+                    if s.any_pushing:
+                        fl, push = f1[li], s.lim_pushing
+                        new_hi &= ~push | (fl >= 0)
+                        new_lo &= ~push | (fl <= 0)
+                    if new_hi.any() or new_lo.any():
+                        sim.frozen[new_hi] = 1
+                        sim.frozen[new_lo] = -1
+                        guess[k] = z
+                        if (s.lim_pushing & (new_hi | new_lo)).any():
+                            g = z.copy()
+                            g[li[new_hi]] = s.lim_hi[new_hi]
+                            g[li[new_lo]] = s.lim_lo[new_lo]
+                            guess[k] = sim.solve_algebraic(t + h, g)
+                            sim._refresh_jacobian(t + h, guess[k])
+                        nxt.append(k)
+                        continue
+                    sim._release_held(f1)
+                sim._corr = z - sim._pred if guess[k] is None else None
+                sim._corr_h = h
+                if nit > sim.max_iter // 2 - 1:
+                    sim._refresh_next = True
+                sim.z, sim._f = z, f1.copy()
+                sim.t = t + h
+                sim.stats["steps"] += 1
+            if fresh:
+                self.refresh_jacobian(t, xp.stack([zn[k] for k in fresh]), fresh)
+            pending = nxt
+        return eject
+
+    # -------------------------------------------------------------------- run
+    def run(self, t_end):
+        """Simulate every member from 0 to ``t_end`` [s]; returns ``(results, rerun)``: one
+        :class:`Results` per member (None for the members listed in ``rerun``, which left the
+        lockstep and must be run one by one)."""
+        from .events import flatten
+
+        t_end = float(t_end)
+        B, nx = self.B, self.nx
+        evs, ctls, recs = [], [], []
+        for sc, sim in zip(self.scen, self.sims):
+            events = list(sc.get("events", ()))
+            for ev in flatten(events):
+                if ev.t > t_end:
+                    raise DataError(repr(ev), "t", ev.t, f"the event comes after the end of the run "
+                                    f"(t_end = {t_end:g} s): move it earlier or simulate longer")
+            for ev in events:
+                if hasattr(ev, "parts"):
+                    ev.validate(sim.sys)
+            events = sorted(flatten(events), key=lambda e: e.t)
+            for ev in events:
+                ev.validate(sim.sys)
+            controllers = list(sc.get("controllers", ()))
+            for c in controllers:
+                c.bind(sim.sys)
+            evs.append(events)
+            ctls.append(controllers)
+            sim._corr = sim._corr_h = None
+            sim._refresh_next = False
+            sim._jump, sim._jump_t = None, -math.inf
+        recs = _BatchRecorder(self.sims[0].sys, self.sims[0].record)
+        failures, fstats = [None] * B, [None] * B
+        rerun = []
+        act = list(range(B))
+        self._sync_network(act)
+        self.t = 0.0
+
+        def fail(k, exc):
+            failures[k], fstats[k] = exc, dict(self.sims[k].stats)
+            act.remove(k)
+
+        # initial point: network solved with the initial Jacobian, controllers' first samples
+        Z = xp.stack([self.sims[k].z for k in act])
+        self.refresh_jacobian(0.0, Z, act)
+        self._solve_jump(0.0, act, {}, {}, fail)
+        with_ctl = [k for k in act if ctls[k]]
+        if with_ctl:
+            self._accept_all(act)
+            self._sample(0.0, with_ctl, ctls, fail)
+            self._solve_jump(0.0, [k for k in with_ctl if k in act], {}, {}, fail)
+        ctx = self._accept_all(act)
+        for j, k in enumerate(act):
+            sim = self.sims[k]
+            sim._delta0 = xp.array(ctx.sig["delta"][j], dtype=float, copy=True)
+        self._record(0.0, act, recs, ctx)
+        ev_i = [0] * B
+        nstep = 0
+        eps = 1e-12
+        while act and self.t < t_end - eps:
+            nb_k = {}
+            for k in act:
+                tb = t_end
+                if ev_i[k] < len(evs[k]):
+                    tb = min(tb, evs[k][ev_i[k]].t)
+                for c in ctls[k]:
+                    tb = min(tb, c.next_time(self.t))
+                nb_k[k] = tb
+            tb = min(nb_k.values())
+            h = min(self.sims[act[0]].dt, tb - self.t)
+            if tb - (self.t + h) < 1e-3 * self.sims[act[0]].dt:
+                h = tb - self.t
+            if h > eps:
+                for k in self._step(h, act):
+                    act.remove(k)
+                    rerun.append(k)
+                nstep += 1
+                self.steps += 1
+                self.t += h
+                ctx = self._accept_all(act)
+                self._check(act, ctx, fail)
+            hit = abs(self.t - tb) <= eps * max(1.0, abs(tb)) * 10
+            if hit:
+                self.t = tb
+                for k in act:
+                    self.sims[k].t = tb
+            own = [k for k in act if hit and abs(nb_k[k] - tb) <= eps * max(1.0, abs(tb)) * 10]
+            own_set = set(own)
+            plain = [k for k in act if k not in own_set]
+            if plain and nstep % self.sims[plain[0]].save_every == 0:
+                self._record(self.t, plain, recs, ctx, act)
+            if own:
+                self._record(self.t, own, recs, ctx, act)
+                jumps, new_jac, held = {}, {}, {}
+                t0 = time.perf_counter()
+                for k in list(own):
+                    sim = self.sims[k]
+                    events = evs[k]
+                    try:
+                        while ev_i[k] < len(events) and events[ev_i[k]].t <= self.t + 1e-12:
+                            events[ev_i[k]].apply(sim)
+                            ev_i[k] += 1
+                            new_jac[k] = True
+                    except SimulationError as exc:
+                        fail(k, exc)
+                        continue
+                    held[k] = [_held(c) for c in ctls[k]]
+                    if new_jac.get(k):
+                        jumps[k] = None
+                self.timing["events"] += time.perf_counter() - t0
+                own = [k for k in own if k in act]
+                changed = self._sample(self.t, own, ctls, fail)
+                for k in own:
+                    if k in act and (k in jumps or changed.get(k)):
+                        jumps[k] = None
+                self._sync_network(list(jumps))
+                if jumps:
+                    guesses = {}
+                    fresh = [k for k in jumps if new_jac.get(k)]
+                    if fresh:
+                        self.refresh_jacobian(self.t, xp.stack([self.sims[k].z for k in fresh]), fresh)
+                    for k in jumps:
+                        sim = self.sims[k]
+                        if new_jac.get(k):
+                            sim._jump = None
+                            sim._corr = None
+                        elif sim._jump is not None and sim._jump_t > self.t - 1.5 * _gap(ctls[k]):
+                            guesses[k] = sim.z[nx:] + sim._jump
+                    paths = {k: _output_path(ctls[k], held[k]) for k in jumps}
+                    y_before = {k: self.sims[k].z[nx:] for k in jumps}
+                    self._solve_jump(self.t, list(jumps), guesses, paths, fail)
+                    jk = [k for k in jumps if k in act]
+                    for k in jk:
+                        sim = self.sims[k]
+                        if not new_jac.get(k):
+                            sim._jump = sim.z[nx:] - y_before[k]
+                            sim._jump_t = self.t
+                        sim._release_held(sim._f)
+                    ctx = self._accept_all(act)
+                    self._record(self.t, jk, recs, ctx, act)
+        for k in act:
+            fstats[k] = dict(self.sims[k].stats)
+        results = recs.finish(B, failures, fstats)
+        for k in rerun:
+            results[k] = None
+        return results, rerun
+
+    def _accept_all(self, act):
+        """The context of every active member at its accepted point (one evaluation)."""
+        if not act:
+            return None
+        Z = xp.stack([self.sims[k].z for k in act])
+        F, ctx = self.residual(self.t, Z, act)
+        self._pos = {k: j for j, k in enumerate(act)}   # a member's view is made when it is read
+        self._ctx = ctx
+        return ctx
+
+    def _record(self, t, rows, recs, ctx, act=None):
+        if not rows:
+            return
+        t0 = time.perf_counter()
+        recs.add(t, rows, xp.stack([self.sims[k].z for k in rows]), self._ctx,
+                 [self._pos[k] for k in rows])
+        self.timing["record"] += time.perf_counter() - t0
+
+    def _check(self, act, ctx, fail):
+        """Divergence and loss of synchronism, per member (as :meth:`Simulator._check`)."""
+        Z = xp.stack([self.sims[k].z for k in act])
+        bad = ~(xp.abs(Z).max(axis=1) <= 1e6)
+        d = ctx.sig["delta"]
+        if d.shape[-1] > 1:
+            e = d - xp.stack([self.sims[k]._delta0 for k in act])
+            bad |= (e.max(axis=1) - e.min(axis=1)) > self.sims[act[0]].max_spread
+        for j in xp.nonzero(bad)[0].tolist():
+            k = act[j]
+            sim = self.sims[k]
+            sim._ctx = sim.sys.residual(sim.t, sim.z)[1]   # the member's own evaluation
+            try:
+                sim._check()
+            except SimulationError as exc:
+                fail(k, exc)
+
+    def _sample(self, t, rows, ctls, fail):
+        """Take the due samples of members ``rows``; ``{k: changed}``. The ``j``-th controllers
+        of the members that share one ``K`` declared ``batched`` are evaluated by one call of
+        ``K`` on the stacked measurements; the others one by one (:meth:`DigitalController.sample`)."""
+        t0 = time.perf_counter()
+        changed = {k: False for k in rows}
+        for j in range(max((len(ctls[k]) for k in rows), default=0)):
+            groups = {}
+            for k in rows:
+                if k not in changed or j >= len(ctls[k]):
+                    continue
+                c = ctls[k][j]
+                if not c.due(t):
+                    continue
+                sim = self.sims[k]
+                sim._ctx = _RowCtx(self._ctx, self._pos[k], sim.sys)   # what the measurement reads
+                try:
+                    if getattr(c, "batched", False):
+                        m = c.measurement(sim, t)
+                        if m is not None:
+                            groups.setdefault(id(c.K), []).append((k, c, m))
+                            continue
+                        changed[k] |= c.hold(t, c.bypass)
+                    else:
+                        changed[k] |= c.sample(sim, t, sim.z)
+                except SimulationError as exc:
+                    fail(k, exc)
+                    del changed[k]
+            for members in groups.values():
+                c0 = members[0][1]
+                try:
+                    U = xp.asarray(c0.K(xp.stack([xp.asarray(m, dtype=float) for _, _, m in members])),
+                                   dtype=float)
+                    if U.shape[0] != len(members):
+                        raise ValueError(f"a batched policy returned {U.shape[0]} rows for {len(members)}")
+                except Exception as exc:
+                    for k, c, _ in members:
+                        fail(k, SimulationError(t, "controller", f"'{c.name}' raised {exc!r}"))
+                        del changed[k]
+                    continue
+                for (k, c, m), u in zip(members, U):
+                    try:
+                        changed[k] |= c.hold(t, u, m)
+                    except SimulationError as exc:
+                        fail(k, exc)
+                        del changed[k]
+        self.timing["events"] += time.perf_counter() - t0
+        return changed
+
+    def _solve_jump(self, t, rows, guesses, paths, fail):
+        """Consistent network re-solve of members ``rows`` after a jump: the batched chord
+        iteration, then each member's own :meth:`Simulator.solve_algebraic` for those whose
+        chord iteration did not converge (Newton, path following, continuation)."""
+        if not rows:
+            return
+        nx = self.nx
+        Z = xp.stack([self.sims[k].z for k in rows])
+        for j, k in enumerate(rows):
+            if guesses.get(k) is not None:
+                Z[j, nx:] = guesses[k]
+        done = self._alg_chord(t, Z, rows)
+        for k in rows:
+            sim = self.sims[k]
+            if k in done:
+                sim.z, F = done[k]
+                sim._f = F[:nx].copy()
+                continue
+            try:   # the member's own re-solve: its chord iteration again, then Newton and the rest
+                sim.t = t
+                z, F, sctx = sim.solve_algebraic(t, sim.z, return_eval=True, y_guess=guesses.get(k),
+                                                 path=paths.get(k))
+            except SimulationError as exc:
+                fail(k, exc)
+                continue
+            sim.z, sim._f = z, F[:nx].copy()
+            self._sync_network([k])
+
+
+def _gap(controllers):
+    return min([c.T for c in controllers if hasattr(c, "T")] or [0.0])
+
+
+def breakpoint_key(scenario, dt):
+    """The breakpoints of a scenario that are not on the step grid (multiples of ``dt``) and its
+    controllers' sampling (``T``, ``t0``): members with equal keys take the same steps together
+    as alone."""
+    from .events import flatten
+
+    off = []
+    for ev in flatten(list(scenario.get("events", ()))):
+        q = ev.t / dt
+        if abs(q - round(q)) > 1e-9 * max(1.0, abs(q)):
+            off.append(round(ev.t, 12))
+    ctl = tuple(sorted((round(getattr(c, "T", 0.0), 12), round(getattr(c, "t0", 0.0), 12))
+                       for c in scenario.get("controllers", ())))
+    return tuple(sorted(set(off))), ctl
+
+
+def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failure="return",
+                   stats=None, **sim_kw) -> list[Results]:
+    """Simulate ``scenarios`` of one grid in batches; one :class:`Results` per scenario, in order.
+
+    Parameters
+    ----------
+    system : System
+        The grid (set up); every scenario runs on a deep copy of it.
+    scenarios : list of dict
+        ``{"events": [...], "controllers": [...]}`` per scenario (fresh objects per scenario).
+    t_end : float
+        Final time [s].
+    batch_size : int
+        Largest number of members advanced together.
+    exact : bool
+        Group the members so that each takes the steps of its one-by-one run (by
+        :func:`breakpoint_key`): results equal to one-by-one runs to round-off. ``False``
+        batches members whose breakpoints differ (they share the union of the breakpoints:
+        more, shorter steps; results differ from one-by-one runs by the step error).
+    on_failure : {"return", "raise"}
+        A member's failure is in its ``Results.failure``; ``"raise"`` raises the first one after
+        every member has run.
+    stats : dict, optional
+        Filled with ``batches``, ``rerun`` (members re-run one by one), ``alone`` (members run
+        one by one from the start) and ``timing`` (summed :attr:`BatchSimulator.timing`).
+    **sim_kw
+        :class:`Simulator` keyword arguments (``dt``, ``tol``, ``record``, ...).
+
+    Examples
+    --------
+    >>> res = simulate_batch(sys, [{"events": [Fault(3, 0.2, 0.25, xf=x)]} for x in (0.05, 0.1)],
+    ...                      5.0, dt=5e-3)                          # doctest: +SKIP
+    """
+    if on_failure not in ("return", "raise"):
+        raise DataError("simulate_batch", "on_failure", on_failure, 'use "return" or "raise"')
+    if not (isinstance(batch_size, int) and batch_size >= 1):
+        raise DataError("simulate_batch", "batch_size", batch_size, "give a positive integer")
+    if not system.is_setup:
+        system.setup()
+    scenarios = [dict(s) for s in scenarios]
+    dt = float(sim_kw.get("dt", 1 / 120))
+    out = [None] * len(scenarios)
+    st = {"batches": 0, "rerun": 0, "alone": 0, "timing": dict.fromkeys(TIMED, 0.0)}
+    groups = {}
+    alone = []
+    for i, sc in enumerate(scenarios):
+        if batch_unsupported(system, sc.get("events", ())):
+            alone.append(i)
+            continue
+        key = breakpoint_key(sc, dt) if exact else None
+        groups.setdefault(key, []).append(i)
+
+    def one(i):
+        sc = scenarios[i]
+        for c in sc.get("controllers", ()):
+            if hasattr(c, "log_t"):
+                c.log_t, c.log_u = [], []
+        sim = Simulator(copy.deepcopy(system), **sim_kw)
+        return sim.run(t_end, events=sc.get("events", ()), controllers=sc.get("controllers", ()),
+                       on_failure="return")
+
+    for members in groups.values():
+        for a in range(0, len(members), batch_size):
+            part = members[a:a + batch_size]
+            bs = BatchSimulator(system, [scenarios[i] for i in part], **sim_kw)
+            res, rerun = bs.run(t_end)
+            st["batches"] += 1
+            for key, v in bs.timing.items():
+                st["timing"][key] += v
+            for j, i in enumerate(part):
+                out[i] = res[j]
+            for j in rerun:
+                log.info("scenario %d left the batch (its step had to be shortened): run alone", part[j])
+                out[part[j]] = one(part[j])
+                st["rerun"] += 1
+    for i in alone:
+        out[i] = one(i)
+        st["alone"] += 1
+    if stats is not None:
+        stats.update(st)
+    if on_failure == "raise":
+        for r in out:
+            if r.failure is not None:
+                raise r.failure
+    return out

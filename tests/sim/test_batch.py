@@ -1,0 +1,218 @@
+"""Batched simulation (weakgrid.sim.batch): each member's run equals its one-by-one run.
+
+Oracle: the one-by-one :class:`Simulator` run of the same scenario. A member keeps its own
+Newton convergence, Jacobian refreshes, held limits and failure, so its trajectory, its
+statistics (steps, Newton iterations, Jacobians, LU factorizations, evaluations) and its
+failure must be those of its run alone, its trajectory to round-off: measured 0 to 5e-11 pu
+(a device's batched evaluation may take its vectorized branch for the whole batch, e.g. the
+UPQC's rating clip, where alone it takes the equivalent unclipped one).
+"""
+
+import copy
+
+import numpy as np
+import pytest
+from sim_cases import build_gti_upqc_sg
+from test_loss_of_synchronism import _system
+
+from weakgrid.sim.batch import BatchSimulator, breakpoint_key, simulate_batch
+from weakgrid.sim.controllers import DigitalController, UPQCTarget, gti_design_states
+from weakgrid.sim.errors import DataError
+from weakgrid.sim.events import Fault, GeneratorTrip, LoadStep
+from weakgrid.sim.integrate import Simulator
+
+DT = 5e-3
+
+
+def _alone(system, sc, t_end, **kw):
+    return Simulator(copy.deepcopy(system), **kw).run(
+        t_end, events=sc.get("events", ()), controllers=sc.get("controllers", ()), on_failure="return")
+
+
+def _same(a, b, atol_states=1e-10, rtol_outputs=1e-9):
+    """Same columns, times, statistics and failure; states and bus voltages to ``atol_states``
+    pu, every other recorded signal (outputs, some of them derivatives) to ``rtol_outputs`` of
+    its range."""
+    assert a.names == b.names
+    assert a.data.shape == b.data.shape, (a.data.shape, b.data.shape)
+    np.testing.assert_allclose(b.t, a.t, atol=1e-12)
+    # the same steps, Newton iterations, Jacobians, factorizations and evaluations
+    assert a.stats == b.stats
+    assert (a.failure is None) == (b.failure is None)
+    if a.failure is not None:
+        assert (a.failure.cause, str(a.failure)) == (b.failure.cause, str(b.failure))
+        assert b.failure.t == pytest.approx(a.failure.t, abs=1e-12)
+    d = np.abs(a.data - b.data)
+    cols = [i for i, n in enumerate(a.names) if n.endswith((".Vr", ".Vi", ".delta", ".omega"))]
+    if cols:
+        assert d[:, cols].max() <= atol_states, d[:, cols].max()
+    scale = np.maximum(1.0, np.abs(a.data).max(axis=0))
+    assert (d / scale).max() <= rtol_outputs, a.names[int(np.argmax((d / scale).max(axis=0)))]
+    return float(d.max())
+
+
+def _faults():
+    # clearing times on the step grid: every member takes the steps of its run alone
+    return [{"events": [Fault(b, 0.2, 0.2 + k * DT, xf=x)]}
+            for b, k, x in [(1, 6, 0.05), (2, 10, 0.1), (3, 20, 0.02), (3, 8, 0.2)]]
+
+
+def test_fault_scenarios_batched_equal_one_by_one():
+    s = build_gti_upqc_sg("reduced")
+    alone = [_alone(s, sc, 2.0, dt=DT, tol=1e-6) for sc in _faults()]
+    st = {}
+    got = simulate_batch(s, _faults(), 2.0, dt=DT, tol=1e-6, stats=st)
+    assert st["batches"] == 1 and st["alone"] == 0
+    for a, b in zip(alone, got):
+        assert a.ok and b.ok
+        _same(a, b)
+    # the faults differ, so the members do too (the comparison is not between equal runs)
+    assert np.abs(got[0]["SG.omega"] - got[2]["SG.omega"]).max() > 1e-4
+
+
+def test_a_member_that_loses_synchronism_stops_alone():
+    s = _system(0.0)    # three classical machines in a row (test_loss_of_synchronism)
+
+    def scen():
+        return [{"events": [Fault(1, 1.0, 1.1)]},               # stable
+                {"events": [Fault(1, 1.0, 1.4)]},               # too long: pole slip
+                {}]                                             # quiet
+    kw = dict(dt=1 / 120, tol=1e-10)
+    alone = [_alone(s, sc, 3.0, **kw) for sc in scen()]
+    assert alone[0].ok and alone[2].ok
+    assert alone[1].failure.cause == "loss of synchronism"
+    st = {}
+    got = simulate_batch(s, scen(), 3.0, stats=st, **kw)
+    assert st["batches"] == 1 and st["rerun"] == 0
+    for a, b in zip(alone, got):
+        _same(a, b)
+    assert got[0].t[-1] == pytest.approx(3.0) and got[1].t[-1] < 1.5
+
+
+def test_a_newton_failure_stops_alone_and_a_shortened_step_leaves_the_batch():
+    s = build_gti_upqc_sg("reduced")    # one machine: its rotor angle has no spread
+
+    def scen():
+        return [{"events": [Fault(3, 0.2, 0.25, xf=0.05)]},
+                {"events": [LoadStep(2, 0.2, dP=3000.0)]},      # absurd: no network solution
+                {"events": [Fault(1, 0.2, 0.35, xf=0.03)]}]     # its Newton needs a shorter step
+    kw = dict(dt=DT, tol=1e-6)
+    alone = [_alone(s, sc, 1.0, **kw) for sc in scen()]
+    assert alone[0].ok and alone[2].ok
+    assert alone[1].failure.cause == "newton" and alone[1].failure.t == pytest.approx(0.2)
+    st = {}
+    got = simulate_batch(s, scen(), 1.0, stats=st, **kw)
+    assert st["batches"] == 1 and st["rerun"] == 1
+    for a, b in zip(alone, got):
+        _same(a, b)
+
+
+def _K(m):
+    return [float(np.clip(-0.5 * m[0] - 2.0 * m[1], -0.15, 0.15)), float(np.clip(-0.2 * m[1], -0.1, 0.1))]
+
+
+def _K2(m):
+    return [float(np.clip(-0.2 * m[0] - 1.0 * m[1], -0.15, 0.15)), 0.0]
+
+
+def _controlled(T=DT, tf=1.0):
+    return [{"events": [Fault(3, 0.2, 0.25, xf=x)],
+             "controllers": [DigitalController(K, T, gti_design_states("PV"), UPQCTarget("U"),
+                                               enable=[(0.25, tf)])]}
+            for K, x in ((_K, 0.05), (_K2, 0.05), (_K, 0.1))]
+
+
+def test_digital_controllers_batched_equal_one_by_one():
+    s = build_gti_upqc_sg("reduced")
+    alone_sc = _controlled()
+    alone = [_alone(s, sc, 1.0, dt=DT, tol=1e-6) for sc in alone_sc]
+    sc = _controlled()
+    got = simulate_batch(s, sc, 1.0, dt=DT, tol=1e-6)
+    for a, b, ca, cb in zip(alone, got, alone_sc, sc):
+        assert a.ok and b.ok
+        _same(a, b)
+        ua, ub = np.array(ca["controllers"][0].log_u), np.array(cb["controllers"][0].log_u)
+        assert ua.shape == ub.shape and np.abs(ua - ub).max() < 1e-9
+    assert np.abs(got[0]["U.Vup"] - got[1]["U.Vup"]).max() > 1e-4    # the policies act differently
+
+
+def test_members_with_breakpoints_off_the_step_grid_are_batched_apart():
+    a = {"events": [Fault(1, 0.2, 0.2 + 6 * DT)]}
+    b = {"events": [Fault(1, 0.2, 0.2 + 6.5 * DT)]}
+    assert breakpoint_key(a, DT) != breakpoint_key(b, DT)
+    assert breakpoint_key(a, DT) == breakpoint_key({"events": [Fault(2, 0.2, 0.2 + 9 * DT)]}, DT)
+    s = build_gti_upqc_sg("reduced")
+    ref = [_alone(s, sc, 0.6, dt=DT, tol=1e-6) for sc in (copy.deepcopy(a), copy.deepcopy(b))]
+    st = {}
+    got = simulate_batch(s, [a, b], 0.6, dt=DT, tol=1e-6, stats=st)
+    assert st["batches"] == 2
+    for r, g in zip(ref, got):
+        _same(r, g)
+
+
+def test_generator_trip_runs_alone_with_the_same_result():
+    s = _system(0.0)
+    sc = [{"events": [GeneratorTrip(0, 0.5)]}, {"events": [Fault(1, 0.5, 0.6)]}]
+    st = {}
+    got = simulate_batch(s, sc, 1.0, dt=1 / 120, stats=st)
+    assert st["alone"] == 1 and st["batches"] == 1
+    _same(_alone(s, {"events": [GeneratorTrip(0, 0.5)]}, 1.0, dt=1 / 120), got[0])
+
+
+@pytest.mark.parametrize("field, kw", [("batch_size", dict(batch_size=0)),
+                                       ("on_failure", dict(on_failure="ignore"))])
+def test_bad_arguments_are_refused_naming_the_field(field, kw):
+    s = _system(0.0)
+    with pytest.raises(DataError, match=field):
+        simulate_batch(s, [{}], 1.0, **kw)
+
+
+def test_a_member_with_a_device_event_is_refused_by_the_batch_simulator():
+    s = _system(0.0)
+    with pytest.raises(DataError, match="GeneratorTrip"):
+        BatchSimulator(s, [{"events": [GeneratorTrip(0, 0.5)]}])
+
+
+class _VectorPolicy:
+    """The feedback of ``_K`` on arrays: ``(n,)`` → ``(2,)`` and ``(B, n)`` → ``(B, 2)``; counts its calls."""
+
+    def __init__(self):
+        self.calls = 0
+
+    def __call__(self, m):
+        self.calls += 1
+        m = np.asarray(m, dtype=float)
+        return np.stack([np.clip(-0.5 * m[..., 0] - 2.0 * m[..., 1], -0.15, 0.15),
+                         np.clip(-0.2 * m[..., 1], -0.1, 0.1)], axis=-1)
+
+
+def test_a_batched_policy_is_called_once_per_sample_for_the_whole_batch():
+    s = build_gti_upqc_sg("reduced")
+    tf = 0.6
+
+    def scen(K, batched):
+        return [{"events": [Fault(3, 0.2, 0.25, xf=x)],
+                 "controllers": [DigitalController(K, DT, gti_design_states("PV"), UPQCTarget("U"),
+                                                   enable=[(0.25, tf)], batched=batched)]}
+                for x in (0.05, 0.08, 0.1)]
+    alone = [_alone(s, sc, tf, dt=DT, tol=1e-6) for sc in scen(_K, False)]
+    K = _VectorPolicy()
+    got = simulate_batch(s, scen(K, True), tf, dt=DT, tol=1e-6)
+    n_samples = len([t for t in np.arange(0.25, tf - 1e-9, DT)])    # active samples in [0.25, tf)
+    assert n_samples - 1 <= K.calls <= n_samples + 1                 # not 3x: one call per instant
+    for a, b in zip(alone, got):
+        assert a.ok and b.ok
+        _same(a, b)
+
+
+def test_a_batched_policy_returning_the_wrong_rows_fails_its_members_as_a_controller_error():
+    s = build_gti_upqc_sg("reduced")
+
+    def K(m):   # one row whatever the batch
+        return np.zeros((1, 2))
+    sc = [{"controllers": [DigitalController(K, DT, gti_design_states("PV"), UPQCTarget("U"), batched=True,
+                                             enable=[(0.05, 1.0)])]} for _ in range(2)]
+    got = simulate_batch(s, sc, 0.1, dt=DT, tol=1e-6)
+    assert all(r.failure is not None and r.failure.cause == "controller" for r in got)
+    assert all(r.failure.t == pytest.approx(0.05) and r.t[-1] == pytest.approx(0.05) for r in got)
+    assert "1 rows for 2" in str(got[0].failure)
