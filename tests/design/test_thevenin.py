@@ -104,15 +104,16 @@ def test_bad_grid_model_is_refused_naming_the_field():
 def test_design_and_modes_print_both_forms_and_the_option_switches(capsys):
     from weakgrid.cli.main import main
 
+    # the study designs with the Thevenin form; --set switches back to the paper's
     assert main(["design", "ieee9-sg-upqc", "--no-train"]) == 0
     out = capsys.readouterr().out
-    assert "grid_model = 'paper' (used): 2.455 Hz, +18.9%" in out
-    assert "grid_model = 'thevenin': 2.045 Hz, -1.0%" in out
-    assert "MISMATCH" in out
+    assert "grid_model = 'thevenin' (used): 2.045 Hz, -1.0%" in out
+    assert "grid_model = 'paper': 2.455 Hz, +18.9%" in out
+    assert "MISMATCH" not in out
     assert main(["design", "ieee9-sg-upqc", "--no-train", "--set",
-                 "design.grid_model=thevenin"]) == 0
+                 "design.grid_model=paper"]) == 0
     out = capsys.readouterr().out
-    assert "grid_model = 'thevenin' (used)" in out and "MISMATCH" not in out
+    assert "grid_model = 'paper' (used)" in out and "MISMATCH" in out
     assert main(["modes", "ieee9-sg-upqc"]) == 0
     out = capsys.readouterr().out
-    assert "grid_model = 'thevenin': 2.045 Hz, -1.0% vs the grid's 2.065 Hz" in out
+    assert "grid_model = 'thevenin' (used): 2.045 Hz, -1.0% vs the grid's 2.065 Hz" in out
