@@ -4,8 +4,9 @@ A map is drawn from the result table of a sweep (:func:`weakgrid.sweep.run_sweep
 one panel per value of a facet field (e.g. the load level), the two swept fields
 on the axes as evenly spaced categories (their values as tick labels), each
 cell coloured by the quantity and labelled with its value, and with the claim's
-verdict in that cell as a mark: ``✓`` holds, ``✗`` does not, ``=`` tie within the
-numerical uncertainty, ``!`` a run failed. A cell without a value shows ``–`` and, instead
+verdict in that cell as a mark: ``✓`` holds, ``✗`` does not (also: the controller failed where
+its baseline finished), ``=`` tie within the measured uncertainty (its ± printed), ``!`` a run
+failed with nothing to compare (both runs, or the only one). A cell without a value shows ``–`` and, instead
 of a verdict, why (a ``note``: a run failed, no settling, …). The setting the paper (or the
 shipped study) uses is outlined.
 """
@@ -31,7 +32,7 @@ def _fmt(v):
 
 
 def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
-             note: str | None = None, facet: str | None = None, mark=None, title: str = "", value_label: str = "",
+             note: str | None = None, uncertainty: str | None = None, facet: str | None = None, mark=None, title: str = "", value_label: str = "",
              x_label: str = "", y_label: str = "", cmap: str = "RdBu_r", center=None,
              mark_label: str = "the paper's setting", path=None):
     """Draw (and optionally save) a map of ``value`` over fields ``x`` and ``y``.
@@ -47,6 +48,9 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
         Column of the measured quantity (e.g. the HJI/(29) cost ratio).
     verdict : str, optional
         Column holding ``"holds"``, ``"not"``, ``"tie"`` or ``"failed"`` per cell.
+    uncertainty : str, optional
+        Column of the relative uncertainty of a cell's comparison, printed (``±x %``) under
+        a tie's mark.
     note : str, optional
         Column of short texts written in the cell under its value (why a cell has no
         value: a failed run, no settling, …).
@@ -97,6 +101,10 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
             if verdict is not None:
                 v0 = grp[verdict].iloc[0]
                 V[i][j] = VERDICT_MARKS.get(None if v0 is None or v0 != v0 else v0, "?")
+                u0 = grp[uncertainty].iloc[0] if uncertainty is not None and \
+                    uncertainty in grp else None
+                if v0 == "tie" and isinstance(u0, float) and math.isfinite(u0):
+                    V[i][j] += f" ±{u0:.1%}"
             if note is not None and note in grp and isinstance(grp[note].iloc[0], str):
                 N[i][j] = grp[note].iloc[0]
         im = ax.pcolormesh(np.arange(len(xs) + 1) - 0.5, np.arange(len(ys) + 1) - 0.5,
@@ -139,9 +147,13 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
     if mark is not None:
         legend += f"outlined: {mark_label}"
     if verdict is not None:
-        legend += ("; " if legend else "") + ("✓ holds  ✗ does not  = tie (within the "
-                                              "numerical uncertainty)  ! a run failed  "
-                                              "– no value (why, in the cell)")
+        legend += ("; " if legend else "") + ("✓ holds (a baseline's failure named)  ✗ does "
+                                              "not (a failure of ours where the baseline "
+                                              "finished counts: named)  = tie: the difference "
+                                              "is within the measured uncertainty ± (step "
+                                              "halving + the metric's definition)  ! a run "
+                                              "failed, nothing to compare  – no value (why, "
+                                              "in the cell)")
     if title or legend:
         import textwrap
 

@@ -10,6 +10,7 @@ import pandas as pd
 
 from ..fileio import write_text_atomic
 from .failure import FAILED_CELLS_NOTE
+from .ties import compare, run_uncertainty
 
 __all__ = ["metrics_frame", "write_tables", "write_html", "sweep_html", "TOPICS", "BETTER",
            "who_did_best", "md_cell"]
@@ -55,7 +56,7 @@ BETTER = {
     "speed_peak_dev_pu": "lower", "speed_backswing_pu": "lower", "speed_settling_s": "lower",
     "speed_itae": "lower", "vdc_peak_dev_pu": "lower", "vdc_backswing_pu": "lower",
     "vdc_settling_s": "lower", "vdc_itae": "lower", "control_cost": "lower",
-    "vu_peak_pu": "lower",
+    "running_cost_18": "lower", "vu_peak_pu": "lower",
 }
 # effort metrics: a controller that does not drive the UPQC (exactly 0) does not take part
 EFFORT = ("control_cost", "vu_peak_pu")
@@ -169,17 +170,22 @@ def who_did_best(metrics: list[dict], uncertainty: dict | None = None,
     out = []
     for sc, ms in by_sc.items():
         for key, way in BETTER.items():
-            vals = [(m["controller"], float(m[key])) for m in ms
+            runs = [m for m in ms
                     if isinstance(m.get(key), (int, float)) and not _empty(m.get(key))
                     and not isinstance(m.get(key), bool)
                     and not (key in EFFORT and m[key] == 0)]
+            vals = [(m["controller"], float(m[key])) for m in runs]
             if len(vals) < 2:
                 continue
-            vals.sort(key=lambda cv: cv[1], reverse=(way == "higher"))
+            order = sorted(range(len(vals)), key=lambda i: vals[i][1], reverse=(way == "higher"))
+            vals = [vals[i] for i in order]
+            runs = [runs[i] for i in order]
             best = vals[0][1]
             u = float(uncertainty.get(key, float("nan")))
-            tol = abs(best) * u if u == u else 0.0
-            tied = [c for c, v in vals if abs(v - best) <= tol]
+            # the one tie rule (weakgrid.study.ties): step halving + the metric's definition
+            ub = run_uncertainty(runs[0], key, u)
+            tied = [c for (c, v), r in zip(vals, runs)
+                    if compare(v, best, run_uncertainty(r, key, u), ub)[0] == "tie"]
             out.append({"scenario": sc, "metric": key, "better": way,
                         "best": " = ".join(names.get(c, c) for c in tied), "value": best,
                         "tie": len(tied) > 1, "uncertainty": u,
@@ -235,7 +241,7 @@ _CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto
 margin:1em 0}td,th{border:1px solid #ccc;padding:3px 6px;vertical-align:top;min-width:4em;
 max-width:40em;overflow-wrap:break-word}td:first-child{white-space:nowrap}pre{white-space:pre-wrap;overflow-wrap:anywhere;
 max-height:30em;overflow:auto}th{background:#f4f4f4}.reproduced{background:#d8f5d8}
-.partly{background:#fff3c4}.not{background:#f8d0d0}.notrun{background:#eee}
+.partly{background:#fff3c4}.tie{background:#dde8f8}.not{background:#f8d0d0}.notrun{background:#eee}
 img{max-width:100%;border:1px solid #ddd;margin:0.5em 0}"""
 
 
@@ -274,7 +280,9 @@ def write_html(path, *, claims, metrics, figures, designs, meta, notes=None, map
         cls = c["verdict"].replace(" ", "")
         parts.append(f"<tr><td>{e(c['id'])}</td><td>{e(c['case'])}</td><td>{e(c['paper'])}"
                      f"</td><td>{e(c['measured'] or '—')}</td><td>{e(c['rule'])}</td>"
-                     f"<td class='{cls}'>{e(c['verdict'])}</td>" +
+                     f"<td class='{cls}'>{e(c['verdict'])}"
+                     + (f"<br><small>{e(c['why'])}</small>" if c.get("why") else "")
+                     + "</td>" +
                      (f"<td>{e(c.get('map_setting') or '—')}</td>"
                       f"<td>{e(c.get('map_region') or 'not mapped')}</td>" if with_maps else "")
                      + "</tr>")
