@@ -73,7 +73,7 @@ SWEEP_DEFINITIONS = [
     "--quick; the claim table takes the largest over the sweeps) and (2) the metric's "
     "sensitivity to its own definition, re-measured on the run's trajectory (settling band "
     "1.5 % and 3 % around 2 %; backswing against the final value instead of the set-point; "
-    "ITAE and costs summed to 0.5 s before the end). Losses count: a run of the claim's "
+    "ITAE and costs summed over a horizon 10 % shorter). Losses count: a run of the claim's "
     "controller that failed where its baseline finished is 'not' (its cause named); the "
     "baseline failing where the controller finished stays 'holds'/'reproduced', named.",
 ]   # design-model mode vs the full grid's mode: relative frequency mismatch

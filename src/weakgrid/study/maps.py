@@ -104,7 +104,7 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
                 u0 = grp[uncertainty].iloc[0] if uncertainty is not None and \
                     uncertainty in grp else None
                 if v0 == "tie" and isinstance(u0, float) and math.isfinite(u0):
-                    V[i][j] += f" ±{u0:.1%}"
+                    V[i][j] += f" ±{u0 * 100:.2g}%"
             if note is not None and note in grp and isinstance(grp[note].iloc[0], str):
                 N[i][j] = grp[note].iloc[0]
         im = ax.pcolormesh(np.arange(len(xs) + 1) - 0.5, np.arange(len(ys) + 1) - 0.5,

@@ -154,8 +154,10 @@ def definition_spread(value, alternatives) -> float:
     """``max |alt − value| / |value|`` over ``alternatives`` (the same metric re-measured
     with its definition's parameter moved), relative [–].
 
-    ``nan`` when ``value`` is not finite; ``0`` when ``value`` is 0 and every alternative
-    is 0 too; alternatives that are not finite are skipped (pass a bound instead: e.g. a
+    ``nan`` when ``value`` is not finite, or is 0 while an alternative is not (a relative
+    spread of 0 is undefined; a relative uncertainty times the value adds nothing there
+    anyway); ``0`` when every alternative equals ``value``; alternatives that are not finite
+    are skipped (pass a bound instead: e.g. a
     settling time that is undefined at a tighter band is at least the record's length).
     """
     value = float(value)
@@ -166,5 +168,5 @@ def definition_spread(value, alternatives) -> float:
         return 0.0
     d = max(abs(a - value) for a in alts)
     if value == 0:
-        return 0.0 if d == 0 else float("inf")
+        return 0.0 if d == 0 else float("nan")
     return float(d / abs(value))

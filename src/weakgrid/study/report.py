@@ -151,7 +151,8 @@ def who_did_best(metrics: list[dict], uncertainty: dict | None = None,
     """Per scenario and metric of :data:`BETTER`, the controller that did best.
 
     ``uncertainty``: metric → relative numerical uncertainty (``|m(T) − m(T/2)| / |m(T)|``,
-    the sweeps' half-step check), when measured; a controller within it of the best is a tie.
+    the sweeps' half-step check), when measured; with each run's ``<metric>_def_unc`` it makes
+    the tie rule of :mod:`weakgrid.study.ties`: a controller within it of the best is a tie.
     ``names``: controller → full name. Returns rows ``scenario``, ``metric``, ``best``
     (names, ``" = "`` between tied ones), ``value``, ``tie`` (bool), ``uncertainty`` (NaN when
     not measured), ``others`` (the rest, with their values). Failed runs are left out, and
@@ -211,9 +212,11 @@ def _best_html(rows) -> str:
         f"</td><td>{e(r['others'])}</td></tr>" for r in rows)
     return ("<h2>Who did best</h2><p>Per scenario and metric, the controller with the best "
             "value (failed runs left out; on control cost and |Vu| peak, the controllers that do "
-            "not drive the UPQC left out). Controllers within the numerical uncertainty of "
-            "the best (relative, from the half-step check of the study's sweep) are a tie, "
-            "named together; where it was not measured, no tie is named.</p><div class='scroll'>"
+            "not drive the UPQC left out). Controllers within the measured uncertainty of "
+            "the best are a tie, named together — the tie rule of the claim table and the "
+            "maps: step halving (relative, from the half-step check of the study's sweep; the "
+            "column below) plus each run's sensitivity of the metric to its own definition "
+            "(settling band 1.5–3 %, …).</p><div class='scroll'>"
             "<table><tr><th>scenario</th><th>metric</th><th>best</th><th>value</th>"
             f"<th>numerical uncertainty</th><th>the others</th></tr>{body}</table></div>")
 

@@ -330,7 +330,7 @@ def map_summaries(maps) -> list[dict]:
                 if ties:
                     tr = row[row["verdict"] == "tie"]
                     txt += "; tie at " + ", ".join(
-                        f"{v:g}" + (f" (±{u:.1%})" if isinstance(u, float) and math.isfinite(u)
+                        f"{v:g}" + (f" (±{u * 100:.2g} %)" if isinstance(u, float) and math.isfinite(u)
                                     else "") for v, u in zip(ties, tr["uncertainty"]))
                 lost = row[(row["verdict"] == "not") & row["note"].fillna("").str.contains(
                     " failed:")] if "note" in row else row.iloc[:0]

@@ -57,4 +57,4 @@ def unc_text(va, vb, tol) -> str:
     d = abs(float(va) - float(vb))
     rel = tol / abs(float(vb)) if vb else math.nan
     return (f"|Δ| {d:.3g} {'≤' if d <= tol else '>'} uncertainty {tol:.3g}"
-            + (f" (±{rel:.1%} of the baseline)" if math.isfinite(rel) else ""))
+            + (f" (±{rel * 100:.2g} % of the baseline)" if math.isfinite(rel) else ""))
