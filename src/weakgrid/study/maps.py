@@ -85,8 +85,26 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
     norm = None
     if center is not None and vmin < center < vmax:
         norm = TwoSlopeNorm(vcenter=center, vmin=vmin, vmax=vmax)
-    fig, axes = new_figure(1, len(facets), figsize=(1.2 + 0.9 * len(xs) * len(facets) + 1.2,
-                                                     1.4 + 0.55 * len(ys)),
+    import textwrap
+
+    fig_w = 1.2 + 0.9 * len(xs) * len(facets) + 1.2
+    legend = ""
+    if mark is not None:
+        legend += f"outlined: {mark_label}"
+    if verdict is not None:
+        legend += ("; " if legend else "") + ("✓ holds (a baseline's failure named)  ✗ does "
+                                              "not (a failure of ours where the baseline "
+                                              "finished counts: named)  = tie: the difference "
+                                              "is within the measured uncertainty ± (step "
+                                              "halving + the metric's definition)  ! a run "
+                                              "failed, nothing to compare  – no value (why, "
+                                              "in the cell)")
+    width = max(40, int(fig_w * 13))       # characters that fit at fontsize 9
+    heading = "\n".join(textwrap.fill(t, width) for t in (title, legend) if t)
+    # the heading's lines get their own height (else they squash a one-row map)
+    n_lines = heading.count("\n") + 1 if heading else 0
+    fig, axes = new_figure(1, len(facets), figsize=(fig_w, 1.4 + 0.55 * len(ys)
+                                                    + 0.17 * n_lines),
                            squeeze=False, layout="constrained")
     im = None
     for ax, fv in zip(axes[0], facets):
@@ -143,23 +161,8 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
     bar_in = 0.9 * (fig.get_figheight() - 1.0)            # the bar's length, roughly [in]
     per_line = max(12, int(bar_in * 72 / (0.6 * 9)))      # characters of 9-pt text in it
     cb.set_label("\n".join(textwrap.wrap(value_label or value, per_line)), fontsize=9)
-    legend = ""
-    if mark is not None:
-        legend += f"outlined: {mark_label}"
-    if verdict is not None:
-        legend += ("; " if legend else "") + ("✓ holds (a baseline's failure named)  ✗ does "
-                                              "not (a failure of ours where the baseline "
-                                              "finished counts: named)  = tie: the difference "
-                                              "is within the measured uncertainty ± (step "
-                                              "halving + the metric's definition)  ! a run "
-                                              "failed, nothing to compare  – no value (why, "
-                                              "in the cell)")
-    if title or legend:
-        import textwrap
-
-        width = max(40, int(fig.get_figwidth() * 13))   # characters that fit at fontsize 9
-        fig.suptitle("\n".join(textwrap.fill(t, width) for t in (title, legend) if t),
-                     fontsize=9)
+    if heading:
+        fig.suptitle(heading, fontsize=9)
     if path is not None:
         from ..fileio import savefig_atomic
 
