@@ -48,19 +48,25 @@ def test_failure_text_states_the_fold_in_the_grids_terms():
 
 def test_failed_cells_name_their_cause():
     rows = []
-    for r, ca, cb in ((0.1, "ok", "ok"), (0.6, "failed", "ok")):
+    for r, ca, cb in ((0.1, "ok", "ok"), (0.6, "failed", "ok"), (1.0, "failed", "failed")):
         rows.append({"scenario": "s", "upqc.rating": r, "t_off": 0.3, "load": "high",
                      "controller": "a", "dt_factor": 1.0, "status": ca, "cost": 0.5,
                      "failure": COLLAPSE if ca == "failed" else ""})
         rows.append({"scenario": "s", "upqc.rating": r, "t_off": 0.3, "load": "high",
                      "controller": "b", "dt_factor": 1.0, "status": cb, "cost": 1.0,
-                     "failure": ""})
+                     "failure": COLLAPSE if cb == "failed" else ""})
     spec = {"claim": "X", "kind": "ratio", "metric": "cost", "a": "a", "b": "b",
             "holds_below": 0.8}
     axes = ["upqc.rating", "t_off", "load"]
     cells = map_cells(pd.DataFrame(rows), spec, axes)
     c = cells.set_index("upqc.rating")
-    assert c.loc[0.6, "verdict"] == "failed" and c.loc[0.6, "detail"] == "a voltage collapse"
+    # a lost, b finished: a loss ("not"), its cause named
+    assert c.loc[0.6, "verdict"] == "not" and c.loc[0.6, "note"] == "a failed: voltage collapse"
+    assert c.loc[0.6, "detail"].startswith("a failed: voltage collapse at t")
+    # both lost: nothing to compare
+    assert c.loc[1.0, "verdict"] == "failed"
+    assert c.loc[1.0, "detail"] == "a voltage collapse; b voltage collapse"
     s = map_summaries([{"spec": spec, "cells": cells, "mark": (0.1, 0.3),
                         "axes": ("upqc.rating", "t_off", "load")}])[0]
-    assert "a run failed at 0.6 (a voltage collapse)" in s["region"]
+    assert "not at 0.6 (a failed: voltage collapse)" in s["region"]
+    assert "a run failed at 1 (a voltage collapse; b voltage collapse)" in s["region"]

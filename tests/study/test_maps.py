@@ -60,3 +60,15 @@ def test_cell_without_value_says_why_not_a_verdict(tmp_path):
     texts = [t.get_text() for t in panel.texts]
     assert "–\nhji: no\nsettling" in texts or "–\nhji: no settling" in texts   # why; no ✓/✗
     assert not any(t.startswith("–") and ("✗" in t or "✓" in t) for t in texts)
+
+
+def test_a_tie_prints_its_uncertainty_and_the_legend_says_what_counts(tmp_path):
+    df = _table()
+    df["u"] = np.nan
+    df.loc[1, "verdict"] = "tie"
+    df.loc[1, "u"] = 0.031
+    fig = plot_map(df, "rating", "dur", "v", verdict="verdict", uncertainty="u", facet="load")
+    texts = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert any(t.endswith("= ±3.1%") for t in texts)
+    legend = fig._suptitle.get_text().replace("\n", " ")
+    assert "within the measured uncertainty" in legend and "failure of ours" in legend

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from weakgrid.study.metrics import (
-    control_cost, itae, running_cost, settling_time, stability_verdict,
+    backswing, control_cost, itae, running_cost, settling_time, stability_verdict,
 )
 
 
@@ -68,3 +68,30 @@ def test_backswing_of_a_damped_cosine():
     t, y = damped(sigma, omega)
     # first negative extreme near half a period: e^{-σ·π/ω}
     assert backswing(t, y, y_final=0.0) == pytest.approx(np.exp(-sigma * np.pi / omega), rel=2e-2)
+
+
+def test_definition_spread_of_the_settling_band():
+    """A decaying oscillation: its settling time moves with the band (1.5 % / 3 % around 2 %)
+    by a measured amount, recorded as the metric's definition sensitivity; the runner's
+    helper records it for every signal's settling time, backswing and ITAE."""
+    from weakgrid.study.metrics import SETTLING_BANDS, definition_spread
+    from weakgrid.study.runner import _definition_spreads
+
+    t = np.linspace(-1, 10, 22001)          # at the set-point 1.0 until the disturbance at 0
+    y = np.where(t < 0, 1.0, 1 + 0.1 * np.exp(-t) * np.cos(2 * np.pi * t))
+    ts = settling_time(t, y, 0.0, y_final=1.0)
+    alts = [settling_time(t, y, 0.0, band=b, y_final=1.0) for b in SETTLING_BANDS]
+    # envelope e^-t: the band moves the settling by about ln(2/1.5) and ln(3/2) s
+    assert alts[0] > ts > alts[1]
+    spread = definition_spread(ts, alts)
+    assert spread == pytest.approx(max(abs(a - ts) for a in alts) / ts)
+    assert 0.05 < spread < 0.2
+    m = {"x_settling_s": ts, "x_backswing_pu": backswing(t, y, 0.0, y_final=1.0),
+         "x_itae": itae(t, y, 0.0, y_final=1.0)}
+    post = t >= 0.0           # the runner passes the record after the disturbance and y0
+    d = _definition_spreads("x", t[post], y[post], 0.0, 1.0, m)
+    assert d["x_settling_s_def_unc"] == pytest.approx(spread)
+    assert d["x_backswing_pu_def_unc"] < 1e-3       # settled: final value = set-point
+    assert 0 <= d["x_itae_def_unc"] < 1e-3          # the last 0.5 s add almost nothing
+    assert definition_spread(float("nan"), [1.0]) != definition_spread(float("nan"), [1.0])
+    assert definition_spread(2.0, [float("nan")]) == 0.0

@@ -214,7 +214,8 @@ def test_map_cells_ties_wins_and_failures():
             "holds_below": 0.8}
     cells = map_cells(_cells_table(), spec, ["upqc.rating", "t_off", "load"])
     v = dict(zip(cells["upqc.rating"], cells["verdict"]))
-    assert v == {0.1: "tie", 0.3: "holds", 0.5: "failed"}
+    # a failed where b finished: a loss, counted as "not" (it was "failed" only)
+    assert v == {0.1: "tie", 0.3: "holds", 0.5: "not"}
     val = dict(zip(cells["upqc.rating"], cells["value"]))
     assert val[0.3] == pytest.approx(0.5) and math.isnan(val[0.5])
     # without the dt check there is no uncertainty: 0.98 is then "not" (above 0.8)
@@ -243,7 +244,7 @@ def test_map_cell_without_value_has_a_reason_not_a_verdict():
     t2 = _cells_table()
     cells = map_cells(t2[t2["dt_factor"] == 1.0], dict(spec, metric="cost"),
                       ["upqc.rating", "t_off", "load"])
-    assert dict(zip(cells["upqc.rating"], cells["note"]))[0.5] == "a failed"
+    assert dict(zip(cells["upqc.rating"], cells["note"]))[0.5] == "a failed: failed"
 
 
 def test_report_is_one_self_contained_file(tmp_path):
@@ -293,8 +294,56 @@ def test_ratio_cell_where_only_the_baseline_fails_holds():
     cells = map_cells(t, spec, ["upqc.rating", "t_off", "load"])
     c = cells[cells["upqc.rating"] == 0.5].iloc[0]
     assert c["verdict"] == "holds" and math.isnan(c["value"])
-    assert c["note"] == "b loss of synchronism" and "loss of synchronism" in c["detail"]
+    assert c["note"] == "b failed: loss of synchronism" and "loss of synchronism" in c["detail"]
     from weakgrid.study.sweep_maps import map_summaries
     s = map_summaries([{"spec": spec, "cells": cells, "mark": None,
                         "axes": ("upqc.rating", "t_off", "load")}])[0]
-    assert "0.5 (b loss of synchronism)" in s["region"] and "0.3" in s["region"]
+    assert "0.5 (b failed: loss of synchronism)" in s["region"] and "0.3" in s["region"]
+
+
+def _lost_table(kind_col="cost"):
+    t = _cells_table()
+    t = t[t["dt_factor"] == 1.0].copy()
+    t["failure"] = np.where(t["status"] == "failed", "simulation stopped at t = 3.427 s: "
+                            "loss of synchronism (rotor angle spread 181 deg)", "")
+    return t
+
+
+@pytest.mark.parametrize("kind", ["ratio", "wins"])
+def test_an_hji_failure_where_the_baseline_survives_is_not(kind):
+    """Losses are counted: a (HJI) loses synchronism at rating 0.5 while b finishes — the cell
+    is "not (a failed: loss of synchronism)", no longer a neutral "failed"; both failing stays
+    "failed"."""
+    t = _lost_table()
+    spec = {"claim": "X", "kind": kind, "metric": "cost", "metrics": ["cost"], "a": "a",
+            "b": "b", "holds_below": 0.8}
+    cells = map_cells(t, spec, ["upqc.rating", "t_off", "load"])
+    c = cells[cells["upqc.rating"] == 0.5].iloc[0]
+    assert c["verdict"] == "not" and math.isnan(c["value"])
+    assert c["note"] == "a failed: loss of synchronism"
+    from weakgrid.study.sweep_maps import map_summaries
+    s = map_summaries([{"spec": spec, "cells": cells, "mark": None,
+                        "axes": ("upqc.rating", "t_off", "load")}])[0]
+    assert "not at 0.5 (a failed: loss of synchronism)" in s["region"]
+    t.loc[t["upqc.rating"] == 0.5, "status"] = "failed"          # both fail: no comparison
+    cells = map_cells(t, spec, ["upqc.rating", "t_off", "load"])
+    assert cells[cells["upqc.rating"] == 0.5].iloc[0]["verdict"] == "failed"
+
+
+def test_map_tie_within_the_metrics_definition_band():
+    """Without any step-halving check, a 2 % difference in settling time is a tie when the
+    settling time moves by 3 % with the band (1.5–3 %): the same rule as the claim table."""
+    t = _cells_table()
+    t = t[(t["dt_factor"] == 1.0) & (t["upqc.rating"] == 0.1)].copy()
+    t = t.rename(columns={"cost": "speed_settling_s"})
+    spec = {"claim": "X", "kind": "ratio", "metric": "speed_settling_s", "a": "a", "b": "b",
+            "holds_below": 1.0}
+    cells = map_cells(t, spec, ["upqc.rating", "t_off", "load"])
+    assert cells["verdict"].tolist() == ["holds"]           # 1.00 < 1.02, no band: a win
+    t["speed_settling_s_def_unc"] = np.where(t["controller"] == "a", 0.03, 0.0)
+    cells = map_cells(t, spec, ["upqc.rating", "t_off", "load"])
+    assert cells["verdict"].tolist() == ["tie"]
+    assert cells["uncertainty"].iloc[0] == pytest.approx(0.03 / 1.02)
+    w = map_cells(t, dict(spec, kind="wins", metrics=["speed_settling_s"]),
+                  ["upqc.rating", "t_off", "load"])
+    assert w["verdict"].tolist() == ["tie"]

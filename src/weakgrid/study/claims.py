@@ -3,14 +3,25 @@
 A study's ``[[claims]]`` entry: ``id``, ``case`` (label), ``paper`` (what the paper says),
 ``rule`` (the verdict rule in words, shown beside the verdict), ``judge`` (one of
 :data:`RULES`) and the judge's parameters (run ids, thresholds). A judge receives
-``{run id: metrics}`` and returns ``(verdict, measured text)`` with verdict ``reproduced`` /
-``partly`` / ``not`` / ``not run``.
+``{run id: metrics}`` and returns ``(verdict, measured text)`` or ``(verdict, measured text,
+why)`` with verdict ``reproduced`` / ``partly`` / ``tie`` / ``not`` / ``not run``; ``why`` names
+what decided it in a few words (a tie and its uncertainty, a failed run and its cause).
+
+Judges that compare two runs take ``step_unc`` (metric → relative step-halving uncertainty,
+from the sweeps' half-step check; :func:`weakgrid.study.sweep_maps.metric_uncertainty`) and
+apply the one tie rule of :mod:`weakgrid.study.ties`, as the maps do. A run of the claim's
+controller that failed while its baseline finished counts as ``not`` ("… failed: cause"); the
+baseline failing while the controller finished stays ``reproduced``, saying so.
 """
 
 from __future__ import annotations
 
 import fnmatch
+import inspect
 import math
+
+from .failure import failure_kind
+from .ties import compare, run_uncertainty, unc_text
 
 __all__ = ["RULES", "judge_all", "judge_claim"]
 
@@ -28,34 +39,90 @@ def _fmt(v, unit="", nd=3):
 
 
 def _combine(vs):
+    """One verdict of a claim's pairs: all alike → that one; any reproduced or partly →
+    partly; else (ties and losses mixed) → not."""
     if not vs:
         return "not run"
-    if all(v == "reproduced" for v in vs):
-        return "reproduced"
-    if all(v == "not" for v in vs):
-        return "not"
-    return "partly"
+    if len(set(vs)) == 1:
+        return vs[0]
+    if any(v in ("reproduced", "partly") for v in vs):
+        return "partly"
+    return "not"
 
 
-def cost_less(m, pairs, reduction=0.2, settling_tol=0.25, settling="vdc_settling_s"):
-    """Run a needs ≥ ``reduction`` less applied control cost than run b, same settling ±tol."""
-    out, verdicts = [], []
+def _loss(m, ia, ib):
+    """``(verdict, why)`` when run ``ia`` (the claim's controller) or ``ib`` (its baseline)
+    failed: a lost a (loss of synchronism, Newton failure, …) while b finished counts as
+    ``not``; a lost b while a finished stays ``reproduced``, saying so; None when both
+    finished."""
+    ra, rb = m.get(ia) or {}, m.get(ib) or {}
+    fa, fb = bool(ra.get("failed")), bool(rb.get("failed"))
+    cause = (lambda r: failure_kind(r.get("failure")) or "failed")  # noqa: E731
+    if fa and fb:
+        return "not", f"both failed: {ia} {cause(ra)}, {ib} {cause(rb)}"
+    if fa:
+        return "not", f"{ia} failed: {cause(ra)}"
+    if fb:
+        return "reproduced", f"{ib} failed: {cause(rb)}"
+    return None
+
+
+def _cmp(m, ia, ib, key, step_unc):
+    """The tie rule (:func:`weakgrid.study.ties.compare`) on ``key`` of runs ia and ib:
+    ``("a" | "b" | "tie" | "n/a", text)``."""
+    a, b = _get(m, ia, key), _get(m, ib, key)
+    if a is None or b is None:
+        return "n/a", ""
+    step = (step_unc or {}).get(key)
+    who, tol = compare(a, b, run_uncertainty(m.get(ia), key, step),
+                       run_uncertainty(m.get(ib), key, step))
+    return who, unc_text(a, b, tol)
+
+
+_COST_NAMES = {"control_cost": "applied control cost Σu'Ru·T",
+               "control_cost_demanded": "demanded control cost Σu'Ru·T",
+               "running_cost_18": "running cost of (18) Σx'Qx+u'Ru (Fig. 10)"}
+
+
+def cost_less(m, pairs, reduction=0.2, settling_tol=0.25, settling="vdc_settling_s",
+              metric="control_cost", step_unc=None):
+    """Run a needs ≥ ``reduction`` less ``metric`` (a cost) than run b, same settling ±tol.
+
+    A difference within the measured uncertainty (:mod:`weakgrid.study.ties`) is a tie; a
+    smaller cost beyond it is ``partly``; a failed run a is ``not`` (b failed: reproduced).
+    """
+    out, verdicts, why = [], [], []
+    name = _COST_NAMES.get(metric, metric)
     for label, ia, ib in pairs:
-        a, b = _get(m, ia, "control_cost"), _get(m, ib, "control_cost")
-        da, db = _get(m, ia, "control_cost_demanded"), _get(m, ib, "control_cost_demanded")
-        ra, rb = _get(m, ia, "running_cost_18"), _get(m, ib, "running_cost_18")
+        if ia not in m or ib not in m:
+            continue
+        loss = _loss(m, ia, ib)
+        if loss:
+            out.append(f"{label}: {loss[1]}")
+            verdicts.append(loss[0])
+            why.append(f"{label}: {loss[1]}")
+            continue
+        a, b = _get(m, ia, metric), _get(m, ib, metric)
         sa, sb = _get(m, ia, settling), _get(m, ib, settling)
         if a is None or b is None or b == 0:
             continue
         red = 1 - a / b
+        who, utext = _cmp(m, ia, ib, metric, step_unc)
         same = sa is not None and sb is not None and abs(sa - sb) <= settling_tol * max(sb, 1e-9)
-        out.append(f"{label}: {ia} control cost {_fmt(a)} vs {ib} {_fmt(b)} "
-                   f"({red * 100:+.0f} % less; demanded before the rating limit: {_fmt(da)} "
-                   f"vs {_fmt(db)}); running cost of (18) {_fmt(ra)} vs {_fmt(rb)}; settling "
+        extra = ""
+        if metric == "control_cost":
+            da, db = _get(m, ia, "control_cost_demanded"), _get(m, ib, "control_cost_demanded")
+            extra = f"; demanded before the rating limit: {_fmt(da)} vs {_fmt(db)}"
+        out.append(f"{label}: {ia} {name} {_fmt(a)} vs {ib} {_fmt(b)} "
+                   f"({red * 100:+.1f} % less; {utext}){extra}; settling "
                    f"{_fmt(sa, ' s')} vs {_fmt(sb, ' s')}")
-        verdicts.append("reproduced" if red >= reduction and same else "partly" if red > 0
-                        else "not")
-    return _combine(verdicts), "; ".join(out)
+        if who == "tie":
+            verdicts.append("tie")
+            why.append(f"{label}: tie, {utext}")
+        else:
+            verdicts.append("reproduced" if red >= reduction and same else "partly"
+                            if who == "a" else "not")
+    return _combine(verdicts), "; ".join(out), "; ".join(why)
 
 
 def power_share(m, runs, lo, hi, paper_pct):
@@ -88,44 +155,85 @@ def itae_close(m, pairs, close=0.1, partly=0.3, metrics=("speed_itae", "vdc_itae
     return _combine(vs), "; ".join(out)
 
 
-def beats_baselines(m, groups):
+def _pair_verdict(results):
+    """A pair's verdict from its comparisons (each "a" won, "b" won, "tie"; "n/a" skipped)."""
+    rs = [r for r in results if r != "n/a"]
+    if not rs:
+        return None
+    if all(r == "a" for r in rs):
+        return "reproduced"
+    if all(r == "tie" for r in rs):
+        return "tie"
+    return "partly" if "a" in rs else "not"
+
+
+def beats_baselines(m, groups, step_unc=None):
     """Lower ITAE of speed and dc-link voltage than each baseline (or the baseline failed).
 
-    ``groups``: ``[[label, run, baseline label, baseline run], …]``.
+    ``groups``: ``[[label, run, baseline label, baseline run], …]``. Differences within the
+    measured uncertainty are ties (:mod:`weakgrid.study.ties`); a failed run of ours while
+    the baseline finished is ``not``.
     """
-    out, vs = [], []
+    out, vs, why = [], [], []
     for label, hid, base, bid in groups:
+        if hid not in m or bid not in m:
+            continue
+        loss = _loss(m, hid, bid)
+        if loss:
+            out.append(f"{label} vs {base}: {loss[1]}")
+            vs.append(loss[0])
+            why.append(f"{label} vs {base}: {loss[1]}")
+            continue
         h, hv = _get(m, hid, "speed_itae"), _get(m, hid, "vdc_itae")
         b, bv = _get(m, bid, "speed_itae"), _get(m, bid, "vdc_itae")
-        failed = (m.get(bid) or {}).get("failed")
-        if h is None or (b is None and not failed):
+        if h is None or b is None:
             continue
-        if failed:
-            out.append(f"{label}: {base} run failed (lost stability), {hid} did not")
-            vs.append("reproduced")
-            continue
-        better = h < b and (hv is None or bv is None or hv < bv)
-        out.append(f"{label} vs {base}: ITAE speed {_fmt(h)} vs {_fmt(b)}, dc-link "
-                   f"{_fmt(hv)} vs {_fmt(bv)}")
-        vs.append("reproduced" if better else "partly" if h < b or
-                  (hv is not None and bv is not None and hv < bv) else "not")
-    return _combine(vs), "; ".join(out)
+        cs, ts = _cmp(m, hid, bid, "speed_itae", step_unc)
+        cv, tv = _cmp(m, hid, bid, "vdc_itae", step_unc)
+        out.append(f"{label} vs {base}: ITAE speed {_fmt(h)} vs {_fmt(b)} ({ts}), dc-link "
+                   f"{_fmt(hv)} vs {_fmt(bv)}" + (f" ({tv})" if tv else ""))
+        v = _pair_verdict([cs, cv])
+        vs.append(v)
+        if "tie" in (cs, cv):
+            why.append(f"{label} vs {base}: tie on " + " and ".join(
+                k for k, c in (("speed", cs), ("dc link", cv)) if c == "tie"))
+    return _combine(vs), "; ".join(out), "; ".join(why)
 
 
 def less_overshoot_settling(m, pairs, overshoot="speed_backswing_pu",
-                            settling="speed_settling_s"):
-    """Run a has a smaller overshoot (backswing) and settling time than run b."""
-    out, vs = [], []
+                            settling="speed_settling_s", step_unc=None):
+    """Run a has a smaller overshoot (backswing) and settling time than run b.
+
+    Each comparison goes through the tie rule (:mod:`weakgrid.study.ties`): a difference
+    within the measured uncertainty (step halving + the metric's sensitivity to its own
+    definition, e.g. the settling band) is a tie. A failed run a is ``not`` (b failed while a
+    finished: reproduced); a settling time a has and b has not (b never settles) is a win.
+    """
+    out, vs, why = [], [], []
     for label, h, l_ in pairs:
+        if h not in m or l_ not in m:
+            continue
+        loss = _loss(m, h, l_)
+        if loss:
+            out.append(f"{label}: {loss[1]}")
+            vs.append(loss[0])
+            why.append(f"{label}: {loss[1]}")
+            continue
         oh, ol = _get(m, h, overshoot), _get(m, l_, overshoot)
         sh, sl = _get(m, h, settling), _get(m, l_, settling)
         if oh is None or ol is None:
             continue
-        out.append(f"{label}: speed overshoot (backswing) {_fmt(oh)} vs {_fmt(ol)} pu, "
-                   f"settling {_fmt(sh, ' s')} vs {_fmt(sl, ' s')}")
-        wins = [oh < ol, sh is not None and (sl is None or sh < sl)]
-        vs.append("reproduced" if all(wins) else "partly" if any(wins) else "not")
-    return _combine(vs), "; ".join(out)
+        co, to = _cmp(m, h, l_, overshoot, step_unc)
+        cs, ts = _cmp(m, h, l_, settling, step_unc)
+        if cs == "n/a":       # a settles and b does not: a wins; a does not: b wins
+            cs = "a" if sh is not None else "b"
+        out.append(f"{label}: speed overshoot (backswing) {_fmt(oh)} vs {_fmt(ol)} pu ({to}), "
+                   f"settling {_fmt(sh, ' s')} vs {_fmt(sl, ' s')}" + (f" ({ts})" if ts else ""))
+        vs.append(_pair_verdict([co, cs]))
+        if "tie" in (co, cs):
+            why.append(f"{label}: tie on " + " and ".join(
+                k for k, c in (("overshoot", co), ("settling", cs)) if c == "tie"))
+    return _combine(vs), "; ".join(out), "; ".join(why)
 
 
 def max_below(m, runs, below, partly, metric="vu_peak_pu"):
@@ -167,17 +275,22 @@ RULES = {"cost_less": cost_less, "power_share": power_share, "itae_close": itae_
 _META = ("id", "case", "paper", "rule", "judge")
 
 
-def judge_claim(claim: dict, metrics_by_id: dict) -> dict:
+def judge_claim(claim: dict, metrics_by_id: dict, step_unc: dict | None = None) -> dict:
     """The verdict of one claim (a dict of a study file) on ``{run id: metrics}``.
 
-    Returns ``id``, ``case``, ``paper`` (the claim), ``rule``, ``verdict`` and ``measured``.
+    ``step_unc``: metric → relative step-halving uncertainty (None: not measured).
+    Returns ``id``, ``case``, ``paper`` (the claim), ``rule``, ``verdict``, ``measured`` and
+    ``why`` (what decided the verdict: a tie and its uncertainty, a failed run; may be "").
     """
     params = {k: v for k, v in claim.items() if k not in _META}
-    verdict, measured = RULES[claim["judge"]](metrics_by_id, **params)
+    fn = RULES[claim["judge"]]
+    if "step_unc" in inspect.signature(fn).parameters:
+        params["step_unc"] = step_unc
+    verdict, measured, why = (*fn(metrics_by_id, **params), "")[:3]
     return {"id": claim["id"], "case": claim.get("case", ""), "paper": claim["paper"],
-            "rule": claim["rule"], "verdict": verdict, "measured": measured}
+            "rule": claim["rule"], "verdict": verdict, "measured": measured, "why": why}
 
 
-def judge_all(claims: list, metrics_by_id: dict) -> list[dict]:
+def judge_all(claims: list, metrics_by_id: dict, step_unc: dict | None = None) -> list[dict]:
     """Verdicts of ``claims`` (dicts from study files) on ``{run id: metrics}``."""
-    return [judge_claim(c, metrics_by_id) for c in claims]
+    return [judge_claim(c, metrics_by_id, step_unc) for c in claims]

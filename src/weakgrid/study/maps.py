@@ -4,9 +4,11 @@ A map is drawn from the result table of a sweep (:func:`weakgrid.sweep.run_sweep
 one panel per value of a facet field (e.g. the load level), the two swept fields
 on the axes as evenly spaced categories (their values as tick labels), each
 cell coloured by the quantity and labelled with its value, and with the claim's
-verdict in that cell as a mark: ``✓`` holds, ``✗`` does not, ``=`` tie within the
-numerical uncertainty, ``!`` a run failed. A cell whose device power went beyond the UPQC's
-rating or the line's power carries a marker in its corner (:data:`DEVICE_MARK`). A cell without a value shows ``–`` and, instead
+verdict in that cell as a mark: ``✓`` holds, ``✗`` does not (also: the controller failed where
+its baseline finished), ``=`` tie within the measured uncertainty (its ± printed), ``!`` a run
+failed with nothing to compare (both runs, or the only one). A cell whose device power went
+beyond the UPQC's rating or the line's power carries a marker in its corner
+(:data:`DEVICE_MARK`). A cell without a value shows ``–`` and, instead
 of a verdict, why (a ``note``: a run failed, no settling, …). The setting the paper (or the
 shipped study) uses is outlined.
 """
@@ -37,7 +39,7 @@ def _fmt(v):
 
 
 def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
-             note: str | None = None, facet: str | None = None, mark=None, title: str = "", value_label: str = "",
+             note: str | None = None, uncertainty: str | None = None, facet: str | None = None, mark=None, title: str = "", value_label: str = "",
              x_label: str = "", y_label: str = "", cmap: str = "RdBu_r", center=None,
              mark_label: str = "the paper's setting", path=None, device: str | None = None):
     """Draw (and optionally save) a map of ``value`` over fields ``x`` and ``y``.
@@ -53,6 +55,9 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
         Column of the measured quantity (e.g. the HJI/(29) cost ratio).
     verdict : str, optional
         Column holding ``"holds"``, ``"not"``, ``"tie"`` or ``"failed"`` per cell.
+    uncertainty : str, optional
+        Column of the relative uncertainty of a cell's comparison, printed (``±x %``) under
+        a tie's mark.
     note : str, optional
         Column of short texts written in the cell under its value (why a cell has no
         value: a failed run, no settling, …).
@@ -91,11 +96,31 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
     norm = None
     if center is not None and vmin < center < vmax:
         norm = TwoSlopeNorm(vcenter=center, vmin=vmin, vmax=vmax)
-    fig, axes = new_figure(1, len(facets), figsize=(1.2 + 0.9 * len(xs) * len(facets) + 1.2,
-                                                     1.4 + 0.55 * len(ys)),
+    import textwrap
+
+    fig_w = 1.2 + 0.9 * len(xs) * len(facets) + 1.2
+    legend = ""
+    if mark is not None:
+        legend += f"outlined: {mark_label}"
+    if verdict is not None:
+        legend += ("; " if legend else "") + ("✓ holds (a baseline's failure named)  ✗ does "
+                                              "not (a failure of ours where the baseline "
+                                              "finished counts: named)  = tie: the difference "
+                                              "is within the measured uncertainty ± (step "
+                                              "halving + the metric's definition)  ! a run "
+                                              "failed, nothing to compare  – no value (why, "
+                                              "in the cell)")
+    if device is not None and device in table and any(
+            DEVICE_MARK.get(str(v or ""), "") for v in table[device]):
+        legend += ("; " if legend else "") + DEVICE_LEGEND
+    width = max(40, int(fig_w * 13))       # characters that fit at fontsize 9
+    heading = "\n".join(textwrap.fill(t, width) for t in (title, legend) if t)
+    # the heading's lines get their own height (else they squash a one-row map)
+    n_lines = heading.count("\n") + 1 if heading else 0
+    fig, axes = new_figure(1, len(facets), figsize=(fig_w, 1.4 + 0.55 * len(ys)
+                                                    + 0.17 * n_lines),
                            squeeze=False, layout="constrained")
     im = None
-    any_device = [False]
     for ax, fv in zip(axes[0], facets):
         sub = table if fv is None else table[table[facet] == fv]
         Z = np.full((len(ys), len(xs)), np.nan)
@@ -109,6 +134,10 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
             if verdict is not None:
                 v0 = grp[verdict].iloc[0]
                 V[i][j] = VERDICT_MARKS.get(None if v0 is None or v0 != v0 else v0, "?")
+                u0 = grp[uncertainty].iloc[0] if uncertainty is not None and \
+                    uncertainty in grp else None
+                if v0 == "tie" and isinstance(u0, float) and math.isfinite(u0):
+                    V[i][j] += f" ±{u0 * 100:.2g}%"
             if note is not None and note in grp and isinstance(grp[note].iloc[0], str):
                 N[i][j] = grp[note].iloc[0]
             if device is not None and device in grp:
@@ -137,7 +166,6 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
                 ax.text(j + 0.45, i + 0.42, dm, ha="right", va="top", fontsize=6,
                         color="black", bbox=dict(boxstyle="round,pad=0.1", fc="orange",
                                                  ec="none", alpha=0.9))
-                any_device[0] = True
         if mark is not None and mark[0] in xs and mark[1] in ys:
             j, i = xs.index(mark[0]), ys.index(mark[1])
             ax.add_patch(Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, lw=2.5,
@@ -155,21 +183,8 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
     bar_in = 0.9 * (fig.get_figheight() - 1.0)            # the bar's length, roughly [in]
     per_line = max(12, int(bar_in * 72 / (0.6 * 9)))      # characters of 9-pt text in it
     cb.set_label("\n".join(textwrap.wrap(value_label or value, per_line)), fontsize=9)
-    legend = ""
-    if mark is not None:
-        legend += f"outlined: {mark_label}"
-    if verdict is not None:
-        legend += ("; " if legend else "") + ("✓ holds  ✗ does not  = tie (within the "
-                                              "numerical uncertainty)  ! a run failed  "
-                                              "– no value (why, in the cell)")
-    if any_device[0]:
-        legend += ("; " if legend else "") + DEVICE_LEGEND
-    if title or legend:
-        import textwrap
-
-        width = max(40, int(fig.get_figwidth() * 13))   # characters that fit at fontsize 9
-        fig.suptitle("\n".join(textwrap.fill(t, width) for t in (title, legend) if t),
-                     fontsize=9)
+    if heading:
+        fig.suptitle(heading, fontsize=9)
     if path is not None:
         from ..fileio import savefig_atomic
 

@@ -18,7 +18,14 @@ Definitions used throughout the reports:
 * **ITAE** — ``∫ (t − t_start)·|e(t)| dt`` (trapezoid rule);
 * **control cost** — ``Σ_k u_k'R u_k · T`` over the controller's samples, with ``u``
   as applied (limited to the UPQC rating; the demanded one is reported too);
-* **running cost of (18)** — ``Σ_{j≤k} x_j'Qx_j + u_j'Ru_j`` along the samples.
+* **running cost of (18)** — ``Σ_{j≤k} x_j'Qx_j + u_j'Ru_j`` along the samples;
+* **definition sensitivity** (``<metric>_def_unc``, relative) — how much a metric moves when
+  its own definition's parameter moves, re-measured on the same trajectory
+  (:func:`definition_spread`): the settling time with the band at 1.5 % and 3 % around the
+  default 2 % (:data:`SETTLING_BANDS`); the backswing against the final value (mean over the
+  last ``tail``) instead of the pre-fault set-point; ITAE and the costs summed to
+  ``tail`` (0.5 s) before the run's end instead of to its end. It is one half of a metric's
+  measured uncertainty (the other: step halving); :mod:`weakgrid.study.ties` adds them.
 """
 
 from __future__ import annotations
@@ -28,7 +35,10 @@ import numpy as np
 from ..game.errors import ParameterError, ShapeError
 
 __all__ = ["settling_time", "itae", "backswing", "control_cost",
-           "running_cost", "stability_verdict"]
+           "running_cost", "stability_verdict", "definition_spread", "SETTLING_BANDS"]
+
+#: The settling band's alternatives around the default 2 % (the definition sensitivity).
+SETTLING_BANDS = (0.015, 0.03)
 
 
 def _check(t, y):
@@ -138,3 +148,25 @@ def stability_verdict(t, y, t_start=0.0, tail=1.0, settled_fraction=0.05) -> str
     if amp_late > 1.2 * amp_prev:
         return "unstable"
     return "undamped" if amp_late > 0.8 * amp_prev else "stable"
+
+
+def definition_spread(value, alternatives) -> float:
+    """``max |alt − value| / |value|`` over ``alternatives`` (the same metric re-measured
+    with its definition's parameter moved), relative [–].
+
+    ``nan`` when ``value`` is not finite, or is 0 while an alternative is not (a relative
+    spread of 0 is undefined; a relative uncertainty times the value adds nothing there
+    anyway); ``0`` when every alternative equals ``value``; alternatives that are not finite
+    are skipped (pass a bound instead: e.g. a
+    settling time that is undefined at a tighter band is at least the record's length).
+    """
+    value = float(value)
+    if not np.isfinite(value):
+        return float("nan")
+    alts = [float(a) for a in alternatives if np.isfinite(a)]
+    if not alts:
+        return 0.0
+    d = max(abs(a - value) for a in alts)
+    if value == 0:
+        return 0.0 if d == 0 else float("nan")
+    return float(d / abs(value))

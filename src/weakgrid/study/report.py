@@ -10,6 +10,7 @@ import pandas as pd
 
 from ..fileio import write_text_atomic
 from .failure import FAILED_CELLS_NOTE
+from .ties import compare, run_uncertainty
 
 __all__ = ["metrics_frame", "write_tables", "write_html", "sweep_html", "TOPICS", "BETTER",
            "who_did_best", "md_cell"]
@@ -63,7 +64,7 @@ BETTER = {
     "speed_peak_dev_pu": "lower", "speed_backswing_pu": "lower", "speed_settling_s": "lower",
     "speed_itae": "lower", "vdc_peak_dev_pu": "lower", "vdc_backswing_pu": "lower",
     "vdc_settling_s": "lower", "vdc_itae": "lower", "control_cost": "lower",
-    "vu_peak_pu": "lower",
+    "running_cost_18": "lower", "vu_peak_pu": "lower",
 }
 # effort metrics: a controller that does not drive the UPQC (exactly 0) does not take part
 EFFORT = ("control_cost", "vu_peak_pu")
@@ -159,7 +160,8 @@ def who_did_best(metrics: list[dict], uncertainty: dict | None = None,
     """Per scenario and metric of :data:`BETTER`, the controller that did best.
 
     ``uncertainty``: metric → relative numerical uncertainty (``|m(T) − m(T/2)| / |m(T)|``,
-    the sweeps' half-step check), when measured; a controller within it of the best is a tie.
+    the sweeps' half-step check), when measured; with each run's ``<metric>_def_unc`` it makes
+    the tie rule of :mod:`weakgrid.study.ties`: a controller within it of the best is a tie.
     ``names``: controller → full name. Returns rows ``scenario``, ``metric``, ``best``
     (names, ``" = "`` between tied ones), ``value``, ``tie`` (bool), ``uncertainty`` (NaN when
     not measured), ``others`` (the rest, with their values). Failed runs are left out, and
@@ -178,17 +180,22 @@ def who_did_best(metrics: list[dict], uncertainty: dict | None = None,
     out = []
     for sc, ms in by_sc.items():
         for key, way in BETTER.items():
-            vals = [(m["controller"], float(m[key])) for m in ms
+            runs = [m for m in ms
                     if isinstance(m.get(key), (int, float)) and not _empty(m.get(key))
                     and not isinstance(m.get(key), bool)
                     and not (key in EFFORT and m[key] == 0)]
+            vals = [(m["controller"], float(m[key])) for m in runs]
             if len(vals) < 2:
                 continue
-            vals.sort(key=lambda cv: cv[1], reverse=(way == "higher"))
+            order = sorted(range(len(vals)), key=lambda i: vals[i][1], reverse=(way == "higher"))
+            vals = [vals[i] for i in order]
+            runs = [runs[i] for i in order]
             best = vals[0][1]
             u = float(uncertainty.get(key, float("nan")))
-            tol = abs(best) * u if u == u else 0.0
-            tied = [c for c, v in vals if abs(v - best) <= tol]
+            # the one tie rule (weakgrid.study.ties): step halving + the metric's definition
+            ub = run_uncertainty(runs[0], key, u)
+            tied = [c for (c, v), r in zip(vals, runs)
+                    if compare(v, best, run_uncertainty(r, key, u), ub)[0] == "tie"]
             out.append({"scenario": sc, "metric": key, "better": way,
                         "best": " = ".join(names.get(c, c) for c in tied), "value": best,
                         "tie": len(tied) > 1, "uncertainty": u,
@@ -214,9 +221,11 @@ def _best_html(rows) -> str:
         f"</td><td>{e(r['others'])}</td></tr>" for r in rows)
     return ("<h2>Who did best</h2><p>Per scenario and metric, the controller with the best "
             "value (failed runs left out; on control cost and |Vu| peak, the controllers that do "
-            "not drive the UPQC left out). Controllers within the numerical uncertainty of "
-            "the best (relative, from the half-step check of the study's sweep) are a tie, "
-            "named together; where it was not measured, no tie is named.</p><div class='scroll'>"
+            "not drive the UPQC left out). Controllers within the measured uncertainty of "
+            "the best are a tie, named together — the tie rule of the claim table and the "
+            "maps: step halving (relative, from the half-step check of the study's sweep; the "
+            "column below) plus each run's sensitivity of the metric to its own definition "
+            "(settling band 1.5–3 %, …).</p><div class='scroll'>"
             "<table><tr><th>scenario</th><th>metric</th><th>best</th><th>value</th>"
             f"<th>numerical uncertainty</th><th>the others</th></tr>{body}</table></div>")
 
@@ -244,7 +253,7 @@ _CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto
 margin:1em 0}td,th{border:1px solid #ccc;padding:3px 6px;vertical-align:top;min-width:4em;
 max-width:40em;overflow-wrap:break-word}td:first-child{white-space:nowrap}pre{white-space:pre-wrap;overflow-wrap:anywhere;
 max-height:30em;overflow:auto}th{background:#f4f4f4}.reproduced{background:#d8f5d8}
-.partly{background:#fff3c4}.not{background:#f8d0d0}.notrun{background:#eee}
+.partly{background:#fff3c4}.tie{background:#dde8f8}.not{background:#f8d0d0}.notrun{background:#eee}
 img{max-width:100%;border:1px solid #ddd;margin:0.5em 0}"""
 
 
@@ -283,7 +292,9 @@ def write_html(path, *, claims, metrics, figures, designs, meta, notes=None, map
         cls = c["verdict"].replace(" ", "")
         parts.append(f"<tr><td>{e(c['id'])}</td><td>{e(c['case'])}</td><td>{e(c['paper'])}"
                      f"</td><td>{e(c['measured'] or '—')}</td><td>{e(c['rule'])}</td>"
-                     f"<td class='{cls}'>{e(c['verdict'])}</td>" +
+                     f"<td class='{cls}'>{e(c['verdict'])}"
+                     + (f"<br><small>{e(c['why'])}</small>" if c.get("why") else "")
+                     + "</td>" +
                      (f"<td>{e(c.get('map_setting') or '—')}</td>"
                       f"<td>{e(c.get('map_region') or 'not mapped')}</td>" if with_maps else "")
                      + "</tr>")

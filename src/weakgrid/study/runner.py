@@ -17,7 +17,8 @@ from .build import build_setup
 from .controllers import controller_variant, make_controller
 from .device import power_metrics
 from .failure import failure_text
-from .metrics import backswing, control_cost, itae, running_cost, settling_time, stability_verdict
+from .metrics import (SETTLING_BANDS, backswing, control_cost, definition_spread, itae,
+                      running_cost, settling_time, stability_verdict)
 
 __all__ = ["Run", "RunRecord", "run_scenario", "enable_windows", "make_events", "sim_settings",
            "derive_series", "flat_columns", "record_list"]
@@ -377,6 +378,7 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
             metrics[f"{label}_final_dev_pu"] = float(y[ok][-1] - y[0])  # back to set-point?
             metrics[f"{label}_verdict"] = stability_verdict(t[ok], y[ok], after) \
                 if res.failure is None else "unstable"
+            metrics.update(_definition_spreads(label, t[ok], y[ok], after, y[0], metrics))
         else:
             metrics.update({f"{label}_peak_dev_pu": float("nan"),
                             f"{label}_backswing_pu": float("nan"),
@@ -392,6 +394,12 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     metrics["control_cost_demanded"] = control_cost(uk, R_DESIGN, T)
     rc = running_cost(xa, ua, Q_DESIGN, R_DESIGN)
     metrics["running_cost_18"] = float(rc[-1]) if rc.size else 0.0
+    # the costs' sensitivity to their horizon: summed to the end less _HORIZON of the record
+    early = tk <= (t[-1] - _HORIZON * (t[-1] - after)) if len(tk) else np.zeros(0, bool)
+    metrics["control_cost_def_unc"] = definition_spread(
+        metrics["control_cost"], [control_cost(ua[early], R_DESIGN, T)] if early.any() else [])
+    metrics["running_cost_18_def_unc"] = definition_spread(
+        metrics["running_cost_18"], [float(rc[early][-1])] if early.any() else [])
     # per sample: the measured signals (NaN while bypassed), design states, demanded and
     # applied u, the running cost (and J, below)
     samples = {"tk": tk, "running_cost": rc, "x_design": xk, "y_measured": yk,
@@ -421,6 +429,35 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
             "sim": {"dt": float(dt), "tol": None if tol is None else float(tol)}}
     return RunRecord(run, metrics, series, info, samples=flat_columns(samples), results=res,
                      aliases=aliases)
+
+
+_TAIL = 0.5          # s: the final value's window (the metrics' default tail)
+_HORIZON = 0.1       # the horizon's move for the definition check: this fraction of the record
+                     # after the last disturbance is left out of ITAE and the costs
+
+
+def _definition_spreads(label, t, y, after, y0, metrics) -> dict:
+    """``<metric>_def_unc`` of a signal's metrics: each re-measured on the same trajectory with
+    its definition's parameter moved (:func:`weakgrid.study.metrics.definition_spread`).
+
+    ``t``, ``y``: the signal from ``after`` (the last disturbance) on; ``y0``: its set-point
+    (the pre-disturbance value the metrics are measured against)."""
+    out = {}
+    ts = metrics[f"{label}_settling_s"]
+    # a band at which the signal does not settle inside the record: at least the record's end
+    longest = max(float(t[-1] - _TAIL - after), ts if np.isfinite(ts) else 0.0)
+    alts = [settling_time(t, y, after, band=b, y_final=y0, tail=_TAIL) for b in SETTLING_BANDS]
+    out[f"{label}_settling_s_def_unc"] = definition_spread(
+        ts, [a if np.isfinite(a) else longest for a in alts])
+    # backswing past the final value (the mean over the last _TAIL s), not the set-point
+    out[f"{label}_backswing_pu_def_unc"] = definition_spread(
+        metrics[f"{label}_backswing_pu"], [backswing(t, y, after, tail=_TAIL)])
+    early = t <= t[-1] - _HORIZON * (t[-1] - after)
+    out[f"{label}_itae_def_unc"] = definition_spread(
+        metrics[f"{label}_itae"],
+        [itae(t[early], y[early], after, y_final=y0)] if (early & (t >= after)).sum() > 2
+        else [])
+    return out
 
 
 def omega_of(study):

@@ -611,9 +611,9 @@ def _claims(d):
         for k in ("id", "paper", "rule"):
             _need(c, k, w, str)
         params = inspect.signature(RULES[judge]).parameters
-        _keys(c, F.keys("claims") | (set(params) - {"m"}), w)
+        _keys(c, F.keys("claims") | (set(params) - {"m", "step_unc"}), w)
         for k, p in params.items():
-            if k != "m" and p.default is inspect.Parameter.empty and k not in c:
+            if k not in ("m", "step_unc") and p.default is inspect.Parameter.empty and k not in c:
                 raise ParameterError(f"{w}.{k}", None, f"missing; the judge '{judge}' needs it")
 
 

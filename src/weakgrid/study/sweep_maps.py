@@ -6,19 +6,26 @@ table (a row per run; :mod:`weakgrid.study.sweep`)::
     claim, title, label        the claim's id, the map's title and colour-bar label
     id                         the map's own id when a claim has several maps [claim]
     kind = "ratio"             metric of controller a / of b; holds if ≤ holds_below
-                               (or b failed while a finished: no value, holds, b's cause noted)
+                               (or b failed while a finished: no value, holds, b's cause noted;
+                               a failed while b finished: a loss, not, a's cause noted)
     kind = "value"             metric of controller a; holds if within holds_within = [lo, hi]
                                (no rule: the map only shows the quantity)
-    kind = "wins"              a smaller than b on every one of ``metrics`` (or b failed)
+    kind = "wins"              a smaller than b on every one of ``metrics`` (or b failed;
+                               a failed while b finished: not)
     kind = "stable"            a's speed verdict "stable" while b's is not (or b failed)
     x, y, facet                table columns (default: the sweep's first three axes)
 
-Ties: a comparison (ratio, wins) whose difference is smaller than the runs' numerical
-uncertainty is a tie, not a win. The uncertainty of a metric is measured by running the
-``[sweep.dt_check]`` points again at half the integration step: ``|m(T) − m(T/2)|`` relative
-to ``|m(T)|``, per load level and fault severity (the row of the map), applied to every cell
-of that row (a row without a check takes the largest measured at its load level). A cell where
-a run failed is marked failed, its detail naming the cause (voltage collapse, loss of
+Ties: a comparison (ratio, wins) whose difference is smaller than the runs' measured
+uncertainty is a tie, not a win — the one rule of :mod:`weakgrid.study.ties`, as in the claim
+table. A run's uncertainty is its step-halving part plus its metric's sensitivity to its own
+definition (``<metric>_def_unc``, recorded with every run: the settling band 1.5 %/3 %, …).
+The step-halving part is measured by running the ``[sweep.dt_check]`` points again at half the
+integration step: ``|m(T) − m(T/2)|`` relative to ``|m(T)|``, per load level and fault severity
+(the row of the map), applied to every cell of that row (a row without a check takes the
+largest measured at its load level). Losses are counted: where controller a failed and the
+baseline b finished, the cell is ``not`` with the note "a failed: cause"; where b failed and a
+finished, ``holds`` with "b failed: cause"; where both failed (or a ``value`` map's run
+failed), the cell is marked failed, its detail naming the cause (voltage collapse, loss of
 synchronism, …; :mod:`weakgrid.study.failure`). A cell without a value gets no verdict but a
 ``note`` saying why: a run failed, or the metric is undefined for a run that finished (e.g. the
 speed did not settle inside the run: no settling time).
@@ -33,6 +40,7 @@ import pandas as pd
 from ..game.errors import ParameterError
 from .failure import failure_kind
 from .maps import plot_map
+from .ties import compare, run_uncertainty
 
 __all__ = ["map_cells", "draw_maps", "map_summaries", "MAP_KINDS"]
 
@@ -101,6 +109,13 @@ def _why_missing(metric, who) -> str:
     return f"{who}: no {metric}"
 
 
+def _lost(a, ra):
+    """A cell where controller ``a`` failed while the baseline finished: counted as a loss,
+    ``not`` (``verdict, value, note, detail``)."""
+    kind = failure_kind(ra.get("failure")) or "failed"
+    return "not", math.nan, f"{a} failed: {kind}", f"{a} failed: {ra.get('failure', '')}"[:120]
+
+
 def _unc(by_row, rk):
     """The row's measured uncertainty, else the largest measured in its facet (load level)."""
     if rk in by_row:
@@ -157,46 +172,55 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
             m = spec["metric"]
             va, vb = _num(ra.get(m)), _num(rb.get(m)) if rb is not None else math.nan
             val = va / vb if vb else math.nan
-            ua, ub = _unc(unc[(m, a)], rk), _unc(unc[(m, b)], rk)
-            if ua is not None and ub is not None:
-                u = (ua * abs(va) + ub * abs(vb)) / abs(vb) if vb else math.nan
-            if fa:
+            ua = run_uncertainty(ra, m, _unc(unc[(m, a)], rk))
+            ub = run_uncertainty(rb, m, _unc(unc[(m, b)], rk)) if rb is not None else 0.0
+            if fa and rb is not None and not fb:    # ours lost the run, the baseline did not
+                verdict, val, note, detail = _lost(a, ra)
+            elif fa:
                 verdict = "failed"
             elif fb:    # only the baseline lost the run (e.g. LQR out of step): a holds, no value
                 val = math.nan
                 verdict, detail = "holds", f"{b} failed: {rb.get('failure', '')}"[:120]
-                note = f"{b} {failure_kind(rb.get('failure'))}"
+                note = f"{b} failed: {failure_kind(rb.get('failure')) or 'failed'}"
             elif not math.isfinite(val):      # a metric undefined for a finished run
                 note = _why_missing(m, [c for c, v in ((a, va), (b, vb))
                                         if not math.isfinite(v)] or [f"{a}/{b}"])
-            elif math.isfinite(u) and abs(va - vb) <= u * abs(vb):
-                verdict = "tie"
             else:
-                verdict = "holds" if val <= spec.get("holds_below", 1.0) else "not"
+                who, tol = compare(va, vb, ua, ub)
+                u = tol / abs(vb) if tol > 0 else math.nan
+                if who == "tie":
+                    verdict = "tie"
+                else:
+                    verdict = "holds" if val <= spec.get("holds_below", 1.0) else "not"
         elif kind == "wins":
             m0 = metrics[0]
             va0 = _num(ra.get(m0))
             vb0 = _num(rb.get(m0)) if rb is not None else math.nan
             val = va0 / vb0 if vb0 and not fb else math.nan
-            if fa:
+            if fa and rb is not None and not fb:
+                verdict, val, note, detail = _lost(a, ra)
+            elif fa:
                 verdict = "failed"
             elif fb:
                 verdict, detail = "holds", f"{b} failed: {rb.get('failure', '')}"[:120]
+                note = f"{b} failed: {failure_kind(rb.get('failure')) or 'failed'}"
             else:
-                res = []
+                res, us = [], []
                 for m in metrics:
                     va, vb = _num(ra.get(m)), _num(rb.get(m))
-                    ua, ub = _unc(unc[(m, a)], rk), _unc(unc[(m, b)], rk)
-                    tol = (ua * abs(va) + ub * abs(vb)) if ua is not None and ub is not None \
-                        else 0.0
-                    if not (math.isfinite(va) and math.isfinite(vb)):
+                    who, tol = compare(va, vb,
+                                       run_uncertainty(ra, m, _unc(unc[(m, a)], rk)),
+                                       run_uncertainty(rb, m, _unc(unc[(m, b)], rk)))
+                    if who == "n/a":
                         res.append("not")
-                    elif abs(va - vb) <= tol:
-                        res.append("tie")
                     else:
-                        res.append("holds" if va < vb else "not")
+                        res.append({"tie": "tie", "a": "holds", "b": "not"}[who])
+                        if vb and tol > 0:
+                            us.append(tol / abs(vb))
                     detail += f"{m}: {va:.3g} vs {vb:.3g}; "
                 verdict = "not" if "not" in res else ("tie" if "tie" in res else "holds")
+                if us:
+                    u = max(us)
         elif kind == "stable":
             val = _num(ra.get(spec.get("metric", "speed_settling_s")))
             sa = "unstable" if fa else ra.get("speed_verdict")
@@ -278,6 +302,7 @@ def draw_maps(study, table, folder, quick=False) -> list[dict]:
         fshort = facet.split(".")[-1] if facet else None
         shown = cells.rename(columns={facet: fshort}) if facet else cells
         fig = plot_map(shown, x, y, "value", verdict="verdict", note="note", facet=fshort,
+                       uncertainty="uncertainty",
                        mark=mark, device="device_over",
                        title=f"{spec['claim']}: {spec.get('title', '')}",
                        value_label=spec.get("label", spec.get("metric", "")),
@@ -328,7 +353,15 @@ def map_summaries(maps) -> list[dict]:
                 txt += ("holds at " + ", ".join(f"{v:g}" + (f" ({w})" if w else "")
                                                 for v, w in zip(ok, why))) if ok else "holds nowhere"
                 if ties:
-                    txt += "; tie at " + ", ".join(f"{v:g}" for v in ties)
+                    tr = row[row["verdict"] == "tie"]
+                    txt += "; tie at " + ", ".join(
+                        f"{v:g}" + (f" (±{u * 100:.2g} %)" if isinstance(u, float) and math.isfinite(u)
+                                    else "") for v, u in zip(ties, tr["uncertainty"]))
+                lost = row[(row["verdict"] == "not") & row["note"].fillna("").str.contains(
+                    " failed:")] if "note" in row else row.iloc[:0]
+                if not lost.empty:
+                    txt += "; not at " + ", ".join(f"{v:g} ({n})" for v, n in
+                                                   zip(lost[x], lost["note"]))
                 if fails:
                     fr = row[row["verdict"] == "failed"]
                     txt += "; a run failed at " + ", ".join(
