@@ -70,8 +70,9 @@ Run:  PYTHONPATH=src python benchmarks/bench_sweep.py [n_ratings] [--dask-defaul
       PYTHONPATH=src python benchmarks/bench_sweep.py --study [--repeats N] [--workers W]
 
 ``--study``: the commands users wait for, batched against the scalar path (issue #21), each
-pair measured in one run of this script, alternating, a fresh output folder and cache each
-time, medians of ``--repeats`` (default 1):
+pair measured in one run of this script, a fresh output folder and cache each time, each in a
+fresh process (its own imports and per-process caches, as a command runs), the order
+alternated between repeats, medians of ``--repeats`` (default 1):
 
 * the case-1 quick sweep (``weakgrid sweep case1-weak-grid --quick``: 12 runs) on ``W``
   workers (default 2; 0 = serially in this process);
@@ -328,9 +329,22 @@ def main(n_ratings=8, dask_defaults=False):
     print(f"load average after: {os.getloadavg()}")
 
 
-def _timed(fn):
+def _fresh(fn, *args):
+    """``(wall time [s], fn(*args))`` in a fresh process (as a command runs: its own imports
+    and per-process caches, none left warm by the measurement before)."""
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(1, mp_context=mp.get_context("spawn")) as ex:
+        return ex.submit(_timed, fn, *args).result()
+
+
+def _timed(fn, *args):
+    import logging
+
+    logging.disable(logging.INFO)
     t0 = time.perf_counter()
-    out = fn()
+    out = fn(*args)
     return time.perf_counter() - t0, out
 
 
@@ -361,21 +375,17 @@ def _same_table(a, b):
 def study_commands(repeats=1, workers=2):
     """The case-1 quick sweep and ``reproduce --quick``, scalar against batched (see the
     module's text); prints the medians and ratios."""
-    import logging
-
-    logging.disable(logging.INFO)
     print(f"== study commands, scalar vs batched, {workers} workers, medians of {repeats} ==")
     print(f"load average before: {os.getloadavg()}  (cores: {os.cpu_count()})")
     for label, fn in (("case-1 quick sweep (12 runs)", _case1_quick_sweep),
                       ("reproduce --quick", _reproduce_quick)):
         times = {"scalar": [], "batched": []}
         same = True
-        for _ in range(repeats):
+        for k in range(repeats):
             tables = {}
-            for path in ("scalar", "batched"):
+            for path in ("scalar", "batched")[::1 if k % 2 == 0 else -1]:   # order alternated
                 with tempfile.TemporaryDirectory() as tmp:
-                    t, tables[path] = _timed(lambda: fn(f"{tmp}/out", workers,
-                                                        path == "batched"))
+                    t, tables[path] = _fresh(fn, f"{tmp}/out", workers, path == "batched")
                 times[path].append(t)
             same = same and _same_table(tables["scalar"], tables["batched"])
         s, b = (statistics.median(times[k]) for k in ("scalar", "batched"))
