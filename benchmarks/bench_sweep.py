@@ -67,6 +67,24 @@ ratios themselves are noisy: 0.75x-1.72x), the engine before (``--dask-defaults`
   (``bench_sweep.py 32``) 1.96x warm, 1.89x cold; the plain pool 2.02-2.03x.
 
 Run:  PYTHONPATH=src python benchmarks/bench_sweep.py [n_ratings] [--dask-defaults]
+      PYTHONPATH=src python benchmarks/bench_sweep.py --study [--repeats N] [--workers W]
+
+``--study``: the commands users wait for, batched against the scalar path (issue #21), each
+pair measured in one run of this script, a fresh output folder and cache each time, each in a
+fresh process (its own imports and per-process caches, as a command runs), the order
+alternated between repeats, medians of ``--repeats`` (default 1):
+
+* the case-1 quick sweep (``weakgrid sweep case1-weak-grid --quick``: 12 runs) on ``W``
+  workers (default 2; 0 = serially in this process);
+* ``weakgrid reproduce --quick`` (its runs, trainings, figures, report and the maps' sweeps).
+
+The scalar path is one task per run (:func:`weakgrid.sweep.execute`); the batched path groups
+a sweep's runs by grid (:func:`weakgrid.study.batches.batch_key`) and hands each batch to
+:func:`weakgrid.study.batches.simulate_many`, a task per batch — today a loop over the batch's
+runs, so the two measure the same simulations (the ratio shows the cost of batching the
+tasks); once ``simulate_many`` advances a batch in one simulator pass, the same command
+measures the batched simulator's gain. The tables of both paths are checked equal (times
+aside).
 
 ``--dask-defaults``: the cluster with Dask's default settings and the runs in the sweep's
 order (the engine before the changes above), for a comparison on the same machine.
@@ -311,6 +329,81 @@ def main(n_ratings=8, dask_defaults=False):
     print(f"load average after: {os.getloadavg()}")
 
 
+def _fresh(fn, *args):
+    """``(wall time [s], fn(*args))`` in a fresh process (as a command runs: its own imports
+    and per-process caches, none left warm by the measurement before)."""
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(1, mp_context=mp.get_context("spawn")) as ex:
+        return ex.submit(_timed, fn, *args).result()
+
+
+def _timed(fn, *args):
+    import logging
+
+    logging.disable(logging.INFO)
+    t0 = time.perf_counter()
+    out = fn(*args)
+    return time.perf_counter() - t0, out
+
+
+def _case1_quick_sweep(out, workers, batched):
+    from weakgrid.study.sweep import run_study_sweep
+
+    return run_study_sweep(load_study("case1-weak-grid"), out, quick=True, workers=workers,
+                           progress=False, batched=batched)
+
+
+def _reproduce_quick(out, workers, batched):
+    from weakgrid.study.reproduce import reproduce
+
+    return reproduce(out, quick=True, workers=workers, progress=False, batched=batched)["sweep"]
+
+
+def _same_table(a, b):
+    times = [c for c in ("wall_s", "sim_wall_s", "traceback_tail") if c in a.columns]
+    try:
+        import pandas as pd
+
+        pd.testing.assert_frame_equal(a.drop(columns=times), b.drop(columns=times))
+        return True
+    except AssertionError:
+        return False
+
+
+def study_commands(repeats=1, workers=2):
+    """The case-1 quick sweep and ``reproduce --quick``, scalar against batched (see the
+    module's text); prints the medians and ratios."""
+    print(f"== study commands, scalar vs batched, {workers} workers, medians of {repeats} ==")
+    print(f"load average before: {os.getloadavg()}  (cores: {os.cpu_count()})")
+    for label, fn in (("case-1 quick sweep (12 runs)", _case1_quick_sweep),
+                      ("reproduce --quick", _reproduce_quick)):
+        times = {"scalar": [], "batched": []}
+        same = True
+        for k in range(repeats):
+            tables = {}
+            for path in ("scalar", "batched")[::1 if k % 2 == 0 else -1]:   # order alternated
+                with tempfile.TemporaryDirectory() as tmp:
+                    t, tables[path] = _fresh(fn, f"{tmp}/out", workers, path == "batched")
+                times[path].append(t)
+            same = same and _same_table(tables["scalar"], tables["batched"])
+        s, b = (statistics.median(times[k]) for k in ("scalar", "batched"))
+        print(f"{label}: scalar {s:7.1f} s, batched {b:7.1f} s -> {s / b:.2f}x "
+              f"(tables equal: {same}; all: scalar {[round(x, 1) for x in times['scalar']]}, "
+              f"batched {[round(x, 1) for x in times['batched']]})")
+    print(f"load average after: {os.getloadavg()}")
+
+
+def _option(name, default):
+    if name in sys.argv:
+        return int(sys.argv[sys.argv.index(name) + 1])
+    return default
+
+
 if __name__ == "__main__":
+    if "--study" in sys.argv:
+        study_commands(_option("--repeats", 1), _option("--workers", 2))
+        sys.exit(0)
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     main(int(args[0]) if args else 8, dask_defaults="--dask-defaults" in sys.argv)

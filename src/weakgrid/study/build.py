@@ -45,9 +45,11 @@ The UPQC is either an existing series branch (``upqc.branch``: a branch name, a 
 from __future__ import annotations
 
 import contextlib
+import copy
 import logging
 import math
 import warnings
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -56,6 +58,7 @@ from ..design import derive_design
 from ..design.upqc_insert import insert_upqc_matpower, insert_upqc_pandapower
 from .grid_edits import apply_case_edits, has_edits, per_level
 from ..game.errors import ParameterError
+from ..hashing import canonical_json
 from ..logs import quiet_loggers
 from ..sim.errors import DataError, DataWarning
 from ..sim.controllers import gti_signals, gti_state_map, mapped, sg_signals, sg_state_map
@@ -333,7 +336,51 @@ def _pandapower_impedance(net, z, f, t, name):
 
 
 # ----------------------------------------------------------------------------- setup
+#: per process: the grids built by :func:`_network`, most recent last (a command builds the
+#: same grid at the same load for its planning, its training and every run of it; reading a
+#: case and its power flow's network once is enough)
+_NETWORKS: OrderedDict = OrderedDict()
+NETWORK_CACHE_SIZE = 8
+_FILE_FIELDS = ("file", "raw", "dyr")
+
+
+def _network_key(study, load) -> str:
+    """What :func:`_build_network` reads: ``[grid]``, ``[upqc]`` but its rating (a sweep's
+    axis; the grid does not depend on it), the study's folder, the load level and the stamp
+    (size, modification time) of every file ``[grid]`` names — an edited case file is read
+    again."""
+    g = study.data["grid"]
+    up = {k: v for k, v in study.data["upqc"].items() if k != "rating"}
+    stamps = {}
+    for k in _FILE_FIELDS:
+        v = g.get(k)
+        if isinstance(v, str):
+            p = study.resolve(v)
+            try:
+                st = p.stat()
+                stamps[k] = [str(p), st.st_size, st.st_mtime_ns]
+            except OSError:
+                stamps[k] = str(p)
+    return canonical_json([g, up, str(study.base_dir), load, stamps])
+
+
 def _network(study, load):
+    """``(Network, bus_id name→number, branch names, upqc row, System or None)`` at ``load``:
+    a private copy of the grid :func:`_build_network` built (once per process for the same
+    inputs, :func:`_network_key`); the caller may edit it."""
+    key = _network_key(study, load)
+    hit = _NETWORKS.get(key)
+    if hit is None:
+        hit = _build_network(study, load)
+        _NETWORKS[key] = copy.deepcopy(hit)   # kept pristine: every caller gets a copy
+        while len(_NETWORKS) > NETWORK_CACHE_SIZE:
+            _NETWORKS.popitem(last=False)
+        return hit
+    _NETWORKS.move_to_end(key)
+    return copy.deepcopy(hit)
+
+
+def _build_network(study, load):
     """``(Network, bus_id name→number, branch names, upqc row, System or None)`` at ``load``."""
     g = study.data["grid"]
     up = study.data["upqc"]

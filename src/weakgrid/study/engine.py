@@ -31,6 +31,7 @@ from ..design import design_mode, machine_mode, mode_states, modes
 from ..fileio import write_json_atomic
 from ..manifest import Manifest
 from ..models import load_preset
+from .batches import STUDY_BATCHES
 from .build import build_setup
 from .cache import inputs_key, load_run, remove_stale, save_run
 from .claims import judge_all
@@ -190,7 +191,7 @@ def check_events(plan) -> None:
 
 
 def run_studies(studies, output, quick=False, log=None, title=None, progress=True,
-                scheduler=None, workers=None, maps=True, force=False) -> dict:
+                scheduler=None, workers=None, maps=True, force=False, batched=False) -> dict:
     """Run every (scenario, controller) of ``studies`` and write everything to ``output``.
 
     The runs (and the sweeps of the studies that have a ``[sweep]`` table, drawn as maps
@@ -202,6 +203,9 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
     stops the run before any work (unless ``force``: overwritten); other files are left alone.
     Every run's events are built on its grid while planning (:func:`check_events`): a bad
     event stops the command before any training or write.
+
+    ``batched``: the maps' sweep runs in batches of one grid
+    (:func:`weakgrid.study.batches.simulate_many`; default: a task per run, the scalar path).
 
     Returns a summary dict (claims, metrics, figures, report, designs, maps).
     """
@@ -341,7 +345,7 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                                     workers=0 if serial else None, client=client,
                                     progress=progress, log=log, cost=run_cost,
                                     table_path=out / _sweep_file(quick),
-                                    desc="maps")
+                                    desc="maps", batch=STUDY_BATCHES if batched else None)
     map_list, sweeps, uncertainty = [], [], {}
     for st in swept:
         sub = sweep_table[sweep_table["scenario"].isin(st.data["sweep"]["scenarios"])]

@@ -338,15 +338,18 @@ def claim_sweep_outputs(study, output, quick=False, maps=False, force=False,
 
 def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
                     progress=True, log=None, cache_dir=None, force=False,
-                    maps=False) -> pd.DataFrame:
+                    maps=False, batched=False) -> pd.DataFrame:
     """Run the study's sweep; write ``<output>/<study>-sweep.parquet``; return the table.
 
     The cache (``<output>/cache`` unless given) keeps every finished run: an interrupted
     sweep resumes, a repeated one runs nothing. The table (and the maps' files, ``maps``)
     are listed in the folder's manifest before they are written; a file of another origin
     in the way stops the sweep before any run unless ``force``
-    (:class:`weakgrid.manifest.Manifest`).
+    (:class:`weakgrid.manifest.Manifest`). ``batched``: the runs of one grid go to
+    :func:`weakgrid.study.batches.simulate_many` together, a task per batch (default: a task
+    per run, the scalar path).
     """
+    from .batches import STUDY_BATCHES
     from .sweep_estimate import run_cost
 
     out = Path(output)
@@ -356,6 +359,7 @@ def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
 
     table = run_sweep(pts, run_point, cache_dir=cache_dir or out / "cache",
                       scheduler=scheduler, workers=workers, progress=progress, log=log,
-                      cost=run_cost, table_path=table_path, desc=f"sweep {study.name}")
+                      cost=run_cost, table_path=table_path, desc=f"sweep {study.name}",
+                      batch=STUDY_BATCHES if batched else None)
     Manifest(out).record([table_path])   # its content, as written
     return table

@@ -10,8 +10,11 @@ an existing one, with a progress bar, and returns one table, a row per run.
 
 from .axes import Axis, Point, expand, get_path, set_path
 from .cache import ResultCache, canonical_json, code_fingerprint, run_key
-from .engine import SweepInterrupted, execute, open_client, results_table, run_sweep
+from .batches import Batch, group, scatter
+from .engine import (SweepInterrupted, execute, execute_batch, open_client, results_table,
+                     run_sweep)
 
 __all__ = ["Axis", "Point", "expand", "get_path", "set_path", "ResultCache", "canonical_json",
-           "code_fingerprint", "run_key", "SweepInterrupted", "execute", "results_table",
+           "code_fingerprint", "run_key", "SweepInterrupted", "execute", "execute_batch",
+           "results_table", "Batch", "group", "scatter",
            "run_sweep", "open_client"]

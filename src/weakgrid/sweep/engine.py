@@ -33,7 +33,8 @@ from .cache import ResultCache, run_key
 
 _log = logging.getLogger(__name__)
 
-__all__ = ["run_sweep", "execute", "SweepInterrupted", "results_table", "open_client",
+__all__ = ["run_sweep", "execute", "execute_batch", "SweepInterrupted", "results_table",
+           "open_client",
            "LOCAL_CLUSTER_CONFIG"]
 
 #: Dask settings of the LocalCluster that :func:`open_client` starts. Each worker runs one
@@ -92,22 +93,53 @@ def execute(run, inputs: dict, key: str) -> dict:
     it, ``cpu_s`` [s] (``wall_s`` above ``cpu_s``: the run waited for a core).
     """
     t0, c0 = time.perf_counter(), time.thread_time()
-    signals = None
     try:
         out = run(inputs)
-        if isinstance(out, tuple):
-            out, signals = out
-        metrics = dict(out)
-        status = str(metrics.pop("status", "ok"))
-        failure = str(metrics.pop("failure", "") or "")
-        kind = str(metrics.pop("failure_kind", "") or "")
     except Exception as exc:  # a failing run is a row, whatever it raised
+        out = exc
+    return _record(key, out, time.perf_counter() - t0, time.thread_time() - c0)
+
+
+def execute_batch(run_many, inputs: list, keys: list) -> list:
+    """Run a batch of points (on a worker) and return one record each (as :func:`execute`).
+
+    ``run_many(inputs)`` returns one result per input, in order: what ``run`` of
+    :func:`execute` returns, or the exception that run raised (it becomes that run's failed
+    row alone). If ``run_many`` itself raises, every run of the batch fails with its cause.
+    Each record's ``wall_s`` and ``cpu_s`` are the batch's divided by its size [s].
+    """
+    t0, c0 = time.perf_counter(), time.thread_time()
+    try:
+        outs = list(run_many(list(inputs)))
+        if len(outs) != len(keys):
+            raise RuntimeError(f"{getattr(run_many, '__name__', run_many)} returned "
+                               f"{len(outs)} results for a batch of {len(keys)} runs")
+    except Exception as exc:  # the whole batch failed: each run is a failed row
+        outs = [exc] * len(keys)
+    n = max(len(keys), 1)
+    wall, cpu = (time.perf_counter() - t0) / n, (time.thread_time() - c0) / n
+    return [_record(k, o, wall, cpu) for k, o in zip(keys, outs)]
+
+
+def _record(key, out, wall, cpu) -> dict:
+    """The record of one run from what it returned (or the exception it raised)."""
+    signals = None
+    if not isinstance(out, BaseException):
+        try:
+            if isinstance(out, tuple):
+                out, signals = out
+            metrics = dict(out)
+            status = str(metrics.pop("status", "ok"))
+            failure = str(metrics.pop("failure", "") or "")
+            kind = str(metrics.pop("failure_kind", "") or "")
+        except Exception as exc:  # not metrics: the run's failure too
+            out, signals = exc, None
+    if isinstance(out, BaseException):
         metrics, status = {}, "failed"
-        failure = f"{type(exc).__name__}: {exc}"
-        kind = type(exc).__name__
-        tb = traceback.format_exc(limit=-3)
+        failure = f"{type(out).__name__}: {out}"
+        kind = type(out).__name__
+        tb = "".join(traceback.format_exception(out, limit=-3))
         metrics["traceback_tail"] = tb[-2000:]
-    wall, cpu = time.perf_counter() - t0, time.thread_time() - c0
     rec = {"key": key, "status": status, "failure": failure, "failure_kind": kind,
            "wall_s": wall, "cpu_s": cpu, "metrics": metrics, "weakgrid_version": __version__}
     return {"record": rec, "signals": signals}
@@ -211,12 +243,35 @@ def results_table(points, records) -> pd.DataFrame:
     return df
 
 
-def _priorities(todo, cost):
-    """Dask priorities (higher runs first): by decreasing ``cost``, ties in the given order."""
+def _tasks(todo, run, batch, batch_size):
+    """``(function, arguments, (points, keys))`` of every task: one point each, or with
+    ``batch = (key, run_many)`` one batch each (:func:`weakgrid.sweep.batches.group`)."""
+    if batch is None:
+        return [(execute, (run, p.inputs, k), ([p], [k])) for p, k in todo]
+    from .batches import group
+
+    key, run_many = batch
+    out = []
+    for b in group(todo, lambda pk: key(pk[0].inputs), batch_size):
+        pts = [todo[i][0] for i in b.rows]
+        keys = [todo[i][1] for i in b.rows]
+        out.append((execute_batch, (run_many, [p.inputs for p in pts], keys), (pts, keys)))
+    return out
+
+
+def _results(res):
+    """The records a task returned (a batch returns a list of them)."""
+    return res if isinstance(res, list) else [res]
+
+
+def _priorities(todo, cost, members=None):
+    """Dask priorities (higher runs first): by decreasing ``cost`` (of a batch: the sum over
+    its ``members``), ties in the given order."""
     n = len(todo)
     if cost is None:
         return [n - i for i in range(n)]
-    est = [float(cost(p.inputs)) for p, _ in todo]
+    est = [float(cost(p.inputs)) for p, _ in todo] if members is None else \
+        [sum(float(cost(p.inputs)) for p in m) for m in members]
     order = sorted(range(n), key=lambda i: -est[i] if math.isfinite(est[i]) else 0.0)
     prio = [0] * n
     for rank, i in enumerate(order):
@@ -226,7 +281,8 @@ def _priorities(todo, cost):
 
 def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
               workers: int | None = None, progress: bool = True, table_path=None,
-              desc: str = "sweep", log=None, client=None, cost=None) -> pd.DataFrame:
+              desc: str = "sweep", log=None, client=None, cost=None, batch=None,
+              batch_size: int | None = None) -> pd.DataFrame:
     """Run every point (skipping those already cached) and return the result table.
 
     Parameters
@@ -256,6 +312,15 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
         ``cost(inputs) -> float``, an estimate of a run's cost (any unit): on a cluster the
         costliest runs start first, so that the sweep does not end with one worker on a long
         run and the others idle. Default: the points' order.
+    batch : (key, run_many), optional
+        Run the points in batches instead of one task each: the points still to run whose
+        ``key(inputs)`` is equal form a batch (:func:`weakgrid.sweep.batches.group`: in the
+        points' order), and ``run_many(list of inputs)`` runs a batch as one task
+        (:func:`execute_batch`; for a study, :data:`weakgrid.study.batches.STUDY_BATCHES`).
+        ``run`` still names the runs in the cache: a batched and a one-by-one sweep share
+        their finished runs. Default: one task per point (the scalar path).
+    batch_size : int, optional
+        Largest batch (larger groups are split, so that batches spread over the workers).
 
     Returns
     -------
@@ -288,13 +353,15 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
                                          (" serially" if workers == 0 else
                                           f" on {scheduler or 'a local cluster'}")))
     bar = _progress(total, total - len(todo_unique), progress, desc)
+    tasks = _tasks(todo_unique, run, batch, batch_size)
     try:
         with _sigterm_as_interrupt():
-            if todo_unique and workers == 0 and client is None:
-                for p, k in todo_unique:
-                    records[k] = _store(cache, execute(run, p.inputs, k))
-                    bar.update(1)
-            elif todo_unique:
+            if tasks and workers == 0 and client is None:
+                for fn, args, _ in tasks:
+                    for res in _results(fn(*args)):
+                        records[res["record"]["key"]] = _store(cache, res)
+                        bar.update(1)
+            elif tasks:
                 from distributed import as_completed
 
                 ctx = contextlib.nullcontext(client) if client is not None else \
@@ -302,16 +369,18 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
                 with ctx as cl:
                     # submitted costliest first, each with its priority (Dask starts a
                     # task at once on an idle worker, and runs a queue by priority)
-                    prio = _priorities(todo_unique, cost)
-                    futs = [cl.submit(execute, run, p.inputs, k, key=f"weakgrid-run-{k}",
+                    prio = _priorities([(pts[0], keys_[0]) for _, _, (pts, keys_) in tasks],
+                                       cost, [pts for _, _, (pts, _) in tasks])
+                    futs = [cl.submit(fn, *args, key=f"weakgrid-run-{keys_[0]}"
+                                      + (f"-{len(keys_)}" if len(keys_) > 1 else ""),
                                       pure=False, priority=pr)
-                            for pr, (p, k) in sorted(zip(prio, todo_unique),
-                                                     key=lambda x: -x[0])]
+                            for pr, (fn, args, (_, keys_)) in sorted(zip(prio, tasks),
+                                                                     key=lambda x: -x[0])]
                     try:
                         for fut in as_completed(futs):
-                            res = fut.result()
-                            records[res["record"]["key"]] = _store(cache, res)
-                            bar.update(1)
+                            for res in _results(fut.result()):
+                                records[res["record"]["key"]] = _store(cache, res)
+                                bar.update(1)
                     finally:
                         for f in futs:
                             if not f.done():

@@ -1,0 +1,90 @@
+"""Group a sweep's runs into batches (runs a batched simulator can advance together).
+
+Knows nothing about power systems: a batch is the runs whose ``key(inputs)`` is equal (for a
+study's sweep, the same grid: :func:`weakgrid.study.batches.batch_key`). :func:`group` is
+pure — the batches come in the order of their first run, each run keeps its order inside
+its batch, every run is in exactly one batch — and :func:`scatter` puts the batches'
+results back on the runs' rows.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..game.errors import ParameterError
+
+__all__ = ["Batch", "group", "scatter"]
+
+
+@dataclass(frozen=True)
+class Batch:
+    """Runs that share a key.
+
+    Attributes
+    ----------
+    key : hashable
+        The key every member shares.
+    rows : tuple of int
+        The members' positions in the list given to :func:`group`, increasing.
+    """
+
+    key: object
+    rows: tuple
+
+    def __len__(self):
+        return len(self.rows)
+
+
+def group(items, key, max_size: int | None = None) -> list[Batch]:
+    """The batches of ``items`` by ``key(item)``.
+
+    Parameters
+    ----------
+    items : sequence
+        The runs (any objects; ``key`` reads them).
+    key : callable
+        ``key(item)`` → a hashable value; equal values share a batch.
+    max_size : int, optional
+        Largest batch (a larger group is split into consecutive batches of at most this many,
+        so that batches can still be spread over workers). Default: no limit.
+
+    Returns
+    -------
+    list of Batch
+        In the order of each batch's first member; members in their order in ``items``.
+    """
+    if max_size is not None and (isinstance(max_size, bool) or not isinstance(max_size, int)
+                                 or max_size < 1):
+        raise ParameterError("max_size", max_size, "give a whole number ≥ 1, or None (no "
+                             "limit)")
+    rows: dict = {}
+    for i, it in enumerate(items):
+        rows.setdefault(key(it), []).append(i)
+    out = []
+    for k, r in rows.items():
+        step = max_size or len(r)
+        out += [Batch(k, tuple(r[j:j + step])) for j in range(0, len(r), step)]
+    out.sort(key=lambda b: b.rows[0])
+    return out
+
+
+def scatter(batches, results, n: int) -> list:
+    """Each batch's results (one list per batch, in its members' order) on the rows
+    ``0..n-1`` they came from."""
+    out = [None] * n
+    seen = [False] * n
+    if len(results) != len(batches):
+        raise ParameterError("results", len(results), f"give one list of results per batch "
+                             f"({len(batches)})")
+    for b, res in zip(batches, results):
+        res = list(res)
+        if len(res) != len(b.rows):
+            raise ParameterError("results", len(res), f"batch {b.key!r} has {len(b.rows)} "
+                                 "runs: give one result per run")
+        for i, r in zip(b.rows, res):
+            if seen[i]:
+                raise ParameterError("batches", i, "a row is in two batches")
+            out[i], seen[i] = r, True
+    if not all(seen):
+        raise ParameterError("batches", seen.index(False), "a row is in no batch")
+    return out

@@ -1,0 +1,121 @@
+"""Batches of a sweep: grouping (keys, order, every run once), results back on their rows, and
+a sweep run in batches giving the table of the one-by-one sweep (failures stay their own row)."""
+
+from __future__ import annotations
+
+import sys
+
+import cloudpickle
+import pandas as pd
+import pytest
+
+from weakgrid.game.errors import ParameterError
+from weakgrid.sweep import execute_batch, expand, group, run_sweep, scatter
+
+cloudpickle.register_pickle_by_value(sys.modules[__name__])
+
+BASE = {"upqc": {"rating": 0.15}, "load": "high", "fault": 0.05}
+
+
+def toy_run(inputs):
+    """A deterministic 'simulation': raises for a negative rating, fails at zero."""
+    r = inputs["upqc"]["rating"]
+    if r < 0:
+        raise ValueError(f"rating {r} < 0")
+    if r == 0:
+        return {"status": "failed", "failure": "loss of synchronism", "peak": float("nan")}
+    return {"peak": r * inputs["fault"], "label": inputs["load"]}
+
+
+def toy_many(runs):
+    """The batch hook of the toy: one by one, an exception is that run's result."""
+    out = []
+    for inp in runs:
+        try:
+            out.append(toy_run(inp))
+        except Exception as exc:
+            out.append(exc)
+    return out
+
+
+def by_load(inputs):
+    return inputs["load"]
+
+
+def short_many(runs):
+    return [toy_run(runs[0])]      # a broken batch hook: one result for the whole batch
+
+
+def _tab(df):
+    return df.drop(columns=["wall_s", "traceback_tail"]).reset_index(drop=True)
+
+
+def test_group_keys_order_and_sizes():
+    items = ["a1", "b1", "a2", "c1", "b2", "a3"]
+    bs = group(items, key=lambda s: s[0])
+    assert [(b.key, b.rows) for b in bs] == [("a", (0, 2, 5)), ("b", (1, 4)), ("c", (3,))]
+    bs = group(items, key=lambda s: s[0], max_size=2)
+    assert [(b.key, b.rows) for b in bs] == [("a", (0, 2)), ("b", (1, 4)), ("c", (3,)),
+                                             ("a", (5,))]
+    assert sorted(i for b in bs for i in b.rows) == list(range(len(items)))
+    assert max(len(b) for b in bs) == 2
+    assert group([], key=str) == []
+
+
+@pytest.mark.parametrize("size", [0, -1, 1.5, True])
+def test_group_refuses_a_bad_size(size):
+    with pytest.raises(ParameterError, match="max_size"):
+        group([1, 2], key=str, max_size=size)
+
+
+def test_scatter_puts_each_result_on_its_row():
+    items = [3, 10, 4, 11, 5]
+    bs = group(items, key=lambda x: x >= 10)
+    res = [[x * 2 for x in (items[i] for i in b.rows)] for b in bs]
+    assert scatter(bs, res, len(items)) == [x * 2 for x in items]
+    with pytest.raises(ParameterError, match="one result per run"):
+        scatter(bs, [res[0][:1], res[1]], len(items))
+    with pytest.raises(ParameterError, match="one list of results per batch"):
+        scatter(bs, res[:1], len(items))
+    with pytest.raises(ParameterError, match="in no batch"):
+        scatter(bs, res, len(items) + 1)
+
+
+def test_a_batched_sweep_gives_the_one_by_one_table(tmp_path):
+    pts = expand(BASE, {"upqc.rating": [-0.1, 0.0, 0.1, 0.3], "load": ["high", "low"]})
+    one = run_sweep(pts, toy_run, cache_dir=tmp_path / "one", workers=0, progress=False)
+    seen = []
+
+    def spy(runs):
+        seen.append([(r["load"], r["upqc"]["rating"]) for r in runs])
+        return toy_many(runs)
+
+    many = run_sweep(pts, toy_run, cache_dir=tmp_path / "many", workers=0, progress=False,
+                     batch=(by_load, spy))
+    pd.testing.assert_frame_equal(_tab(one), _tab(many))
+    assert list(many["status"]) == ["failed", "failed"] * 2 + ["ok", "ok"] * 2
+    assert "ValueError: rating -0.1 < 0" in many["failure"][0]
+    assert [len(b) for b in seen] == [4, 4]            # two loads, a batch each, in order
+    assert seen[0] == [("high", -0.1), ("high", 0.0), ("high", 0.1), ("high", 0.3)]
+    # the cache is shared: the one-by-one sweep over the batched one's cache runs nothing
+    again = run_sweep(pts, toy_run, cache_dir=tmp_path / "many", workers=0, progress=False)
+    pd.testing.assert_frame_equal(_tab(again), _tab(many))
+
+
+def test_a_broken_batch_fails_each_of_its_runs_with_the_cause():
+    recs = execute_batch(short_many, [dict(BASE), dict(BASE)], ["k1", "k2"])
+    assert [r["record"]["key"] for r in recs] == ["k1", "k2"]
+    assert all(r["record"]["status"] == "failed" for r in recs)
+    assert "returned 1 results for a batch of 2" in recs[0]["record"]["failure"]
+
+
+def test_batches_on_a_cluster_give_the_serial_table(tmp_path):
+    from weakgrid.sweep import open_client
+
+    pts = expand(BASE, {"upqc.rating": [-0.1, 0.1, 0.2], "load": ["high", "low", "mid"]})
+    serial = run_sweep(pts, toy_run, cache_dir=tmp_path / "s", workers=0, progress=False)
+    with open_client(None, 1) as client:
+        par = run_sweep(pts, toy_run, cache_dir=tmp_path / "p", client=client, progress=False,
+                        batch=(by_load, toy_many), batch_size=2,
+                        cost=lambda inp: inp["upqc"]["rating"])
+    pd.testing.assert_frame_equal(_tab(par), _tab(serial))
