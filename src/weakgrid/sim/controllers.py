@@ -188,7 +188,7 @@ class DigitalController:
 
     def sample(self, sim, t, z):
         """Compute and hold a new output; returns True if it changed."""
-        m = self.measurement(sim, t)
+        m = self.measurement(sim, t, z)
         if m is None:
             return self.hold(t, self.bypass)
         try:
@@ -197,9 +197,12 @@ class DigitalController:
             raise SimulationError(t, "controller", f"'{self.name}' raised {exc!r}") from exc
         return self.hold(t, u, m)
 
-    def measurement(self, sim, t):
-        """The measurement vector at a sample ``t`` of ``sim``, or None while disabled."""
-        return self.measure(sim, t, sim.z, sim._ctx) if self.active(t) else None
+    def measurement(self, sim, t, z=None):
+        """The measurement vector at a sample ``t`` of ``sim`` (its solution ``z``, default
+        ``sim.z``), or None while disabled."""
+        if not self.active(t):
+            return None
+        return self.measure(sim, t, sim.z if z is None else z, sim._ctx)
 
     def hold(self, t, u, m=None):
         """Check the policy's output ``u`` for measurement ``m`` (None: the bypass) and hold it

@@ -23,6 +23,7 @@ class _Loop:
 
     def __init__(self, system):
         self.sys = system
+        self.z = None        # no phasor solution: measurements read ``_ctx``
         self._ctx = {}
 
 
