@@ -487,23 +487,13 @@ class BatchSimulator:
         """Simulate every member from 0 to ``t_end`` [s]; returns ``(results, rerun)``: one
         :class:`Results` per member (None for the members listed in ``rerun``, which left the
         lockstep and must be run one by one)."""
-        from .events import flatten
+        from .events import prepare as prepare_events
 
         t_end = float(t_end)
         B, nx = self.B, self.nx
         evs, ctls, recs = [], [], []
         for sc, sim in zip(self.scen, self.sims):
-            events = list(sc.get("events", ()))
-            for ev in flatten(events):
-                if ev.t > t_end:
-                    raise DataError(repr(ev), "t", ev.t, f"the event comes after the end of the run "
-                                    f"(t_end = {t_end:g} s): move it earlier or simulate longer")
-            for ev in events:
-                if hasattr(ev, "parts"):
-                    ev.validate(sim.sys)
-            events = sorted(flatten(events), key=lambda e: e.t)
-            for ev in events:
-                ev.validate(sim.sys)
+            events = prepare_events(sc.get("events", ()), sim.sys, t_end)
             controllers = list(sc.get("controllers", ()))
             for c in controllers:
                 c.bind(sim.sys)

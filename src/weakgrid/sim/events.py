@@ -163,3 +163,23 @@ def flatten(events):
     for e in events:
         out.extend(e.parts() if hasattr(e, "parts") else [e])
     return out
+
+
+def prepare(events, system, t_end: float) -> list:
+    """A run's events checked against ``system`` and ``t_end`` [s] and flattened into
+    elementary events in time order (what the integrator and the batch step onto).
+
+    Raises :class:`DataError` for an event after ``t_end`` or one that does not fit the
+    system (a missing bus, branch or unit)."""
+    events = list(events)
+    for ev in flatten(events):
+        if ev.t > t_end:
+            raise DataError(repr(ev), "t", ev.t, f"the event comes after the end of the run "
+                            f"(t_end = {t_end:g} s): move it earlier or simulate longer")
+    for ev in events:
+        if hasattr(ev, "parts"):
+            ev.validate(system)
+    events = sorted(flatten(events), key=lambda e: e.t)
+    for ev in events:
+        ev.validate(system)
+    return events

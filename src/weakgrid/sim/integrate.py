@@ -598,7 +598,7 @@ class Simulator:
             ``progress(t)`` after every step, with the time reached [s] (a progress bar).
         """
         sys = self.sys
-        from .events import flatten
+        from .events import prepare as prepare_events
 
         try:
             t_end = float(t_end)
@@ -607,17 +607,7 @@ class Simulator:
         if not (math.isfinite(t_end) and t_end > self.t):
             raise DataError("simulation", "t_end", t_end,
                             f"give a finite final time after the current time {self.t:g} s")
-        events = list(events)
-        for ev in flatten(events):
-            if ev.t > t_end:
-                raise DataError(repr(ev), "t", ev.t, f"the event comes after the end of the run "
-                                f"(t_end = {t_end:g} s): move it earlier or simulate longer")
-        for ev in events:
-            if hasattr(ev, "parts"):
-                ev.validate(sys)
-        events = sorted(flatten(events), key=lambda e: e.t)
-        for ev in events:
-            ev.validate(sys)
+        events = prepare_events(events, sys, t_end)
         controllers = list(controllers)
         for c in controllers:
             c.bind(sys)
