@@ -158,3 +158,17 @@ def test_a_named_controller_meets_both():
     d.pop("figures", None)
     assert not list(validator().iter_errors(d))
     study_from_dict(d)
+
+
+def test_every_example_of_the_reference_is_toml():
+    """The page's examples are highlighted as TOML (the docs build, warnings as errors, failed
+    on inline tables shown alone): each one parses."""
+    import re
+    import tomllib
+
+    from weakgrid.study.reference import reference_markdown
+
+    blocks = re.findall(r"```toml\n(.*?)```", reference_markdown(), re.S)
+    assert len(blocks) > 10
+    for b in blocks:
+        tomllib.loads(b)

@@ -110,9 +110,10 @@ class Setup:
     branch_names: dict = field(default_factory=dict)
     measure_signals: object = None
     state_map: object = None
-    #: the UPQC converters' rating [MVA] (None: not given) and the line's apparent power
-    #: |V_r|·|I_line| at the operating point [MVA] (:mod:`weakgrid.study.device`)
+    #: the UPQC converters' rating [MVA] (None: not given; :mod:`weakgrid.study.device`)
     s_rating_mva: float | None = None
+    #: the line's apparent power, the product of the magnitudes of V_r and I_line at the
+    #: operating point [MVA]
     line_mva: float = float("nan")
 
     def bus(self, ref, where="bus") -> int:

@@ -169,7 +169,9 @@ def _table_md(t: Table) -> list[str]:
     if t.open:
         out += ["", "Other keys are accepted here (see above)."]
     if t.example:
-        out += ["", "Example:", "", "```toml", t.example, "```"]
+        # an inline table (an event) is not a TOML document: shown as the list it goes in
+        ex = f"events = [{t.example}]" if t.example.lstrip().startswith("{") else t.example
+        out += ["", "Example:", "", "```toml", ex, "```"]
     return out + [""]
 
 

@@ -1,10 +1,10 @@
 """weakgrid machine models → DPsim synchronous-generator models (the one mapping table).
 
-=================  ==========================================  =================================
+=================  ============================================  =================================
 weakgrid model     DPsim model (EMT ``emt.ph3``, DP ``dp.ph1``)  how
-=================  ==========================================  =================================
-``GENCLS``         ``SynchronGenerator4OrderVBR``              ``Ld = Lq = Ld_t = Lq_t = xd1``
-=================  ==========================================  =================================
+=================  ============================================  =================================
+``GENCLS``         ``SynchronGenerator4OrderVBR``                ``Ld = Lq = Ld_t = Lq_t = xd1``
+=================  ============================================  =================================
 
 Why the 4th-order model is the classical machine exactly: its transient EMFs obey
 ``Td0' dE'q/dt = Ef - E'q - (Ld - Ld') Id`` and ``Tq0' dE'd/dt = -E'd + (Lq - Lq') Iq``;
