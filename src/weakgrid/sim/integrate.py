@@ -619,11 +619,17 @@ class Simulator:
             self._refresh_jacobian(self.t, self.z)
             self.z = self.solve_algebraic(self.t, self.z)
         F, self._ctx = sys.residual(self.t, self.z)
-        for c in controllers:
-            if c.due(self.t):
-                c.sample(self, self.t, self.z)
-        if controllers:
-            self.z = self.solve_algebraic(self.t, self.z)
+        failure = None
+        try:   # a controller's first sample (or the re-solve after it) can fail like any other
+            for c in controllers:
+                if c.due(self.t):
+                    c.sample(self, self.t, self.z)
+            if controllers:
+                self.z = self.solve_algebraic(self.t, self.z)
+        except SimulationError as exc:
+            if on_failure == "raise":
+                raise
+            failure = exc
         F, self._ctx = sys.residual(self.t, self.z)
         self._f = F[:self.nx].copy()
         if self._delta0 is None:
@@ -631,12 +637,13 @@ class Simulator:
         if sys._accepting:
             sys.accept(self.t, self._ctx)
         rec.add(self.t, self.z, self._ctx)
+        if failure is not None:
+            return rec.finish(failure=failure, stats=dict(self.stats))
         ev_i = 0
         eps = 1e-12
         self._jump, self._jump_t = None, -math.inf
         jump_gap = min([c.T for c in controllers if hasattr(c, "T")] or [0.0])
         nstep = 0
-        failure = None
         try:
             while self.t < t_end - eps:
                 # next breakpoint
