@@ -21,13 +21,11 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "sim"))
 
-from sim_cases import two_machine_case  # noqa: E402
+from sim_cases import classical_smib  # noqa: E402
 
 from weakgrid.sim.emt import simulate_dpsim  # noqa: E402
 from weakgrid.sim.events import Fault  # noqa: E402
 from weakgrid.sim.integrate import simulate  # noqa: E402
-from weakgrid.sim.sources import InfiniteBus  # noqa: E402
-from weakgrid.sim.system import System  # noqa: E402
 
 EVENTS = [Fault(bus=1, t_on=0.1, t_off=0.2)]
 RUNS = [("phasor", 1e-3), ("phasor", 1e-4), ("dpsim-dp", 1e-3), ("dpsim-dp", 1e-4),
@@ -35,15 +33,7 @@ RUNS = [("phasor", 1e-3), ("phasor", 1e-4), ("dpsim-dp", 1e-3), ("dpsim-dp", 1e-
 
 
 def smib():
-    case = two_machine_case(x_line=0.3, p=0.8)
-    case["branch"][0, 2] = 0.01
-    s = System(case)
-    s.add_machine("GENCLS", "G1", 0, Sn=100, M=6.0, D=0.0, ra=0.0, xd1=0.25)
-    src = InfiniteBus()
-    src.add_source("S2", 1)
-    s.add_component(src)
-    s.setup()
-    return s
+    return classical_smib()
 
 
 def one(engine, dt, t_end):

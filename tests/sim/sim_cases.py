@@ -17,6 +17,27 @@ def two_machine_case(x_line=0.3, p=0.8):
     return {"baseMVA": 100.0, "bus": bus, "gen": gen, "branch": branch}
 
 
+def classical_smib(p=0.8, model="GENCLS", upqc_vmax=None, **params):
+    """A machine (``model``, classical by default: Sn 100 MVA, M 6 s, x'd 0.25 pu) on a line
+    (0.01 + j0.3 pu) to an infinite bus, set up; with ``upqc_vmax`` a conventional UPQC "U" on
+    the line. The SMIB every engine (phasor, DPsim EMT and DP) is checked on."""
+    from weakgrid.sim.sources import InfiniteBus
+    from weakgrid.sim.system import System
+    from weakgrid.sim.upqc import UPQC
+
+    case = two_machine_case(x_line=0.3, p=p)
+    case["branch"][0, 2] = 0.01
+    s = System(case)
+    s.add_machine(model, "G1", 0, **{**dict(Sn=100, M=6.0, D=0.0, ra=0.0, xd1=0.25), **params})
+    src = InfiniteBus()
+    src.add_source("S2", 1)
+    s.add_component(src)
+    if upqc_vmax is not None:
+        s.add_component(UPQC()).add_upqc("U", branch=0, structure="conventional", Vmax=upqc_vmax)
+    s.setup()
+    return s
+
+
 def gti_upqc_sg_case(p_gti=50.0):
     """GTI (bus 1) -- UPQC branch -- shunt bus r = 2 (load) -- line -- SG slack bus 3 (load)."""
     bus = np.array([

@@ -18,10 +18,8 @@ from weakgrid.sim.errors import DataError
 from weakgrid.sim.events import Fault, LineTrip
 from weakgrid.sim.integrate import simulate
 from weakgrid.sim.runfile import read_run, write_run
-from weakgrid.sim.sources import InfiniteBus
-from weakgrid.sim.system import System
 
-from sim_cases import two_machine_case
+from sim_cases import classical_smib
 
 pytest.importorskip("dpsimpy")
 from weakgrid.sim.emt import simulate_dpsim  # noqa: E402
@@ -33,17 +31,7 @@ EVENTS = [Fault(bus=1, t_on=T_ON, t_off=T_OFF)]
 
 
 def _smib(model="GENCLS", **params):
-    case = two_machine_case(x_line=0.3, p=PM)
-    case["branch"][0, 2] = 0.01
-    s = System(case)
-    kw = dict(Sn=100, M=M, D=0.0, ra=0.0, xd1=0.25)
-    kw.update(params)
-    s.add_machine(model, "G1", 0, **kw)
-    src = InfiniteBus()
-    src.add_source("S2", 1)
-    s.add_component(src)
-    s.setup()
-    return s
+    return classical_smib(p=PM, model=model, **{"M": M, **params})
 
 
 @pytest.fixture(scope="module")

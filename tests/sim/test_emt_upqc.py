@@ -13,11 +13,8 @@ import pytest
 from weakgrid.sim.controllers import DigitalController, UPQCTarget
 from weakgrid.sim.errors import DataError
 from weakgrid.sim.integrate import simulate
-from weakgrid.sim.sources import InfiniteBus
-from weakgrid.sim.system import System
-from weakgrid.sim.upqc import UPQC
 
-from sim_cases import two_machine_case
+from sim_cases import classical_smib
 
 pytest.importorskip("dpsimpy")
 from weakgrid.sim.emt import simulate_dpsim  # noqa: E402
@@ -28,16 +25,7 @@ T_STEP, T_END, T = 0.1, 0.8, 1e-3
 
 
 def _smib(vmax=0.2):
-    case = two_machine_case(x_line=0.3, p=0.8)
-    case["branch"][0, 2] = 0.01
-    s = System(case)
-    s.add_machine("GENCLS", "G1", 0, Sn=100, M=6.0, D=0.0, ra=0.0, xd1=0.25)
-    src = InfiniteBus()
-    src.add_source("S2", 1)
-    s.add_component(src)
-    s.add_component(UPQC()).add_upqc("U", branch=0, structure="conventional", Vmax=vmax)
-    s.setup()
-    return s
+    return classical_smib(upqc_vmax=vmax)
 
 
 def _controller(u):
