@@ -107,6 +107,12 @@ def _presets():
     return tuple(preset_names())
 
 
+def _grid_models():
+    from ..design.derive import GRID_MODELS
+
+    return GRID_MODELS
+
+
 def _controller_kinds():
     from .controllers import CONTROLLER_KINDS
 
@@ -371,7 +377,7 @@ _add(Table("design", "The design of the controllers (the design model (10) and t
     Field("grid_model", S, "The design model's grid: the paper's stiff shunt-bus voltage, or "
           "the grid's Thevenin equivalent at the shunt bus r with the two-machine inertia "
           "factor (both are derived and both mode checks printed).", default="paper",
-          choices=("paper", "thevenin")),
+          choices=_grid_models),
 ), example='[design]\nT = 1.0e-3\nsettings = "case2-paper"'))
 
 _add(Table("controllers", "The controllers compared; `[controllers.NAME]` tables give a "

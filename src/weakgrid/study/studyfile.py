@@ -418,7 +418,8 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
     _num(ds, "T", "design", positive=True)
     from ..design.derive import GRID_MODELS
 
-    _choice(ds, "grid_model", "design", GRID_MODELS, default="paper")   # not set: the key of
+    _choice(ds, "grid_model", "design", GRID_MODELS,
+            default=F.default("design", "grid_model"))   # not set: the key of
     # every cached run stays as it was
     ds.setdefault("settings", F.default("design", "settings"))
     from ..models import preset_names
