@@ -39,6 +39,7 @@ import time
 import traceback
 from pathlib import Path
 
+from weakgrid.fileio import write_text_atomic
 from weakgrid.sim.errors import DataError
 from weakgrid.sim.peer import psid
 
@@ -208,13 +209,13 @@ def main(argv=None):
         meta["andes"] = andes.__version__
     except ImportError:
         pass
-    Path(a.json).write_text(json.dumps(_jsonable({"meta": meta, "cases": results}), indent=1))
+    write_text_atomic(a.json, json.dumps(_jsonable({"meta": meta, "cases": results}), indent=1))
     if a.docs:
         p = Path(a.docs)
         s = p.read_text()
         i, j = s.index(BEGIN) + len(BEGIN), s.index(END)
         label = f"\n{a.label}\n" if a.label else ""
-        p.write_text(s[:i] + "\n" + label + "\n" + md + "\n" + s[j:])
+        write_text_atomic(p, s[:i] + "\n" + label + "\n" + md + "\n" + s[j:])
     return results
 
 

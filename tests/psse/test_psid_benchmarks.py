@@ -38,13 +38,6 @@ CASES = psid.load_cases(TABLE)
 #: that fails is an expected failure; a listed case that passes fails the suite (strict): the gap
 #: closed and this list must lose it. Same numbers in docs/psse-validation.md.
 KNOWN_GAPS = {
-    "psid29_rena_default_flags": "2-norms within PSID's 1e-2 (P 1.0e-3, Q 2.6e-4, V 4.6e-5) but the "
-        "largest P and Q differences (8.5e-4, 2.3e-4 pu) are 27-28 % of PSS/E's very small swings "
-        "(3.1e-3, 8.6e-4 pu), all in the 15 ms after the trip: PSS/E's injected current is scaled "
-        "by Vest/|V|, Vest averaged with |V| once per 5-ms step (its network interface, not the "
-        "model); with that applied to weakgrid's P and Q: 3.4 %, 1.7 % (test_rena_interface.py)",
-    "psid29_rena_freq_flag": "as psid29_rena_default_flags (P 25.5 %, Q 27.1 % of the swing; "
-        "2-norms within PSID's tolerance); with PSS/E's interface applied 3.1 %, 1.7 %",
     "psid57_degov_nodelay": "the CSV is PowerWorld's, not PSS/E's (cases.toml: PSID's omega_pw, 1/240-s "
         "samples, absolute speed): with PSS/E's GENCLS (te/omega, damping D alone, which PSS/E's own "
         "OMIB results need) 8.7e-5 pu of speed against PSID's 4.7e-5 (9.5 % of the swing); "

@@ -11,7 +11,7 @@ The converter is a controlled current source aligned with its terminal voltage
     LVG(v)   = 0 below Lvpnt0, linear to 1 at Lvpnt1, 1 above
     LVPL(S2) = 0 below Zerox, Lvpl1*(S2 - Zerox)/(Brkpt - Zerox) up to Brkpt, then no limit
                (no limit at all when Lvplsw = 0)
-    P = Ipout*v,  Q = Iqout*v,  I = (Ipout - j Iqout) * V/|V|   (injected)
+    P = Ipout*v,  Q = Iqout*v,  I = (Ipout - j Iqout) * V/|V|   (injected; v -> Vest: PSS/E, below)
 
 Without an electrical control (REECA1) the commands are held at their initial values
 ``Ipcmd = p0/(v LVG(v))``, ``Iqcmd = -q0/v`` (as ANDES). Parameter names and per-unit
@@ -27,6 +27,30 @@ a 0.1-s recovery of the active current). ``rates_per_s = 1`` gives PSS/E's meani
 PSS/E reader, :meth:`psse_params`); the default 0 keeps ANDES's, as imported from ANDES. (PSID
 clamps ``Ipcmd - Ip`` before dividing by ``Tg`` too; its PSS/E benchmark cases, with Rrpwr = 10
 and Iqrmax = 100, never reach the limits, so they do not tell the two readings apart.)
+
+PSS/E's converter interface (``psse_interface``): by default (ANDES, PSID, the continuous model)
+the converter's power is ``P = Ipout*|V|``, ``Q = Iqout*|V|`` at every instant. PSS/E computes the
+converter's P and Q (its PELEC/QELEC, and the power its electrical and plant controls see) with a
+voltage estimate ``Vest`` relaxed towards ``|V|`` once per integration step,
+``Vest_k = (Vest_(k-1) + |V_k|)/2`` at the network solution of step ``k``: ``P = Ipout*Vest``,
+``Q = Iqout*Vest``, while the network receives the current ``(Ipout - j Iqout) V/|V|``. At a
+steady state ``Vest = |V|`` and nothing changes; after a voltage step P and Q move half-way with
+the voltage at the step and the rest follows by halves, step by step. Measured on PSS/E's own
+RENA results (REGCA1 + REECB1 + REPCA1, 5-ms step, line trip at 1 s; ``tests/psse/
+test_rena_interface.py``, ``tests/psse/test_regca1_psse_interface.py``): PSS/E's P and Q are short
+of the continuous converter's by one common factor, 0.47 % at the event sample (half the
+0.95 % voltage step), 0.21 %, 0.11 %, 0.05 % at the next three steps -- ``Vest/|V|`` sample by
+sample -- while PSS/E's bus voltage is that of the unscaled current (4e-6 pu from weakgrid's
+continuous run at +5 ms; scaling the injected current instead moves it 2.5e-5 pu away). It is a
+property of PSS/E's step (a discrete state, not a time constant: the data have none below
+20 ms, and a lag would show the whole step, not half of it, at the event) and is reproduced as
+such: ``Vest_(k-1)`` is discrete memory updated at each accepted point (:meth:`accept`, after
+every step and after an event's network re-solution), and the point being solved uses
+``(Vest_(k-1) + |V|)/2``; it matches PSS/E's time course when weakgrid steps at PSS/E's step.
+The factor 1/2 is the measured one (REGCA1's CON ``Accel`` is 0 in those files and does not
+enter it; the shipped results show nothing of other ``Accel`` values, so ``Accel`` stays
+unused). ``psse_interface = 1`` is set by the PSS/E reader (:meth:`psse_params`), as
+``psse_shaft`` for machines; 0 (the default) keeps the continuous form for every other route.
 
 Limits follow ANDES: the rate limits bound ``T dx/dt``; the upper limit LVPL of ``S0`` is
 an anti-windup limit that moves with ``S2``: a state that crosses it is *reset* to it and held
@@ -93,6 +117,8 @@ class REGCA1(Component):
         Param("gammaq", 1.0, "-", "share of the static generator's Q", "pos"),
         Param("LVPL_strict", 1.0, "-", "1: S0 never exceeds LVPL (reset whenever it crosses it); "
               "0: reset only while dS0/dt >= 0 (ANDES 2.0)", "flag"),
+        Param("psse_interface", 0.0, "-", "1: P, Q = (Ipout, Iqout)*Vest, Vest relaxed by halves towards "
+              "|V| once per step (PSS/E); 0: P, Q = (Ipout, Iqout)*|V| (ANDES, continuous)", "flag"),
         Param("rates_per_s", 0.0, "-", "1: Rrpwr, Iqrmax, Iqrmin bound dIp/dt, dIq/dt [pu/s on Sn] (PSS/E, "
               "WECC); 0: they bound Tg*dIp/dt, Tg*dIq/dt, Rrpwr on the system base (ANDES 2.0)", "flag"),
     )
@@ -106,11 +132,13 @@ class REGCA1(Component):
     def psse_params(cls, values, ctx):
         """PSS/E record -> parameters: ``Sn`` = the generator's MBASE; the rate limits ``Rrpwr``,
         ``Iqrmax``, ``Iqrmin`` keep their PSS/E meaning (pu/s on MBASE: ``rates_per_s = 1``);
-        the record's CONs are otherwise the parameters (``Accel``, the network-interface
-        acceleration factor, has no effect on the model)."""
+        the converter's P and Q are PSS/E's, with the per-step voltage estimate
+        (``psse_interface = 1``, see the module docstring); the record's CONs are otherwise the parameters (``Accel`` has no
+        effect on the model)."""
         v = dict(values)
         v["Sn"] = float(ctx.mbase)
         v["rates_per_s"] = 1.0
+        v["psse_interface"] = 1.0
         return v
 
     @classmethod
@@ -142,6 +170,13 @@ class REGCA1(Component):
             if prm.base == "current":
                 p[prm.name] = p[prm.name] * c
         self._uniq = len(set(self.bus.tolist())) == self.n
+        # PSS/E's interface: Vest is discrete memory, updated at accepted points (accept); only
+        # then is this component one "with discrete memory" (which keeps it out of batches)
+        self._psse_if = p["psse_interface"] > 0
+        if self._psse_if.any():
+            self.accept = self._accept_vest
+        else:
+            self.__dict__.pop("accept", None)
 
     def pattern(self, system):
         groups = []
@@ -188,6 +223,7 @@ class REGCA1(Component):
         self.p0 = pf.Pg[self.gen] * p["gammap"]
         self.q0 = pf.Qg[self.gen] * p["gammaq"]
         self._v0 = v.copy()
+        self._vest = v.copy()         # PSS/E interface: Vest at the last accepted point
         lvg = self._lvg(v)
         for i in np.nonzero(lvg <= 0)[0]:
             raise DataError(self.element(i), "Lvpnt0", p["Lvpnt0"][i],
@@ -240,26 +276,34 @@ class REGCA1(Component):
         vs = np.where(v > 1e-6, v, 1e-6)
         I = (ipout - 1j * iqout) * V / vs
         scatter_add(ctx.I, self.bus, self.connected(I), self._uniq)
+        # the converter's P and Q: with |V|, or with PSS/E's per-step estimate Vest
+        vp = np.where(self._psse_if, 0.5 * (self._vest + v), v)
         # commands: constant unless an electrical control (REECA1) publishes them
         shape = x.shape[:-1] + (self.n,)
         ctx.sig["REGCA1.Ipcmd"] = np.broadcast_to(self.Ipcmd0, shape).copy()
         ctx.sig["REGCA1.Iqcmd"] = np.broadcast_to(self.Iqcmd0, shape).copy()
         ctx.sig["REGCA1.v"] = v
-        ctx.sig["REGCA1.Pe"] = ipout * v
-        ctx.sig["REGCA1.Qe"] = iqout * v
-        self._o = (ipout, iqout, lvg, lvpl, v)
+        ctx.sig["REGCA1.Pe"] = ipout * vp
+        ctx.sig["REGCA1.Qe"] = iqout * vp
+        self._o = (ipout, iqout, lvg, lvpl, v, vp)
 
     def finish(self, ctx):
         x = ctx.x
         sl = self._sls
         s0, s1, s2 = x[..., sl[0]], x[..., sl[1]], x[..., sl[2]]
         ipcmd, iqcmd = ctx.sig["REGCA1.Ipcmd"], ctx.sig["REGCA1.Iqcmd"]
-        ipout, iqout, lvg, lvpl, v = self._o
+        ipout, iqout, lvg, lvpl, v, vp = self._o
         ctx.f[..., sl[0]] = self.S0.deriv(s0, ipcmd)   # upper limit LVPL: see limits()
         ctx.f[..., sl[1]] = self.S1.deriv(s1, iqcmd)
         ctx.f[..., sl[2]] = self.S2.deriv(s2, v)
         o = ctx.out
         o["REGCA1.Ipout"], o["REGCA1.Iqout"] = ipout, iqout
-        o["REGCA1.Pe"], o["REGCA1.Qe"] = ipout * v, iqout * v
+        o["REGCA1.Pe"], o["REGCA1.Qe"] = ipout * vp, iqout * vp
         o["REGCA1.LVG"], o["REGCA1.LVPL"] = lvg, lvpl
         o["REGCA1.Ipcmd"], o["REGCA1.Iqcmd"] = ipcmd + 0.0, iqcmd + 0.0
+
+    def _accept_vest(self, t, ctx):
+        """PSS/E's interface (``psse_interface = 1``): keep ``Vest`` of the accepted point ``t``,
+        ``(Vest_prev + |V|)/2``, for the next step's network solutions."""
+        v = np.abs(ctx.V[..., self.bus])
+        self._vest = np.where(self._psse_if, 0.5 * (self._vest + v), self._vest)
