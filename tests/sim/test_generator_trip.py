@@ -35,8 +35,12 @@ def _system():
 
 
 def _unit_power(res, names):
-    """Active power [pu, system base] of each named machine or converter."""
-    return {n: np.asarray(res[f"{n}.Pe"]) for n in names}
+    """Active power [pu, system base] each named machine or converter injects into bus 102. A
+    converter's is ``Ipout*|V|``: its ``Pe`` read from PSS/E is PSS/E's, with the per-step voltage
+    estimate (REGCA1 ``psse_interface = 1``), which the network does not see."""
+    v = np.asarray(res["bus102.v"])
+    return {n: np.asarray(res[f"{n}.Ipout"]) * v if n.startswith("REGCA1") else np.asarray(res[f"{n}.Pe"])
+            for n in names}
 
 
 def _transformer_flow(s, res):
