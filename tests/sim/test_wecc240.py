@@ -10,8 +10,8 @@ a SEXS needed a field voltage above its EMAX and setup refused the case.
 
 No ANDES result beside it: ANDES 2.0 reads the same two files (109 GENROU, 109 SEXS, 47 GAST,
 37 TGOV1, 25 HYGOV, 10 IEEEST, 37 REGCA1 + REECB1 + REPCA1) and solves the power flow, but its
-initialization fails (checked 2026-12-01): the PI integrator of every REECB1 (``PIQ_xi``)
-starts with a residual of 0.018, its limiter's input at 0 below ``VMIN`` = 0.9.
+initialization fails (checked 2026-12-01, re-checked 2026-12-02): the PI integrator of every
+REECB1 (``PIQ_xi``, 37 of 37) starts with a residual of 0.018, its limiter's input at 0 below ``VMIN`` = 0.9.
 """
 
 import hashlib
