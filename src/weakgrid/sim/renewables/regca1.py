@@ -30,21 +30,22 @@ and Iqrmax = 100, never reach the limits, so they do not tell the two readings a
 
 PSS/E's converter interface (``psse_interface``): by default (ANDES, PSID, the continuous model)
 the converter's power is ``P = Ipout*|V|``, ``Q = Iqout*|V|`` at every instant. PSS/E computes the
-converter's P and Q (its PELEC/QELEC, and the power its electrical and plant controls see) with a
-voltage estimate ``Vest`` relaxed towards ``|V|`` once per integration step,
+converter's P and Q (the ones it reports; here also the ones its electrical and plant controls
+see -- PSS/E's results cannot tell that apart: the largest P difference moves by < 4e-7 pu)
+with a voltage estimate ``Vest`` relaxed towards ``|V|`` once per integration step,
 ``Vest_k = (Vest_(k-1) + |V_k|)/2`` at the network solution of step ``k``: ``P = Ipout*Vest``,
 ``Q = Iqout*Vest``, while the network receives the current ``(Ipout - j Iqout) V/|V|``. At a
 steady state ``Vest = |V|`` and nothing changes; after a voltage step P and Q move half-way with
 the voltage at the step and the rest follows by halves, step by step. Measured on PSS/E's own
 RENA results (REGCA1 + REECB1 + REPCA1, 5-ms step, line trip at 1 s; ``tests/psse/
-test_rena_interface.py``, ``tests/psse/test_regca1_psse_interface.py``): PSS/E's P and Q are short
+test_rena_interface.py``, ``tests/sim/test_regca1_psse_interface.py``): PSS/E's P and Q are short
 of the continuous converter's by one common factor, 0.47 % at the event sample (half the
 0.95 % voltage step), 0.21 %, 0.11 %, 0.05 % at the next three steps -- ``Vest/|V|`` sample by
 sample -- while PSS/E's bus voltage is that of the unscaled current (4e-6 pu from weakgrid's
 continuous run at +5 ms; scaling the injected current instead moves it 2.5e-5 pu away). It is a
 property of PSS/E's step (a discrete state, not a time constant: the data have none below
 20 ms, and a lag would show the whole step, not half of it, at the event) and is reproduced as
-such: ``Vest_(k-1)`` is discrete memory updated at each accepted point (:meth:`accept`, after
+such: ``Vest_(k-1)`` is discrete memory updated at each accepted point (``accept``, after
 every step and after an event's network re-solution), and the point being solved uses
 ``(Vest_(k-1) + |V|)/2``; it matches PSS/E's time course when weakgrid steps at PSS/E's step.
 The factor 1/2 is the measured one (REGCA1's CON ``Accel`` is 0 in those files and does not
