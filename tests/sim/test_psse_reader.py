@@ -435,7 +435,8 @@ def test_truncated_raw_record(tmp_path):
     p = _rewrite(TVC_RAW, tmp_path / "cut.raw", lambda ls: ls[:k + 2])    # 2 of its 4 lines
     with pytest.raises(DataError) as e:
         read_raw(p)
-    _check(e, f"cut.raw line {k + 1}", "transformer record", "ends inside")
+    _check(e, f"cut.raw line {k + 1}", "transformer record", "ends inside", "'WINDV1'", "2 of its 4 lines")
+    assert e.value.field == "WINDV1"        # the first missing field (line 3 of the record)
     p = _rewrite(TVC_RAW, tmp_path / "cut2.raw", lambda ls: ls[:k])       # ends in a section
     with pytest.raises(DataError) as e:
         read_raw(p)

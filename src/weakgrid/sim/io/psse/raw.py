@@ -307,9 +307,12 @@ def read_raw(path) -> RawCase:
             continue
         nl = _record_lines(current, flds, version)
         if pos + nl > len(numbered):
-            raise DataError(rd.where(ln, f"{current} record"), "lines", len(numbered) - pos,
-                            f"the file ends inside a {current} record ({nl} lines expected): "
-                            "complete it")
+            have = len(numbered) - pos
+            first = _LINE_HEADS.get(current, ())
+            field = first[have] if have < len(first) else f"line {have + 1}"
+            raise DataError(rd.where(ln, f"{current} record"), field, None,
+                            f"the file ends inside a {current} record: it has {have} of its {nl} lines, "
+                            f"line {have + 1} (from {field}) and after are missing; complete it")
         rl = [flds] + [split_line(numbered[pos + j][1])[0] for j in range(1, nl)]
         records[current].append(Record(current, ln, rl))
         pos += nl
@@ -320,6 +323,11 @@ def read_raw(path) -> RawCase:
                             "each section ends with a 0 record, the file with Q")
     _parse(case, records, rd)
     return case
+
+
+#: first field of each line of the multi-line records (PSS/E's POM), to name what a truncated one lacks
+_LINE_HEADS = {"transformer": ("I", "R1-2", "WINDV1", "WINDV2", "WINDV3"),
+               "two-terminal dc": ("NAME", "IPR", "IPI"), "vsc dc": ("NAME", "IBUS", "IBUS")}
 
 
 def _record_lines(section, flds, version):
