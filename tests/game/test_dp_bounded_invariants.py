@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from weakgrid.game import PolynomialBasis, full_monomials
-from weakgrid.game.dynamic_programming import DPSettings, _interp_weights, solve_game_dp
+from weakgrid.game.dynamic_programming import (BOUNDED_EXTRAPOLATE_CELLS, DPSettings,
+                                               _interp_weights, solve_game_dp)
 from weakgrid.game.errors import ParameterError
 from weakgrid.game.optimality import default_starts
 from weakgrid.game.rollout import rollout
@@ -51,17 +52,35 @@ def test_bounded_value_is_not_below_the_unbounded_one_with_the_cubic_scheme(poin
 def test_the_cubic_residual_is_continued_linearly_past_the_box():
     # a constant continuation makes a kink at the boundary (the cause of the bounded DP's
     # 3-5 % inconsistency): up to 4 cells out a linear function is read exactly
+    assert BOUNDED_EXTRAPOLATE_CELLS == 4.0
     axes = [np.linspace(-1.0, 1.0, 11), np.linspace(-2.0, 2.0, 9)]
     X = np.stack([v.ravel() for v in np.meshgrid(*axes, indexing="ij")], -1)
 
     def f(Y):
         return 0.3 + 2.0 * Y[:, 0] - 0.7 * Y[:, 1] + 0.5 * Y[:, 0] * Y[:, 1]
     Y = np.array([[1.3, 0.1], [-1.5, -0.4], [0.2, 2.9], [-0.6, -3.5], [1.4, 2.6]])
-    W, idx = _interp_weights(axes, Y, cubic=True)
+    W, idx = _interp_weights(axes, Y, cubic=True, cells=4.0)
     np.testing.assert_allclose((W * f(X)[idx]).sum(1), f(Y), atol=1e-12)
     # beyond 4 cells the continuation is constant (bounded weights for far successors)
-    W2, idx2 = _interp_weights(axes, np.array([[1.8, 0.0], [50.0, 0.0]]), cubic=True)
+    W2, idx2 = _interp_weights(axes, np.array([[1.8, 0.0], [50.0, 0.0]]), cubic=True, cells=4.0)
     np.testing.assert_allclose((W2 * f(X)[idx2]).sum(1), f(np.array([[1.8, 0.0]]))[0])
+
+
+def test_the_continuation_is_linear_with_a_bound_and_constant_without():
+    # case 2 without a bound: its residual falls outward past the power-angle limit; continued
+    # linearly, policy iteration did not converge in 40 iterations and V < 0 (−331 at 61²)
+    prob = load_preset("case2-paper")
+    lo, hi = prob.mesh.lower, prob.mesh.upper
+    dp = solve_game_dp(prob.system, prob.cost, lo, hi, DPSettings(n_points=(61, 61)))
+    assert dp.converged and dp.value(dp.points).min() >= 0.0
+    lin = solve_game_dp(prob.system, prob.cost, lo, hi, DPSettings(n_points=(61, 61),
+                                                                    extrapolate=4, max_iterations=15))
+    assert not lin.converged       # the linear continuation fails here (40 iterations: too)
+    assert DPSettings().extrapolate is None and DPSettings(extrapolate=2).extrapolate == 2.0
+    with pytest.raises(ParameterError, match="extrapolate"):
+        DPSettings(extrapolate=-1)
+    with pytest.raises(ParameterError, match="extrapolate"):
+        DPSettings(extrapolate="far")
 
 
 def test_no_node_of_the_bounded_dp_fails_the_saddle_point_test():
