@@ -129,8 +129,17 @@ def _bounded_from_json(d, X):
 
         opts = {"ftol": 1e-15, "gtol": 1e-13, "maxiter": 2000}
         if shape == "box":  # bounded quasi-Newton directly in u
-            u = minimize(F, np.zeros(2), method="L-BFGS-B", options=opts,
-                         bounds=[(-v * (1 - 1e-15), v * (1 - 1e-15)) for v in lim]).x
+            bnd = [(-v * (1 - 1e-15), v * (1 - 1e-15)) for v in lim]
+            u = minimize(F, np.zeros(2), method="L-BFGS-B", options=opts, bounds=bnd).x
+            # a component at the bound stops L-BFGS-B's f-test early (the barrier's slope
+            # dwarfs the others): polish the free components with that one held
+            hold = np.abs(u) > lim * (1 - 1e-6)
+            if hold.any() and not hold.all():
+                def F1(v, F=F, u=u, hold=hold):
+                    return F(np.where(hold, u, v[0]))
+                u = np.where(hold, u, minimize(F1, u[~hold], method="L-BFGS-B", options=opts,
+                                               bounds=[b for b, h in zip(bnd, hold)
+                                                       if not h]).x[0])
         else:  # polar coordinates, radius bounded
             th0 = np.arctan2(-b[1], -b[0])
             def Fp(z, F=F):

@@ -214,14 +214,37 @@ def test_map_cells_ties_wins_and_failures():
             "holds_below": 0.8}
     cells = map_cells(_cells_table(), spec, ["upqc.rating", "t_off", "load"])
     v = dict(zip(cells["upqc.rating"], cells["verdict"]))
-    # a failed where b finished: a loss, counted as "not" (it was "failed" only)
-    assert v == {0.1: "tie", 0.3: "holds", 0.5: "not"}
+    # a failed where b finished: a loss, counted as "not" (it was "failed" only); at 0.1 the
+    # ratio 0.98 is within the 3 % uncertainty of 1 but far above the threshold 0.8: not
+    assert v == {0.1: "not", 0.3: "holds", 0.5: "not"}
+    # against the claim's threshold 1 the same cell is a tie
+    c1 = map_cells(_cells_table(), dict(spec, holds_below=1.0), ["upqc.rating", "t_off", "load"])
+    assert dict(zip(c1["upqc.rating"], c1["verdict"]))[0.1] == "tie"
     val = dict(zip(cells["upqc.rating"], cells["value"]))
     assert val[0.3] == pytest.approx(0.5) and math.isnan(val[0.5])
     # without the dt check there is no uncertainty: 0.98 is then "not" (above 0.8)
     t = _cells_table()
     cells2 = map_cells(t[t["dt_factor"] == 1.0], spec, ["upqc.rating", "t_off", "load"])
     assert dict(zip(cells2["upqc.rating"], cells2["verdict"]))[0.1] == "not"
+
+
+def test_a_ratio_tie_is_judged_against_the_claims_threshold():
+    """A ratio within the runs' uncertainty of holds_below (0.8) is a tie, whatever its
+    distance from 1; one within the uncertainty of 1 but not of 0.8 is not a tie."""
+    t = _cells_table()
+    t.loc[(t["upqc.rating"] == 0.1) & (t["controller"] == "a"), "cost"] = [0.81, 0.834]
+    t.loc[(t["upqc.rating"] == 0.1) & (t["controller"] == "b"), "cost"] = 1.0
+    spec = {"claim": "X", "kind": "ratio", "metric": "cost", "a": "a", "b": "b",
+            "holds_below": 0.8}
+    cells = map_cells(t, spec, ["upqc.rating", "t_off", "load"])
+    c = cells[cells["upqc.rating"] == 0.1].iloc[0]
+    # |0.81 − 0.8| = 0.01 ≤ 0.024 (step halving moves a by 0.024, 3 %): a tie at the threshold
+    assert c["verdict"] == "tie" and c["value"] == pytest.approx(0.81)
+    assert c["uncertainty"] == pytest.approx(0.024)        # in the ratio's units (b = 1)
+    # 10 % below the threshold: holds, not a tie
+    t.loc[(t["upqc.rating"] == 0.1) & (t["controller"] == "a"), "cost"] = [0.70, 0.721]
+    c = map_cells(t, spec, ["upqc.rating", "t_off", "load"])
+    assert dict(zip(c["upqc.rating"], c["verdict"]))[0.1] == "holds"
 
 
 def test_map_cell_without_value_has_a_reason_not_a_verdict():

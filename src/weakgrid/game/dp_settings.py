@@ -35,6 +35,11 @@ class DPSettings:
     interpolation : {"cubic", "linear"}
         Of the residual: Keys' cubic convolution (C¹, exact for quadratics) or
         multilinear (monotone).
+    extrapolate : float or None
+        Cells beyond the grid box over which the cubic residual is continued linearly
+        (with its end slope; a constant past them); 0 = a constant continuation. None
+        (default): 4 for a cost with an input bound, 0 without
+        (:mod:`weakgrid.game.dynamic_programming`, "Leaving the grid").
     """
 
     n_points: tuple = (61, 61)
@@ -45,6 +50,7 @@ class DPSettings:
     tol: float = 1e-6
     newton_steps: int = 2
     interpolation: str = "cubic"
+    extrapolate: float | None = None
 
     def __post_init__(self):
         import numpy as np   # here, not at import: the CLI reads the defaults only
@@ -81,6 +87,15 @@ class DPSettings:
             raise ParameterError("interpolation", self.interpolation, "use 'cubic' or 'linear'")
         if self.interpolation == "cubic" and min(n) < 4:
             raise ParameterError("n_points", list(n), "cubic interpolation needs ≥ 4 nodes")
+        if self.extrapolate is not None:
+            try:
+                e = float(self.extrapolate)
+            except (TypeError, ValueError):
+                e = float("nan")
+            if not (np.isfinite(e) and 0 <= e <= 100):
+                raise ParameterError("extrapolate", self.extrapolate, "use a number of cells "
+                                     "in [0, 100] (0: constant continuation) or None (auto)")
+            object.__setattr__(self, "extrapolate", e)
         if int(self.newton_steps) != self.newton_steps or self.newton_steps < 1:
             raise ParameterError("newton_steps", self.newton_steps, "use an integer ≥ 1")
 
@@ -92,4 +107,5 @@ class DPSettings:
                 "prior": self.prior if isinstance(self.prior, str) else [list(r) for r in
                                                                           self.prior],
                 "max_iterations": self.max_iterations, "tol": self.tol,
-                "newton_steps": self.newton_steps, "interpolation": self.interpolation}
+                "newton_steps": self.newton_steps, "interpolation": self.interpolation,
+                "extrapolate": self.extrapolate}

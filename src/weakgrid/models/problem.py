@@ -18,6 +18,12 @@ see ``src/weakgrid/data/presets/case1-paper.toml`` for a complete example.
 default) or ``"box"`` (``|u_i| ≤ ū_i``; one value or one per input). The penalty
 ``W(u)`` of :mod:`weakgrid.game.input_bound` then replaces ``u'Ru``. Studies set the
 bound from the device rating with :meth:`TrainingProblem.with_input_bound`.
+
+``[basis]`` may name, as ``bounded = { kind = …, … }``, the basis of the bounded
+(rating-aware) problem: used whenever the cost has a bound (in the file or by
+:meth:`TrainingProblem.with_input_bound`); without it the bounded problem keeps the
+problem's basis. The shipped presets choose ``{ kind = "full", degree = 4 }``: with the
+paper's 8-term basis the bounded value has a ridge at the edge of Ω (docs/beyond.md).
 """
 
 from __future__ import annotations
@@ -176,6 +182,25 @@ def _required(d: dict, keys, kind):
                                  f"{', '.join(keys)}")
 
 
+def _bases(d: dict, n: int):
+    """``(basis, bounded basis or None)`` of a ``[basis]`` table (its ``bounded`` sub-table)."""
+    if "bounded" not in d:
+        return _basis(d, n), None
+    b = d["bounded"]
+    if not isinstance(b, dict):
+        raise ParameterError("basis.bounded", b, "give a table, e.g. bounded = { kind = "
+                             "\"full\", degree = 4 }")
+    if "bounded" in b:
+        raise ParameterError("basis.bounded.bounded", b["bounded"], "the bounded basis has "
+                             "no bounded basis of its own: remove it")
+    try:
+        bb = _basis(b, n)
+    except ParameterError as exc:  # name the field where it is
+        raise ParameterError(exc.field.replace("basis.", "basis.bounded.", 1), exc.value,
+                             exc.fix) from None
+    return _basis({k: v for k, v in d.items() if k != "bounded"}, n), bb
+
+
 def _basis(d: dict, n: int) -> PolynomialBasis:
     kind = d.get("kind", "paper")
     if kind == "paper":
@@ -302,7 +327,9 @@ class TrainingProblem:
         shape : {"disk", "box"}, optional
             Default: the problem file's ``u_bound_shape``, else "disk".
 
-        The published weights are dropped (they are for the unbounded cost).
+        The published weights are dropped (they are for the unbounded cost). The basis
+        is the problem file's ``[basis] bounded`` table while bounded (the shipped
+        presets: every monomial of degree 2–4), its ``[basis]`` otherwise.
         See also :meth:`with_rating`.
         """
         if limit is None:
@@ -313,7 +340,14 @@ class TrainingProblem:
             cost = GameCost.for_system(self.system, c.Q, c.R, c.P, c.gamma, bound=limit,
                                        bound_shape=shape)
         name = self.name if cost.bound is None else f"{self.name}-bounded"
-        return TrainingProblem(name, self.system, self.basis, cost, self.mesh,
+        basis = self.basis
+        raw_basis = self.raw.get("basis", {}) if isinstance(self.raw, dict) else {}
+        if isinstance(raw_basis, dict) and "bounded" in raw_basis:
+            plain, bounded = _bases(raw_basis, self.system.n_states)
+            if (self.cost.bound is None and self.basis == plain) or \
+                    (self.cost.bound is not None and self.basis == bounded):
+                basis = plain if cost.bound is None else bounded   # (a basis set apart stays)
+        return TrainingProblem(name, self.system, basis, cost, self.mesh,
                                self.initial_policy, self.settings,
                                self.published if cost.bound is None else {}, self.raw,
                                self.source)
@@ -349,7 +383,9 @@ def problem_from_dict(d: dict, source: str = "") -> TrainingProblem:
     if mesh.n_states != system.n_states:
         raise ParameterError("mesh.lower", list(mesh.lower),
                              f"give one bound per state ({system.n_states})")
-    basis = _basis(d.get("basis", {}), system.n_states)
+    basis, bounded_basis = _bases(d.get("basis", {}), system.n_states)
+    if cost.bound is not None and bounded_basis is not None:
+        basis = bounded_basis
     policy = _policy(d["initial_policy"], system)
     s = d.get("solver", {})
     _check_keys(s, {"tol_u", "tol_w", "max_outer", "max_inner"}, "solver")

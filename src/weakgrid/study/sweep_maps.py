@@ -5,7 +5,8 @@ table (a row per run; :mod:`weakgrid.study.sweep`)::
 
     claim, title, label        the claim's id, the map's title and colour-bar label
     id                         the map's own id when a claim has several maps [claim]
-    kind = "ratio"             metric of controller a / of b; holds if ≤ holds_below
+    kind = "ratio"             metric of controller a / of b; holds if ≤ holds_below, a tie
+                               if a is within the runs' uncertainty of holds_below·b
                                (or b failed while a finished: no value, holds, b's cause noted;
                                a failed while b finished: a loss, not, a's cause noted)
     kind = "value"             metric of controller a; holds if within holds_within = [lo, hi]
@@ -186,12 +187,13 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
                 note = _why_missing(m, [c for c, v in ((a, va), (b, vb))
                                         if not math.isfinite(v)] or [f"{a}/{b}"])
             else:
-                who, tol = compare(va, vb, ua, ub)
+                # judged against the claim's threshold θ, not against a ratio of 1: a
+                # against θ·b, each with its own uncertainty (tol in a's units; u in the
+                # ratio's)
+                theta = float(spec.get("holds_below", 1.0))
+                who, tol = compare(va, theta * vb, ua, ub)
                 u = tol / abs(vb) if tol > 0 else math.nan
-                if who == "tie":
-                    verdict = "tie"
-                else:
-                    verdict = "holds" if val <= spec.get("holds_below", 1.0) else "not"
+                verdict = {"tie": "tie", "a": "holds", "b": "not"}[who]
         elif kind == "wins":
             m0 = metrics[0]
             va0 = _num(ra.get(m0))
