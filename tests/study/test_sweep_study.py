@@ -247,6 +247,17 @@ def test_a_ratio_tie_is_judged_against_the_claims_threshold():
     assert dict(zip(c["upqc.rating"], c["verdict"]))[0.1] == "holds"
 
 
+def test_a_ratio_maps_colours_turn_at_the_claims_threshold():
+    """The diverging colour scale of a ratio map is centred where holds turns into not (its
+    holds_below), not at a ratio of 1; a wins map's at 1; a value map has none."""
+    from weakgrid.study.sweep_maps import colour_centre
+
+    assert colour_centre({"kind": "ratio", "holds_below": 0.8}) == 0.8
+    assert colour_centre({"kind": "ratio"}) == 1.0
+    assert colour_centre({"kind": "wins"}) == 1.0
+    assert colour_centre({"kind": "value"}) is None
+
+
 def test_map_cell_without_value_has_a_reason_not_a_verdict():
     """A settling-time ratio where a finished run never settles: no value, no ✗, the reason."""
     t = _cells_table()

@@ -529,7 +529,7 @@ _add(Table("sweep.maps", "A map of a sweep for a claim.", (
     Field("metrics", LS, "Metrics (several)."),
     Field("a", S, "Controller a."),
     Field("b", S, "Controller b."),
-    Field("holds_below", N, "kind = ratio: the claim holds where a/b ≤ this.", default=1.0),
+    Field("holds_below", N, "kind = ratio: the claim holds where a/b ≤ this, and is a tie where a is within the runs' uncertainty of this · b; the map's colour scale is centred on it.", default=1.0),
     Field("holds_within", {**LN, "minItems": 2, "maxItems": 2}, "kind = value: the claim "
           "holds where the value is within `[lo, hi]`."),
     Field("label", S, "Its label."),

@@ -278,6 +278,12 @@ def _short(path):
             "load": "load level", "duration": "fault duration [s]"}.get(tail, path)
 
 
+def colour_centre(spec: dict):
+    """Where a map's diverging colour scale turns: where its verdict turns — a ratio map at
+    its claim's ``holds_below``, a wins map at 1; ``None`` (a sequential scale) otherwise."""
+    return {"ratio": float(spec.get("holds_below", 1.0)), "wins": 1.0}.get(spec["kind"])
+
+
 def draw_maps(study, table, folder, quick=False) -> list[dict]:
     """Draw every ``[[sweep.maps]]`` of ``study`` from its sweep ``table`` into ``folder``
     (PNG); returns per map: spec, cells (DataFrame), path, mark."""
@@ -300,7 +306,7 @@ def draw_maps(study, table, folder, quick=False) -> list[dict]:
             out.append({"spec": spec, "cells": cells, "path": None, "mark": mark,
                         "axes": (x, y, facet)})
             continue
-        center = 1.0 if spec["kind"] in ("ratio", "wins") else None
+        center = colour_centre(spec)
         fshort = facet.split(".")[-1] if facet else None
         shown = cells.rename(columns={facet: fshort}) if facet else cells
         fig = plot_map(shown, x, y, "value", verdict="verdict", note="note", facet=fshort,
