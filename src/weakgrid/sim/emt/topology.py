@@ -19,8 +19,8 @@ Mapping
   impedance weakgrid's phasor engine uses (:meth:`weakgrid.sim.network.Network.load_admittance` at the solved
   voltage): a resistor and an inductor or capacitor to ground;
 * :class:`~weakgrid.sim.sources.InfiniteBus`: DPsim's ``NetworkInjection`` (an ideal source) at
-  the power-flow phasor; the conventional UPQC: :mod:`weakgrid.sim.emt.upqc`; other devices (GTI,
-  converters, PVSource, ZIP loads) are refused.
+  the power-flow phasor; the conventional UPQC: :mod:`weakgrid.sim.emt.upqc`; the GTI:
+  :mod:`weakgrid.sim.emt.gti`; other devices (converters, PVSource, ZIP loads) are refused.
 """
 
 from __future__ import annotations
@@ -34,6 +34,8 @@ from ..network import BR_B, BR_R, BR_STATUS, BR_X, SHIFT, TAP, T_BUS, F_BUS, GS,
 
 #: non-machine component types the DPsim engines map
 DEVICE_MAP = {"InfiniteBus": "NetworkInjection",
+              "GTI": "VoltageSource behind its coupling reactance, driven by weakgrid's GTI "
+                     "equations between steps (weakgrid.sim.emt.gti)",
               "UPQC": "VoltageSource + CurrentSource (conventional structure, weakgrid.sim.emt.upqc)"}
 
 
@@ -75,7 +77,7 @@ def bus_base(system):
     return kv * 1e3, (kv ** 2) / system.Sb
 
 
-def build_network(system, kit) -> Circuit:
+def build_network(system, kit, removed=None) -> Circuit:
     """Nodes, branches, shunt admittances and ideal sources of a set-up system in DPsim.
 
     Parameters
@@ -84,6 +86,9 @@ def build_network(system, kit) -> Circuit:
         A set-up system (power flow solved).
     kit : weakgrid.sim.emt.dpsim_module.Kit
         The domain's classes.
+    removed : ndarray of complex, optional
+        Per bus position, admittance [pu] left out of the bus's permanent shunt (the part a
+        load step removes: :func:`weakgrid.sim.emt.events.removed_load`).
     """
     net = system.network
     w = 2 * math.pi * net.f_hz
@@ -118,6 +123,14 @@ def build_network(system, kit) -> Circuit:
                 cap.connect([kit.gnd, n])
                 cir.components.append(cap)
     y = net.load_admittance(net.pf.V) + (net.bus[:, GS] + 1j * net.bus[:, BS]) / system.Sb
+    if removed is not None:
+        for b in np.nonzero(removed)[0]:
+            if y[b].real - removed[b].real < -1e-12:
+                raise DataError(f"LoadStep at bus {net.bus_ids[b]}", "dP",
+                                -removed[b].real * system.Sb,
+                                f"removes more load than the bus holds ({y[b].real * system.Sb:g} "
+                                "MW at the power-flow voltage)")
+        y = y - removed
     for b, yb in enumerate(y):
         _shunt(cir, kit, f"bus{net.bus_ids[b]}", nodes[b], complex(yb) / Zb[b], w)
     for c in system.components.values():
