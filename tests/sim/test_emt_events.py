@@ -52,7 +52,7 @@ def _three(events, t_end=T_END, **kw):
     return out
 
 
-def _check_alike(runs, rel=0.05):
+def _check_alike(runs, rel=0.01):
     exc = {e: np.max(np.abs(r["G1.omega"] - 1.0)) for e, r in runs.items()}
     assert exc["phasor"] > 1e-4, exc
     assert exc["dpsim-emt"] == pytest.approx(exc["dpsim-dp"], rel=0.01), exc
