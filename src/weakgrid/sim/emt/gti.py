@@ -28,7 +28,10 @@ new set point ``Es_k`` (from ``x_k`` and ``theta_r(t_k)``) is held by the DPsim 
 time constant ``Td`` = 10 ms). The phasor engine solves the same equations implicitly with
 the network algebraic.
 
-Refused: a GTI feeding a reduced UPQC (:mod:`weakgrid.sim.emt.upqc`).
+A reduced UPQC (:mod:`weakgrid.sim.emt.upqc`) draws its series power from the GTI's dc link:
+``C Vc dVc/dt = Pin − Pe − P_series`` with ``P_series`` the power its series source delivered
+over the last step (weakgrid's ``gti_p_series`` signal, set between ``compute`` and
+``finish``).
 """
 
 from __future__ import annotations
@@ -41,9 +44,10 @@ from ..component import Context
 
 #: recorded GTI signals (the phasor engine's names ``<gti>.<name>``): states, then outputs
 STATES = ("Vc", "phi_hat")
-OUTPUTS = ("Vs", "ks", "phi_s", "P_ac", "Q", "Pe", "upsilon", "dVc")
+OUTPUTS = ("Vs", "ks", "phi_s", "P_ac", "Q", "Pe", "upsilon", "dVc", "P_series")
 _KINDS = {"Vc": "pu", "phi_hat": "angle", "Vs": "pu", "ks": "pu", "phi_s": "angle",
-          "P_ac": "power", "Q": "power", "Pe": "power", "upsilon": "pu", "dVc": "pu"}
+          "P_ac": "power", "Q": "power", "Pe": "power", "upsilon": "pu", "dVc": "pu",
+          "P_series": "power"}
 
 
 class GTIBridge:
@@ -102,12 +106,15 @@ class GTIBridge:
         else:
             src.attr("V_ref").set(complex(V))
 
-    def _evaluate(self, V, I):
+    def _evaluate(self, V, I, p_series=None):
         """weakgrid's GTI equations at the current states, the measured bus voltages ``V`` [pu]
-        and inverter currents ``I`` [pu, into the bus]: ``(ctx, Es)``."""
+        and inverter currents ``I`` [pu, into the bus], the reduced UPQCs' draw ``p_series``
+        [pu, per GTI]: ``(ctx, Es)``."""
         g = self.g
         ctx = Context(self.system, 0.0, self.x, np.asarray(V, complex))
         g.compute(ctx)
+        if p_series is not None:
+            ctx.sig["gti_p_series"] = np.asarray(p_series, float)
         Es_applied = np.array([it["Es"] for it in self.items])
         g._Pac = (Es_applied * np.conj(I)).real
         g._Q = (ctx.V[g.bus] * np.conj(I)).imag
@@ -116,16 +123,17 @@ class GTIBridge:
         Es = g._Vs * np.exp(1j * (th_r + g._phis))
         return ctx, Es
 
-    def update(self, dt, phasors, current_of):
+    def update(self, dt, phasors, current_of, p_series=None):
         """At a measurement instant ``t_k``: evaluate every GTI at its states ``x_k`` and the
         measured bus ``phasors`` [pu, one per bus position] and inverter currents, advance the
         states to ``x_{k+1}`` (forward Euler over ``dt`` [s]) and set each source for the next
-        step; return the signals at ``t_k``, ``{"<gti>.<signal>": value}``."""
+        step; return the signals at ``t_k``, ``{"<gti>.<signal>": value}``. ``p_series``: the
+        dc power [pu] the reduced UPQCs draw from each GTI (None: none)."""
         if not self.items:
             return {}
         g = self.g
         I = np.array([current_of(it["ind"]) / it["ib"] for it in self.items])
-        ctx, Es = self._evaluate(phasors, I)
+        ctx, Es = self._evaluate(phasors, I, p_series)
         rec = self._record(ctx)
         for k in range(len(g.states)):
             sl = g.sl(k)

@@ -127,7 +127,7 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
     failure = None
     sim.start()
     rec.measure(0.0)
-    rec.gti = gti.update(dt, rec._ph, rec.current)
+    rec.gti = gti.update(dt, rec._ph, rec.current, bridge.gti_draw(len(gti.items)))
     rec.add(0.0)
     for k in range(1, n_steps + 1):
         t = (k - 1) * dt
@@ -140,7 +140,7 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
             rec.add(k * dt)
             failure = SimulationError(k * dt, "divergence", "a DPsim bus voltage is not finite")
             break
-        rec.gti = gti.update(dt, rec._ph, rec.current)
+        rec.gti = gti.update(dt, rec._ph, rec.current, bridge.gti_draw(len(gti.items)))
         if k % decimate == 0 or k == n_steps:
             rec.add(k * dt)
     sim.stop()

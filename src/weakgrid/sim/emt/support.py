@@ -39,12 +39,6 @@ def check_supported(system, events=(), engine: str = "dpsim-emt") -> None:
     domain_of(engine)
     check_machines(system)
     check_devices(system)
-    up = system.components.get("UPQC")
-    if up is not None and up.n and np.asarray(up.reduced).any():
-        bad = [nm for nm, red in zip(up.names, up.reduced) if red]
-        raise DataError(f"UPQC '{bad[0]}'", "structure", "reduced",
-                        "the reduced UPQC (fed from the GTI's dc link) has no DPsim mapping yet; "
-                        "use the conventional structure")
     net = system.network
     for k, row in enumerate(net.branch):
         if row[BR_STATUS] > 0 and row[SHIFT] != 0:
