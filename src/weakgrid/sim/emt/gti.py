@@ -19,7 +19,12 @@ evaluated between DPsim steps from the *measured* terminal quantities:
 * the ac power ``P_ac = Re(Es conj(I))`` and ``Q = Im(V conj(I))`` with ``I`` the measured
   inductor current and ``Es`` the set point the source held over the last step — the power the
   DPsim source actually delivered, so the energy leaving the dc link is the energy the network
-  received (weakgrid's algebraic current ``-jB(Es - V)`` is not used).
+  received (``power="measured"``, the default). With ``power="model"`` the dc link pays
+  weakgrid's model's own power, ``I = -jB(Es - V)`` at the measured ``V`` (the phasor
+  engine's coupling), blind to the coupling inductor's current transients — which the
+  network still receives from the source: not energy-consistent, but it isolates what the
+  dc link's sight of those transients does (docs/engines.md: on the case-1 grid it is the whole
+  difference to the phasor engine).
 
 Time stepping (stated, not hidden): at ``t_k`` the GTI states ``x_k`` and the measurements
 give the derivatives; the states advance by forward Euler, ``x_{k+1} = x_k + dt f_k``, and the
@@ -41,6 +46,7 @@ import math
 import numpy as np
 
 from ..component import Context
+from ..errors import DataError
 
 #: recorded GTI signals (the phasor engine's names ``<gti>.<name>``): states, then outputs
 STATES = ("Vc", "phi_hat")
@@ -63,9 +69,12 @@ class GTIBridge:
         The translated network (its nodes, components and initial phasors ``Vpf`` [V]).
     """
 
-    def __init__(self, system, kit, cir):
+    def __init__(self, system, kit, cir, power="measured"):
         from .topology import bus_base
 
+        if power not in ("measured", "model"):
+            raise DataError("simulate_dpsim", "gti_power", power, "use 'measured' or 'model'")
+        self.power = power
         self.system, self.kit = system, kit
         self.g = g = system.components.get("GTI")
         self.items = []
@@ -115,9 +124,10 @@ class GTIBridge:
         g.compute(ctx)
         if p_series is not None:
             ctx.sig["gti_p_series"] = np.asarray(p_series, float)
-        Es_applied = np.array([it["Es"] for it in self.items])
-        g._Pac = (Es_applied * np.conj(I)).real
-        g._Q = (ctx.V[g.bus] * np.conj(I)).imag
+        if self.power == "measured":
+            Es_applied = np.array([it["Es"] for it in self.items])
+            g._Pac = (Es_applied * np.conj(I)).real
+            g._Q = (ctx.V[g.bus] * np.conj(I)).imag
         g.finish(ctx)
         th_r = np.angle(ctx.V[g.ref])
         Es = g._Vs * np.exp(1j * (th_r + g._phis))

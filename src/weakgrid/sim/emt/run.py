@@ -40,7 +40,8 @@ __all__ = ["DOMAINS", "simulate_dpsim"]
 
 
 def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float = 1e-4,
-                   events=(), controllers=(), decimate: int = 1, name: str = "weakgrid") -> Results:
+                   events=(), controllers=(), decimate: int = 1, name: str = "weakgrid",
+                   gti_power: str = "measured") -> Results:
     """Simulate a set-up ``system`` in DPsim from ``t = 0`` to ``t_end`` [s].
 
     Parameters
@@ -56,6 +57,11 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
         Fixed time step [s] (EMT needs a step well below the nominal period: 1e-4 s at 50/60 Hz).
     events : list
         weakgrid events (:mod:`weakgrid.sim.emt.events` says which are mapped).
+    gti_power : {"measured", "model"}
+        The ac power a GTI's dc link pays (:mod:`weakgrid.sim.emt.gti`): the power its DPsim
+        source delivered (``"measured"``, energy-consistent), or weakgrid's GTI model's own
+        ``Re(Es conj(-jB(Es - V)))`` at the measured voltage (``"model"``, the dc link blind to
+        the coupling's current transients).
     decimate : int
         Record every ``decimate``-th step.
     name : str
@@ -97,14 +103,16 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
         # DPsim writes its own log files (MnaSolverFactory.log, scheduler.log) to a log
         # directory (default ./logs): kept out of the user's working directory
         kit.d.Logger.set_log_dir(logdir)
-        return _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers)
+        return _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers,
+                    gti_power)
 
 
-def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers):
+def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers,
+         gti_power="measured"):
     net = system.network
     cir = build_network(system, kit, removed_load(system, events))
     bridge = UPQCBridge(system, kit, cir)
-    gti = GTIBridge(system, kit, cir)
+    gti = GTIBridge(system, kit, cir, power=gti_power)
     gens = build_machines(system, kit, trip_terminals(system, kit, cir, events), cir.Vpf)
     cir.components.extend(g for _, g in gens)
     sw_events = build_events(system, kit, cir, events, dt)
