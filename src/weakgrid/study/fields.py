@@ -555,6 +555,10 @@ _add(Table("simulation", "Numerical settings of every run of the study.", (
           "its step: the run's step divided into the fewest equal parts of at most 1e-4 s; "
           "a model or event DPsim lacks is refused by name before any run; "
           "documentation: Engines).", default="phasor", choices=_engines),
+    Field("gti_power", S, "DPsim engines: the ac power a GTI's dc link pays — the power its "
+          "DPsim source delivered (energy-consistent), or the GTI model's own power at the "
+          "measured voltage (blind to the coupling's current transients; documentation: "
+          "Engines).", default="measured", choices=("measured", "model")),
     Field("notes", LS, "Notes on the settings."),
 ), example='[simulation]\nrecord = ["*.omega", "bus*.v"]'))
 

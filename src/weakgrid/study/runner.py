@@ -374,7 +374,8 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
 
         dt = dpsim_step(dt)
         res = simulate_dpsim(setup.system, run.t_end, engine=engine, dt=dt, events=events,
-                             controllers=[dc])
+                             controllers=[dc], gti_power=(study.data.get("simulation") or {})
+                             .get("gti_power", "measured"))
         if record is not None:
             res = res.subset([n for n in res.names if any(fnmatch.fnmatchcase(n, p)
                                                           for p in record)])

@@ -447,6 +447,8 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
             from ..sim.emt import ENGINES
 
             _choice(sim, "engine", "simulation", ENGINES)
+        if "gti_power" in sim:
+            _choice(sim, "gti_power", "simulation", ("measured", "model"))
         if "tol" in sim:
             _num(sim, "tol", "simulation", positive=True)
             if not 1e-13 <= sim["tol"] <= 1e-4:
