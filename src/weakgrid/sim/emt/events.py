@@ -99,7 +99,8 @@ def _unit(system, ev):
                         f"{', '.join(others) or 'no machine'})")
     b = int(inst[0][0].bus[inst[0][1]])
     on_bus = [c.element(i) for c in system.components.values()
-              if c.kind in ("machine", "device") and c.n for i in range(c.n)
+              if c.kind in ("machine", "device") and c.n and getattr(c, "bus", None) is not None
+              for i in range(c.n)
               if b in np.atleast_1d(c.bus)[i:i + 1] and (c, i) not in inst]
     if on_bus:
         raise DataError(where, "gen", ev.gen, f"its bus also holds {', '.join(on_bus)}; the DPsim "
