@@ -138,3 +138,22 @@ def test_cleared_impedance_fault_swings_alike():
     # |V| in DP) changes direction about every 80 steps
     d = np.diff(runs["dpsim-dp"]["bus1.v"][runs["dpsim-dp"].t > 0.2 + 1e-9])
     assert np.mean(np.sign(d[1:]) != np.sign(d[:-1])) < 0.05
+
+
+def test_planning_check_refuses_what_the_build_refuses():
+    """weakgrid.sim.emt.check_supported (a study's planning, no DPsim objects built) refuses
+    what simulate_dpsim refuses, with the same field."""
+    from weakgrid.sim.emt import check_supported
+
+    s = _system()
+    for ev, field in ((LineTrip(0, 0.005), "LineTrip"), (LoadStep(bus=1, t=0.005, dP=-10.0), "dP"),
+                      (GeneratorTrip(2, 0.005), "gen")):
+        with pytest.raises(DataError, match=field):
+            check_supported(s, [ev], "dpsim-dp")
+        with pytest.raises(DataError, match=field):
+            simulate_dpsim(s, 0.01, engine="dpsim-dp", events=[ev])
+    check_supported(s, [LoadStep(bus=2, t=0.005, dP=-10.0), Fault(2, 0.001, 0.002, xf=0.1)],
+                    "dpsim-emt")
+    neg = _system(load2=-10.0)                       # generation as a load
+    with pytest.raises(DataError, match="PD/GS"):
+        check_supported(neg, [], "dpsim-dp")

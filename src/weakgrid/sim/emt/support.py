@@ -16,11 +16,10 @@ import numpy as np
 
 from ..errors import DataError
 from ..events import Fault, GeneratorTrip, LoadStep
-from ..network import BR_STATUS, BR_X, SHIFT
 from .dpsim_module import domain_of
 from .events import BOLTED_MAX, removed_load, _unit
 from .machines import check_machines
-from .topology import check_devices
+from .topology import check_devices, check_network
 
 #: largest DPsim step [s] of a study's run (EMT needs a step well below the 50/60 Hz period)
 DT_MAX = 1e-4
@@ -40,13 +39,7 @@ def check_supported(system, events=(), engine: str = "dpsim-emt") -> None:
     check_machines(system)
     check_devices(system)
     net = system.network
-    for k, row in enumerate(net.branch):
-        if row[BR_STATUS] > 0 and row[SHIFT] != 0:
-            raise DataError(f"branch {net.branch_label(k)}", "SHIFT", float(row[SHIFT]),
-                            "a phase-shifting transformer is not mapped to DPsim; use SHIFT = 0")
-        if row[BR_STATUS] > 0 and row[BR_X] <= 0:
-            raise DataError(f"branch {net.branch_label(k)}", "BR_X", float(row[BR_X]),
-                            "the DPsim engines need an inductive branch (BR_X > 0)")
+    check_network(system, removed_load(system, events))
     gti = system.components.get("GTI")
     refs = set(np.asarray(gti.ref).tolist()) if gti is not None and gti.n else set()
     for j, ev in enumerate(events or ()):
@@ -61,11 +54,3 @@ def check_supported(system, events=(), engine: str = "dpsim-emt") -> None:
             raise DataError(f"event {j}", "kind", type(ev).__name__,
                             "the DPsim engines map bus faults (Fault), load steps (LoadStep) "
                             "and generator trips (GeneratorTrip) so far")
-    rem = removed_load(system, events)
-    if rem.any():
-        from ..network import GS
-
-        y = net.load_admittance(net.pf.V).real + net.bus[:, GS] / system.Sb
-        for b in np.nonzero(rem.real > y + 1e-12)[0]:
-            raise DataError(f"LoadStep at bus {net.bus_ids[b]}", "dP", -rem[b].real * system.Sb,
-                            f"removes more load than the bus holds ({y[b] * system.Sb:g} MW)")

@@ -77,6 +77,46 @@ def bus_base(system):
     return kv * 1e3, (kv ** 2) / system.Sb
 
 
+def _shunt_admittance(system, removed=None):
+    """Per bus position, the constant shunt admittance [pu on Sb] the circuit gets: loads at the
+    power-flow voltage plus ``GS + j BS``, less ``removed``."""
+    net = system.network
+    y = net.load_admittance(net.pf.V) + (net.bus[:, GS] + 1j * net.bus[:, BS]) / system.Sb
+    return y if removed is None else y - removed
+
+
+def check_network(system, removed=None) -> None:
+    """Refuse (:class:`DataError`, naming the branch or bus and the field) what the circuit
+    cannot hold: a non-inductive branch (``BR_X <= 0``, a series capacitor), a phase shifter
+    (``SHIFT != 0``: its two-port is not reciprocal, which no network of R, L, C is), a
+    negative shunt conductance (generation as a load), a load step removing more load than its
+    bus holds (``removed``: :func:`weakgrid.sim.emt.events.removed_load`)."""
+    net = system.network
+    up = system.components.get("UPQC")
+    upqc_rows = set(np.asarray(up.branch).tolist()) if up is not None and up.n else set()
+    for k, row in enumerate(net.branch):
+        if row[BR_STATUS] <= 0 or k in upqc_rows:
+            continue
+        where = f"branch {net.branch_label(k)}"
+        if row[SHIFT] != 0:
+            raise DataError(where, "SHIFT", float(row[SHIFT]),
+                            "a phase-shifting transformer is not mapped to DPsim (its two-port is "
+                            "not reciprocal: no network of R, L, C is one); use SHIFT = 0")
+        if row[BR_X] <= 0:
+            raise DataError(where, "BR_X", float(row[BR_X]),
+                            "the DPsim engines need an inductive branch (BR_X > 0)")
+    y0 = _shunt_admittance(system)
+    y = _shunt_admittance(system, removed)
+    for b in np.nonzero(y.real < -1e-12)[0]:
+        if removed is not None and removed[b] != 0 and y0[b].real >= 0:
+            raise DataError(f"LoadStep at bus {net.bus_ids[b]}", "dP", -removed[b].real * system.Sb,
+                            f"removes more load than the bus holds ({y0[b].real * system.Sb:g} "
+                            "MW at the power-flow voltage)")
+        raise DataError(f"bus{net.bus_ids[b]}", "PD/GS", float(y0[b].real),
+                        "a negative shunt conductance (generation as a load) is not mapped to "
+                        "DPsim")
+
+
 def build_network(system, kit, removed=None) -> Circuit:
     """Nodes, branches, shunt admittances and ideal sources of a set-up system in DPsim.
 
@@ -90,6 +130,7 @@ def build_network(system, kit, removed=None) -> Circuit:
         Per bus position, admittance [pu] left out of the bus's permanent shunt (the part a
         load step removes: :func:`weakgrid.sim.emt.events.removed_load`).
     """
+    check_network(system, removed)
     net = system.network
     w = 2 * math.pi * net.f_hz
     Vb, Zb = bus_base(system)
@@ -105,14 +146,11 @@ def build_network(system, kit, removed=None) -> Circuit:
         if row[BR_STATUS] <= 0 or k in upqc_rows:     # a UPQC branch: weakgrid.sim.emt.upqc
             continue
         f, t = net.index_of(int(row[F_BUS])), net.index_of(int(row[T_BUS]))
-        where = f"branch {net.branch_label(k)}"
         tap = row[TAP] if row[TAP] != 0 else 1.0
         if tap != 1.0 or row[SHIFT] != 0 or Zb[f] != Zb[t]:
             _transformer(cir, kit, system, k, row, f, t, w)
             continue
         r, x, bc = float(row[BR_R]), float(row[BR_X]), float(row[BR_B])
-        if x <= 0:
-            raise DataError(where, "BR_X", x, "the DPsim engines need an inductive branch (BR_X > 0)")
         z = Zb[f]
         nf, nt = nodes[f], nodes[t]
         _series_rl(cir, kit, f"br{k}", nf, nt, Vpf[f], Vpf[t], complex(r, x) * z, w)
@@ -122,15 +160,7 @@ def build_network(system, kit, removed=None) -> Circuit:
                 cap.set_parameters(kit.param(0.5 * bc / (z * w)))
                 cap.connect([kit.gnd, n])
                 cir.components.append(cap)
-    y = net.load_admittance(net.pf.V) + (net.bus[:, GS] + 1j * net.bus[:, BS]) / system.Sb
-    if removed is not None:
-        for b in np.nonzero(removed)[0]:
-            if y[b].real - removed[b].real < -1e-12:
-                raise DataError(f"LoadStep at bus {net.bus_ids[b]}", "dP",
-                                -removed[b].real * system.Sb,
-                                f"removes more load than the bus holds ({y[b].real * system.Sb:g} "
-                                "MW at the power-flow voltage)")
-        y = y - removed
+    y = _shunt_admittance(system, removed)
     for b, yb in enumerate(y):
         _shunt(cir, kit, f"bus{net.bus_ids[b]}", nodes[b], complex(yb) / Zb[b], w)
     for c in system.components.values():
@@ -156,9 +186,6 @@ def _shunt(cir, kit, name, node, y, w):
         r.set_parameters(kit.param(1.0 / y.real))
         r.connect([kit.gnd, node])
         cir.components.append(r)
-    elif y.real < 0:
-        raise DataError(name, "PD/GS", y.real, "a negative shunt conductance (generation as a load) "
-                        "is not mapped to DPsim")
     if y.imag < 0:      # inductive (a load absorbing vars)
         L = ph.Inductor(f"{name}.BL", off)
         L.set_parameters(kit.param(-1.0 / (y.imag * w)))
@@ -217,18 +244,10 @@ def _transformer(cir, kit, system, k, row, f, t, w):
     the snubbers negligible), kicked its LV node by 13 % at the first step in DP and stayed
     18 % off the analytic steady state in EMT (not investigated further).
 
-    Refused: ``SHIFT != 0`` (a phase shifter's two-port is not reciprocal,
-    ``Y_ft != Y_tf``, which no network of R, L, C is), ``BR_X <= 0``.
+    Refused (:func:`check_network`): ``SHIFT != 0`` (a phase shifter's two-port is not
+    reciprocal, ``Y_ft != Y_tf``, which no network of R, L, C is), ``BR_X <= 0``.
     """
-    net = system.network
-    where = f"branch {net.branch_label(k)}"
-    if row[SHIFT] != 0:
-        raise DataError(where, "SHIFT", float(row[SHIFT]),
-                        "a phase-shifting transformer is not mapped to DPsim (its two-port is "
-                        "not reciprocal: no network of R, L, C is one); use SHIFT = 0")
     r, x, bc = float(row[BR_R]), float(row[BR_X]), float(row[BR_B])
-    if x <= 0:
-        raise DataError(where, "BR_X", x, "the DPsim engines need an inductive branch (BR_X > 0)")
     Vbase, Zb = bus_base(system)
     tap = float(row[TAP]) if row[TAP] != 0 else 1.0
     N = tap * Vbase[f] / Vbase[t]
