@@ -108,8 +108,6 @@ def test_machines_without_a_dpsim_model_are_refused(model, params, field):
 
 def test_unmapped_events_and_engines_are_refused():
     s = _smib()
-    with pytest.raises(DataError, match="xf"):
-        simulate_dpsim(s, 0.01, engine="dpsim-dp", events=[Fault(bus=1, t_on=0.0, xf=0.05)])
     with pytest.raises(DataError, match="LineTrip"):
         simulate_dpsim(s, 0.01, engine="dpsim-dp", events=[LineTrip(0, 0.005)])
     with pytest.raises(DataError, match="dpsim-emt"):

@@ -58,7 +58,30 @@ def add_operating_point(p):
 
 
 def study_of(args, name=None):
-    """The study named by ``args.study`` (or ``name``) with ``args.overrides`` applied."""
+    """The study named by ``args.study`` (or ``name``) with ``args.overrides`` applied, and
+    ``args.engine`` (``--engine``) as ``simulation.engine`` when it differs from the study's
+    (an unchanged engine leaves the study's data, and so its cached runs' keys, as they are)."""
+    from ..study.runner import sim_engine
     from ..study.studyfile import load_study
 
-    return load_study(args.study if name is None else name, getattr(args, "overrides", None) or ())
+    src = args.study if name is None else name
+    overrides = list(getattr(args, "overrides", None) or ())
+    st = load_study(src, overrides)
+    engine = getattr(args, "engine", None)
+    if engine is not None and engine != sim_engine(st):
+        st = load_study(src, overrides + [("simulation.engine", engine)])
+    return st
+
+
+def add_engine_argument(p):
+    """``--engine``: the simulator of a study's runs (``[simulation] engine``)."""
+    from ..sim.emt import ENGINES
+
+    p.add_argument("--engine", choices=ENGINES, default=None,
+                   help="the simulator of every run: weakgrid's phasor engine, or the same grid "
+                        "in DPsim's electromagnetic transients (dpsim-emt) or dynamic phasors "
+                        "(dpsim-dp), the extra weakgrid[emt] (default: the study's [simulation] "
+                        "engine, else phasor; for a case file: phasor); a model or event DPsim "
+                        "lacks is refused by name before any run; DPsim steps at 1e-4 s (a "
+                        "case: unless --dt; a study: its step divided into parts of at most "
+                        "1e-4 s) (documentation: Engines)")

@@ -8,7 +8,7 @@ from ._common import (HelpFormatter, add_cluster_arguments, add_force_argument, 
                       output_folder)
 
 from ._common import show_progress
-from ._study import add_study_argument, study_of
+from ._study import add_engine_argument, add_study_argument, study_of
 
 NAME = "run"
 
@@ -30,6 +30,7 @@ def add_parser(sub):
                         "and the [sweep.quick] of a study with a [sweep]; what runs is said "
                         "first, the sweep's runs are a table in the report")
     p.add_argument("--list", action="store_true", help="list the shipped studies")
+    add_engine_argument(p)
     add_cluster_arguments(p)
     add_force_argument(p, overwrite="files in the output folder", limits=False)
     p.set_defaults(func=run)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from ._case import FAULT_FORM, STEP_FORM, TRIP_FORM, fault_arg, is_case, load_step_arg, trip_arg
 from ._common import (HelpFormatter, add_force_argument, input_file, output_file, positive_float)
-from ._study import add_set_argument
+from ._study import add_engine_argument, add_set_argument
 
 NAME = "simulate"
 
@@ -22,7 +22,7 @@ NAME = "simulate"
 STUDY_ONLY = {"scenario": "--scenario", "controller": "--controller", "quick": "--quick",
               "list": "--list", "overrides": "--set"}
 CASE_ONLY = {"dyr": "--dyr", "fault": "--fault", "trip": "--trip", "load_step": "--load-step",
-             "dt": "--dt", "record": "--record", "force": "--force", "engine": "--engine"}
+             "dt": "--dt", "record": "--record", "force": "--force"}
 
 
 def add_parser(sub):
@@ -70,12 +70,8 @@ def add_parser(sub):
                    help="record only these signals (names or patterns such as '*.omega', "
                         "'bus103.*'; repeatable); default: every signal up to 3000 DAE "
                         "variables, the machines' speeds and angles above")
-    c.add_argument("--engine", choices=("phasor", "dpsim-emt", "dpsim-dp"), default=None,
-                   help="the simulator: weakgrid's phasor engine when not given, or DPsim's "
-                        "electromagnetic transients (dpsim-emt) or dynamic phasors (dpsim-dp), "
-                        "the extra weakgrid[emt]; models DPsim lacks are refused by name "
-                        "(documentation: Engines); DPsim steps at 1e-4 s unless --dt")
     add_force_argument(c)
+    add_engine_argument(p)
     p.add_argument("--t-end", type=positive_float, default=None,
                    help="simulated time [s] (default: the scenario's; 20 s for a case, as "
                         "ANDES)")

@@ -40,7 +40,7 @@ from .figures import figure_specs, write_figures
 from .protocol import controller_name, protocol_of
 from .report import who_did_best, write_html, write_tables
 from ..sweep import open_client, run_sweep
-from .runner import Run, RunRecord, make_events, run_scenario
+from .runner import Run, RunRecord, check_engine, make_events, run_scenario
 from .sweep import _axes, describe_sweep, run_point, sweep_points
 from .sweep_estimate import estimate_sweep, run_cost
 from .sweep_maps import draw_maps, map_summaries, metric_uncertainty
@@ -180,14 +180,17 @@ def check_events(plan) -> None:
     """Build every run's events on its grid (:func:`weakgrid.study.runner.make_events`) so
     that an event the grid cannot carry (an unknown bus or branch, the UPQC's own branch, a
     load step beyond the grid's size, overlapping faults) stops the command before any
-    training; a grid is set up once per (study, load, UPQC structure, variant)."""
+    training; a grid is set up once per (study, load, UPQC structure, variant). With a DPsim
+    engine (``[simulation] engine``) every model and event of every run is checked against
+    it too (:func:`weakgrid.study.runner.check_engine`): a model it lacks is refused by name
+    before any run."""
     setups = {}
     for st, runs, _ in plan:
         for run in runs:
             key = (id(st), run.load, run.upqc, controller_variant(st, run.controller))
             if key not in setups:
                 setups[key] = build_setup(st, *key[1:])
-            make_events(setups[key], run)
+            check_engine(st, setups[key], make_events(setups[key], run))
 
 
 def run_studies(studies, output, quick=False, log=None, title=None, progress=True,
@@ -254,7 +257,8 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
         sim = st.data.get("simulation") or {}
         if sim:
             case_notes.append("numerics: " + ", ".join(
-                f"{k} = {sim[k]:g}" for k in ("dt", "tol") if k in sim) + " ([simulation]); "
+                f"{k} = {sim[k]:g}" for k in ("dt", "tol") if k in sim)
+                + (f", engine = {sim['engine']}" if "engine" in sim else "") + " ([simulation]); "
                 + "; ".join(sim.get("notes", [])))
         pre = load_preset(st.data["design"]["settings"]).system
         for load, upqc in keys:

@@ -113,6 +113,12 @@ def _grid_models():
     return GRID_MODELS
 
 
+def _engines():
+    from ..sim.emt import ENGINES
+
+    return ENGINES
+
+
 def _controller_kinds():
     from .controllers import CONTROLLER_KINDS
 
@@ -544,6 +550,15 @@ _add(Table("simulation", "Numerical settings of every run of the study.", (
           default=Said("the simulator's default for dt")),
     Field("record", {**LS, "minItems": 1}, "Signal names or fnmatch patterns the run files "
           "keep (the figures' signals always).", default=Said("every signal")),
+    Field("engine", S, "The simulator of every run: weakgrid's phasor engine, or the same grid "
+          "in DPsim's electromagnetic transients or dynamic phasors (the extra `weakgrid[emt]`; "
+          "its step: the run's step divided into the fewest equal parts of at most 1e-4 s; "
+          "a model or event DPsim lacks is refused by name before any run; "
+          "documentation: Engines).", default="phasor", choices=_engines),
+    Field("gti_power", S, "DPsim engines: the ac power a GTI's dc link pays — the power its "
+          "DPsim source delivered (energy-consistent), or the GTI model's own power at the "
+          "measured voltage (blind to the coupling's current transients; documentation: "
+          "Engines).", default="measured", choices=("measured", "model")),
     Field("notes", LS, "Notes on the settings."),
 ), example='[simulation]\nrecord = ["*.omega", "bus*.v"]'))
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import fnmatch
 import time
 from dataclasses import asdict, dataclass, field
 
@@ -270,6 +271,32 @@ def _plausible_step(setup, e, w):
                              f"{STEP_LIMIT:g} × {size:.4g}")
 
 
+def sim_engine(study) -> str:
+    """The engine of ``study``'s runs: ``[simulation] engine`` (default ``"phasor"``)."""
+    return (study.data.get("simulation") or {}).get("engine") or "phasor"
+
+
+def dpsim_measure(setup):
+    """The DPsim twin of ``setup.measure_signals``: the same measured signals of the controlled
+    machine read from DPsim's recorded signals (:mod:`weakgrid.sim.emt.controllers`)."""
+    from ..sim.emt import gti_signals, sg_signals
+
+    if setup.machine == "gti":
+        return gti_signals(setup.source)
+    return sg_signals(setup.source, setup.shunt_bus)
+
+
+def check_engine(study, setup, events) -> None:
+    """Refuse, before any run, a model or event of ``setup`` that ``study``'s engine cannot
+    run (the DPsim engines: :func:`weakgrid.sim.emt.check_supported`; the phasor engine runs
+    everything)."""
+    engine = sim_engine(study)
+    if engine != "phasor":
+        from ..sim.emt import check_supported
+
+        check_supported(setup.system, events, engine)
+
+
 def sim_settings(study, dt_factor: float = 1.0) -> tuple[float, float | None]:
     """``(dt, tol)``: integration step [s] and Newton tolerance [pu] of a run of ``study``.
 
@@ -309,6 +336,8 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
         The design model (10) at ``design_load`` if already derived (a sweep caches it).
     """
     setup = build_setup(study, run.load, run.upqc, controller_variant(study, run.controller))
+    events = make_events(setup, run)
+    check_engine(study, setup, events)     # a model the engine lacks: refused before training
     dload = design_load or run.design_load or run.load
     if design is None:
         design = setup.design if dload == run.load else \
@@ -328,15 +357,28 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
         xs.append(m.copy())
         return u
 
+    engine = sim_engine(study)
     target = UPQCTarget(setup.upqc_name) if setup.upqc_name else _MeasureOnly()
-    dc = DigitalController(K, T=T, measure=setup.measure_signals, target=target,
+    measure = setup.measure_signals if engine == "phasor" else dpsim_measure(setup)
+    dc = DigitalController(K, T=T, measure=measure, target=target,
                            enable=enable_windows(run.bypass, run.t_end), name=run.controller)
-    events = make_events(setup, run)
     t0 = time.perf_counter()
     if dt is None:
         dt, tol = sim_settings(study)
-    res = simulate(setup.system, run.t_end, dt=dt, tol=tol, events=events, controllers=[dc],
-                   on_failure="return", record=record_list(study, setup.signals))
+    record = record_list(study, setup.signals)
+    if engine == "phasor":
+        res = simulate(setup.system, run.t_end, dt=dt, tol=tol, events=events, controllers=[dc],
+                       on_failure="return", record=record)
+    else:
+        from ..sim.emt import dpsim_step, simulate_dpsim
+
+        dt = dpsim_step(dt)
+        res = simulate_dpsim(setup.system, run.t_end, engine=engine, dt=dt, events=events,
+                             controllers=[dc], gti_power=(study.data.get("simulation") or {})
+                             .get("gti_power", "measured"))
+        if record is not None:
+            res = res.subset([n for n in res.names if any(fnmatch.fnmatchcase(n, p)
+                                                          for p in record)])
     wall = time.perf_counter() - t0
     # controller samples: times and (bypass-aware) outputs actually applied
     tk = np.asarray(dc.log_t)
@@ -426,7 +468,8 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
         samples["value_J"], samples["running_cost_w"] = J, rcw
     info = {"design": setup.design.to_dict(), "derivation": setup.derivation.to_dict(),
             "controller": choice.info, "Sb_mva": setup.Sb_mva,
-            "sim": {"dt": float(dt), "tol": None if tol is None else float(tol)}}
+            "sim": {"dt": float(dt), "tol": None if tol is None else float(tol),
+                    "engine": engine}}
     return RunRecord(run, metrics, series, info, samples=flat_columns(samples), results=res,
                      aliases=aliases)
 

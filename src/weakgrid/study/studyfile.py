@@ -443,6 +443,12 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
                 raise ParameterError("simulation.dt", sim["dt"], f"the integration step must not "
                                      f"be longer than the controller's sampling period design.T "
                                      f"({ds['T']:g} s); give dt ≤ T (omit it for dt = T)")
+        if "engine" in sim:    # not set: "phasor", and the key of every cached run stays
+            from ..sim.emt import ENGINES
+
+            _choice(sim, "engine", "simulation", ENGINES)
+        if "gti_power" in sim:
+            _choice(sim, "gti_power", "simulation", ("measured", "model"))
         if "tol" in sim:
             _num(sim, "tol", "simulation", positive=True)
             if not 1e-13 <= sim["tol"] <= 1e-4:

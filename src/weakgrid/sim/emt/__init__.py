@@ -20,6 +20,10 @@ are refused with a :class:`~weakgrid.sim.errors.DataError` naming them; nothing 
 ``dpsimpy`` is imported only when a DPsim run is built (:func:`.dpsim_module.dpsimpy`).
 """
 
+from .controllers import gti_signals, sg_signals
+from .dpsim_module import ENGINES
 from .run import DOMAINS, simulate_dpsim
+from .support import DT_MAX, check_supported, dpsim_step
 
-__all__ = ["DOMAINS", "simulate_dpsim"]
+__all__ = ["DOMAINS", "DT_MAX", "ENGINES", "check_supported", "dpsim_step", "gti_signals", "sg_signals",
+           "simulate_dpsim"]

@@ -44,6 +44,23 @@ def sg_signals(machine_name, upqc_bus):
     return measure
 
 
+def gti_signals(gti_name):
+    """DPsim measurement ``[phi_s, Vc]`` of GTI ``gti_name`` (its phase angle w.r.t. its
+    reference bus [rad] and dc-link voltage [pu], :mod:`weakgrid.sim.emt.gti`) — the signals of
+    :func:`weakgrid.sim.controllers.gti_signals`."""
+    keys = (f"{gti_name}.phi_s", f"{gti_name}.Vc")
+
+    def measure(sim, t, z, ctx):
+        missing = [k for k in keys if k not in ctx]
+        if missing:
+            raise DataError("gti_signals", "signal", missing[0],
+                            f"no such DPsim signal (GTI '{gti_name}'); recorded: "
+                            f"{sorted(ctx)[:8]} ...")
+        return np.array([ctx[k] for k in keys])
+
+    return measure
+
+
 def bind(controllers, system, dt):
     """``[(every, controller)]``: each controller bound to ``system``, sampled every ``every``
     DPsim steps (its period ``T`` a whole number of steps ``dt``, first sample at ``t0 = 0``)."""

@@ -6,6 +6,8 @@ from ..errors import DataError
 
 #: the engine names of the study layer → DPsim domain names
 DOMAINS = {"dpsim-emt": "EMT", "dpsim-dp": "DP"}
+#: every engine: weakgrid's phasor engine, then the DPsim ones
+ENGINES = ("phasor", *DOMAINS)
 
 
 def dpsimpy():

@@ -28,7 +28,8 @@ from ..errors import DataError, SimulationError
 from ..results import Results
 from .controllers import _Loop, bind, sample_all
 from .dpsim_module import DOMAINS, Kit, domain_of
-from .events import build_events
+from .events import build_events, removed_load, trip_terminals, tripped_machines
+from .gti import GTIBridge
 from .machines import build_machines, check_machines
 from .topology import build_network, bus_base, check_devices
 from .upqc import UPQCBridge
@@ -39,7 +40,8 @@ __all__ = ["DOMAINS", "simulate_dpsim"]
 
 
 def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float = 1e-4,
-                   events=(), controllers=(), decimate: int = 1, name: str = "weakgrid") -> Results:
+                   events=(), controllers=(), decimate: int = 1, name: str = "weakgrid",
+                   gti_power: str = "measured") -> Results:
     """Simulate a set-up ``system`` in DPsim from ``t = 0`` to ``t_end`` [s].
 
     Parameters
@@ -55,6 +57,11 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
         Fixed time step [s] (EMT needs a step well below the nominal period: 1e-4 s at 50/60 Hz).
     events : list
         weakgrid events (:mod:`weakgrid.sim.emt.events` says which are mapped).
+    gti_power : {"measured", "model"}
+        The ac power a GTI's dc link pays (:mod:`weakgrid.sim.emt.gti`): the power its DPsim
+        source delivered (``"measured"``, energy-consistent), or weakgrid's GTI model's own
+        ``Re(Es conj(-jB(Es - V)))`` at the measured voltage (``"model"``, the dc link blind to
+        the coupling's current transients).
     decimate : int
         Record every ``decimate``-th step.
     name : str
@@ -96,16 +103,19 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
         # DPsim writes its own log files (MnaSolverFactory.log, scheduler.log) to a log
         # directory (default ./logs): kept out of the user's working directory
         kit.d.Logger.set_log_dir(logdir)
-        return _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers)
+        return _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers,
+                    gti_power)
 
 
-def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers):
+def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers,
+         gti_power="measured"):
     net = system.network
-    cir = build_network(system, kit)
+    cir = build_network(system, kit, removed_load(system, events))
     bridge = UPQCBridge(system, kit, cir)
-    gens = build_machines(system, kit, cir.nodes, cir.Vpf)
+    gti = GTIBridge(system, kit, cir, power=gti_power)
+    gens = build_machines(system, kit, trip_terminals(system, kit, cir, events), cir.Vpf)
     cir.components.extend(g for _, g in gens)
-    sw_events = build_events(system, kit, cir, events)
+    sw_events = build_events(system, kit, cir, events, dt)
     d = kit.d
     topo = d.SystemTopology(net.f_hz, cir.nodes + cir.extra_nodes, cir.components)
     sim = d.Simulation(name, d.LogLevel.off)
@@ -119,12 +129,13 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
         sim.add_event(ev)
     bound = bind(controllers, system, dt)
     loop = _Loop(system)
-    rec = _Recorder(system, kit, gens, cir, bridge)
+    rec = _Recorder(system, kit, gens, cir, bridge, gti, tripped_machines(system, events))
     n_steps = int(round(t_end / dt))
     t0 = time.perf_counter()
     failure = None
     sim.start()
     rec.measure(0.0)
+    rec.gti = gti.update(dt, rec._ph, rec.current, bridge.gti_draw(len(gti.items)))
     rec.add(0.0)
     for k in range(1, n_steps + 1):
         t = (k - 1) * dt
@@ -137,6 +148,7 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
             rec.add(k * dt)
             failure = SimulationError(k * dt, "divergence", "a DPsim bus voltage is not finite")
             break
+        rec.gti = gti.update(dt, rec._ph, rec.current, bridge.gti_draw(len(gti.items)))
         if k % decimate == 0 or k == n_steps:
             rec.add(k * dt)
     sim.stop()
@@ -149,7 +161,7 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
 class _Recorder:
     """Reads DPsim attributes after each step into weakgrid signal columns."""
 
-    def __init__(self, system, kit, gens, cir, bridge):
+    def __init__(self, system, kit, gens, cir, bridge, gti, tripped=None):
         net = system.network
         self.kit, self.gens, self.nodes, self.bridge = kit, gens, cir.nodes, bridge
         self.w = 2 * math.pi * net.f_hz
@@ -169,6 +181,12 @@ class _Recorder:
             names += [f"{nm}.Vup", f"{nm}.Vuq", f"{nm}.Vu", f"{nm}.P_series"]
             kinds += ["pu", "pu", "pu", "power"]
             fac += [1.0, 1.0, 1.0, system.Sb]
+        self.gti_names = [n for n, _ in gti.names()]
+        for n, kind in gti.names():
+            names.append(n)
+            kinds.append(kind)
+            fac.append(system.Sb if kind == "power" else 180 / math.pi if kind == "angle" else 1.0)
+        self.gti = {n: 0.0 for n in self.gti_names}
         if kit.three_phase:
             for b, bid in enumerate(net.bus_ids):
                 names += [f"bus{bid}.va", f"bus{bid}.vb", f"bus{bid}.vc"]
@@ -179,6 +197,7 @@ class _Recorder:
         self._a = np.exp(2j * np.pi / 3)
         self.upqc = [(it["name"], 0.0, 0.0, 0.0, 0.0) for it in bridge.items]
         self._ph, self._abc, self._t = None, None, 0.0
+        self.tripped, self._frozen = dict(tripped or {}), {}
 
     def _space_vector(self, x, t):
         """Line-to-line RMS-scale phasor of three instantaneous phase values (EMT)."""
@@ -209,12 +228,17 @@ class _Recorder:
 
     def _row(self):
         row = []
-        for _, g in self.gens:
-            row += [g.attr("w_r").get(), g.attr("delta").get(), g.attr("Te").get()]
+        for nm, g in self.gens:
+            vals = [g.attr("w_r").get(), g.attr("delta").get(), g.attr("Te").get()]
+            if nm in self.tripped and self._t >= self.tripped[nm] - 1e-12:
+                # tripped: states frozen at the trip, power zero (weakgrid.sim.disconnect)
+                vals = self._frozen.setdefault(nm, vals[:2] + [0.0])
+            row += vals
         for ph in self._ph:
             row += [abs(ph), float(np.angle(ph))]
         for _, up, uq, vu, P in self.upqc:
             row += [up, uq, vu, P]
+        row += [self.gti[n] for n in self.gti_names]
         for abc in self._abc:
             row += list(abc)
         return row

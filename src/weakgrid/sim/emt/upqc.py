@@ -12,8 +12,10 @@ branch, at the shunt bus ``r``, and (conventional structure) draws the series re
   voltage, rewritten between steps likewise.
 
 The phasor engine applies both algebraically at every instant; here they lag by one step
-(1e-4 s by default). The reduced structure (fed from a GTI's dc link) is refused: the GTI has no
-DPsim mapping yet.
+(1e-4 s by default). The reduced structure has no shunt converter: its series power (with the
+converter loss ``chi``, :func:`weakgrid.sim.upqc.series_dc_power`) is drawn from the dc link of
+its GTI (:mod:`weakgrid.sim.emt.gti`), which takes the power the series source delivered over
+the last step (:meth:`UPQCBridge.gti_draw`).
 """
 
 from __future__ import annotations
@@ -22,9 +24,8 @@ import math
 
 import numpy as np
 
-from ..errors import DataError
 from ..network import BR_R, BR_X
-from ..upqc import rating_clip
+from ..upqc import rating_clip, series_dc_power
 
 
 class UPQCBridge:
@@ -35,11 +36,6 @@ class UPQCBridge:
         comp = system.components.get("UPQC")
         if comp is None or comp.n == 0:
             return
-        if comp.reduced.any():
-            bad = [nm for nm, red in zip(comp.names, comp.reduced) if red]
-            raise DataError(f"UPQC '{bad[0]}'", "structure", "reduced",
-                            "the reduced UPQC draws from a GTI's dc link; the GTI has no DPsim "
-                            "mapping yet (refused, not substituted)")
         net = system.network
         w = 2 * math.pi * net.f_hz
         off, ph = kit.d.LogLevel.off, kit.ph
@@ -69,18 +65,24 @@ class UPQCBridge:
             ind.set_parameters(kit.param(row[BR_X] * zb / w))
             ind.connect([a, cir.nodes[b1]])
             cir.components.append(ind)
-            sh = ph.CurrentSource(f"{nm}.shunt", off)
-            self._set_i(sh, 0j, init=True, f=net.f_hz)
-            # injection into bus r: DPsim 1.4's DP current source drives I_ref from its terminal 1
-            # into terminal 2, its EMT one the other way (both checked by the SMIB test against
-            # the phasor engine: the wrong way round the run diverges)
-            sh.connect([cir.nodes[r], kit.gnd] if kit.three_phase else [kit.gnd, cir.nodes[r]])
-            cir.components.append(sh)
+            red = bool(comp.reduced[i])
+            sh = None
+            if not red:
+                sh = ph.CurrentSource(f"{nm}.shunt", off)
+                self._set_i(sh, 0j, init=True, f=net.f_hz)
+                # injection into bus r: DPsim 1.4's DP current source drives I_ref from its
+                # terminal 1 into terminal 2, its EMT one the other way (both checked by the
+                # SMIB test against the phasor engine: the wrong way round the run diverges)
+                sh.connect([cir.nodes[r], kit.gnd] if kit.three_phase else [kit.gnd, cir.nodes[r]])
+                cir.components.append(sh)
             # the branch current is read from the series inductor (DPsim 1.4 does not update a
             # VoltageSource's i_intf in these runs: it stays 0)
             self.items.append(dict(name=nm, i=i, branch=k, r=r, src=src, sh=sh, ind=ind, mid=mid, vb=vb,
-                                   ib=system.Sb * 1e6 / vb, Vmax=float(comp.p["Vmax"][i])))
+                                   ib=system.Sb * 1e6 / vb, Vmax=float(comp.p["Vmax"][i]),
+                                   gti=int(comp.gti_i[i]) if red else None,
+                                   chi=float(comp.p["chi"][i])))
         self.comp = comp
+        self._draw = {}
         cir.upqc_branches = {it["branch"] for it in self.items}
 
     # phasor → DPsim set point (EMT: three rotating phasors, same scale as the node voltages)
@@ -120,6 +122,7 @@ class UPQCBridge:
         (here the branch's series inductor: from bus r towards bus 1).
         """
         out = []
+        self._draw = {}
         for it in self.items:
             i = it["i"]
             u = rating_clip(np.array([self.comp.u_p[i], self.comp.u_q[i]]), it["Vmax"])
@@ -130,7 +133,19 @@ class UPQCBridge:
             I = current_of(it["ind"]) / it["ib"]                # pu on Sb, bus r -> bus 1
             P = (Vu * np.conj(I)).real
             Vr_safe = Vr if abs(Vr) > 1e-6 else 1e-6
-            Ish = -(P / np.conj(Vr_safe))                       # injected into bus r [pu]
-            self._set_i(it["sh"], Ish * it["ib"])
+            if it["sh"] is not None:
+                Ish = -(P / np.conj(Vr_safe))                   # injected into bus r [pu]
+                self._set_i(it["sh"], Ish * it["ib"])
+            else:   # reduced: drawn from the GTI's dc link
+                self._draw[it["gti"]] = self._draw.get(it["gti"], 0.0) + \
+                    float(series_dc_power(P, it["chi"]))
             out.append((it["name"], u[0], u[1], abs(Vu), P))
+        return out
+
+    def gti_draw(self, n_gti: int) -> np.ndarray:
+        """Per GTI (its position in the GTI component), the dc power [pu on Sb] the reduced
+        UPQCs draw, as set by the last :meth:`update` (held over the step since)."""
+        out = np.zeros(n_gti)
+        for g, P in getattr(self, "_draw", {}).items():
+            out[g] += P
         return out
