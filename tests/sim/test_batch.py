@@ -89,7 +89,7 @@ def test_a_member_that_loses_synchronism_stops_alone():
     assert got[0].t[-1] == pytest.approx(3.0) and got[1].t[-1] < 1.5
 
 
-def test_a_newton_failure_stops_alone_and_a_shortened_step_leaves_the_batch():
+def test_a_newton_failure_stops_alone_and_a_halved_step_continues_in_the_batch():
     s = build_gti_upqc_sg("reduced")    # one machine: its rotor angle has no spread
 
     def scen():
@@ -102,7 +102,11 @@ def test_a_newton_failure_stops_alone_and_a_shortened_step_leaves_the_batch():
     assert alone[1].failure.cause == "newton" and alone[1].failure.t == pytest.approx(0.2)
     st = {}
     got = simulate_batch(s, scen(), 1.0, stats=st, **kw)
-    assert st["batches"] == 1 and st["rerun"] == 1
+    # the member that halves its step continues from there in the batch (not re-run from t = 0),
+    # on its own time grid (off the multiples of dt), and still equals its run alone
+    assert st["batches"] == 1 and st["rerun"] == 0 and st["halved"] >= 1
+    off = np.abs(alone[2].t / DT - np.round(alone[2].t / DT)) > 1e-6
+    assert off.any() and not (np.abs(alone[0].t / DT - np.round(alone[0].t / DT)) > 1e-6).any()
     for a, b in zip(alone, got):
         _same(a, b)
 

@@ -53,6 +53,10 @@ from .errors import DataError, SimulationError
 from .integrate import Simulator, _held, _output_path
 from .results import Results
 
+#: members whose times differ by less than this (relative, [s]) step together (round-off of
+#: the sums of their steps: a member that halved a step reaches the grid of the others again)
+_SAME_T = 1e-12
+
 xp = np     # the array namespace of the batched arithmetic (array API: swap for another backend)
 
 log = logging.getLogger(__name__)
@@ -132,7 +136,7 @@ class _BatchRecorder:
             return [Results(xp.zeros(0), [], xp.zeros((0, 0)), [], [], failure=failures[k], stats=stats[k])
                     for k in range(B)]
         if self.blocks:
-            T = xp.concatenate([xp.full(len(m), t) for t, m, _ in self.blocks])
+            T = xp.concatenate([xp.broadcast_to(xp.asarray(t, dtype=float), (len(m),)) for t, m, _ in self.blocks])
             K = xp.concatenate([m for _, m, _ in self.blocks])
             D = xp.concatenate([d for _, _, d in self.blocks])
             order = xp.argsort(K, kind="stable")
@@ -228,6 +232,7 @@ class BatchSimulator:
         self._ynet = [None] * self.B
         self.timing = dict.fromkeys(TIMED, 0.0)
         self.steps = 0
+        self.halved = 0
 
     # ------------------------------------------------------------- evaluations
     def _bind_inputs(self, rows, rep=1):
@@ -414,9 +419,10 @@ class BatchSimulator:
             failed.add(k)
         return done, failed
 
-    def _step(self, h, act):
-        """One step ``h`` of every member in ``act`` (as :meth:`Simulator._step`). Returns the
-        members that must leave the lockstep (their step has to be shortened)."""
+    def _step(self, h, act, retry=False):
+        """One attempt at the step ``h`` of every member in ``act`` (as :meth:`Simulator._step`;
+        ``retry``: the attempt after halving, without the previous step's correction). Returns
+        the members whose Newton failed even with a fresh Jacobian (their step must be halved)."""
         t = self.t
         zn = {k: self.sims[k].z for k in act}
         fn = {k: self.sims[k]._f for k in act}
@@ -425,7 +431,7 @@ class BatchSimulator:
         corr = {}
         for k in act:
             sim = self.sims[k]
-            ok = sim._corr is not None and abs(sim._corr_h - h) <= 1e-9 * h
+            ok = not retry and sim._corr is not None and abs(sim._corr_h - h) <= 1e-9 * h
             corr[k] = sim._corr if ok else None
         pending = list(act)
         eject = []
@@ -475,7 +481,7 @@ class BatchSimulator:
                 if nit > sim.max_iter // 2 - 1:
                     sim._refresh_next = True
                 sim.z, sim._f = z, f1.copy()
-                sim.t = t + h
+                sim.t = sim.t + h     # its own time (the cohort's to round-off)
                 sim.stats["steps"] += 1
             if fresh:
                 self.refresh_jacobian(t, xp.stack([zn[k] for k in fresh]), fresh)
@@ -509,9 +515,12 @@ class BatchSimulator:
         self._sync_network(act)
         self.t = 0.0
 
+        self._failed = set()
+
         def fail(k, exc):
             failures[k], fstats[k] = exc, dict(self.sims[k].stats)
             act.remove(k)
+            self._failed.add(k)
 
         # initial point: network solved with the initial Jacobian, controllers' first samples
         Z = xp.stack([self.sims[k].z for k in act])
@@ -526,97 +535,142 @@ class BatchSimulator:
         for j, k in enumerate(act):
             sim = self.sims[k]
             sim._delta0 = xp.array(ctx.sig["delta"][j], dtype=float, copy=True)
-        self._record(0.0, act, recs, ctx)
+        self._record(act, recs)
         ev_i = [0] * B
-        nstep = 0
+        nstep = [0] * B
         eps = 1e-12
-        while act and self.t < t_end - eps:
-            nb_k = {}
-            for k in act:
-                tb = t_end
+        dt = self.sims[0].dt
+        save_every = self.sims[0].save_every
+        while act:
+            # the members furthest behind step next; the members at that instant step together
+            live = [k for k in act if self.sims[k].t < t_end - eps]
+            if not live:
+                break
+            tmin = min(self.sims[k].t for k in live)
+            coh = [k for k in live if self.sims[k].t - tmin <= _SAME_T * max(1.0, abs(tmin))]
+            tb, groups = {}, {}
+            for k in coh:     # each member's next breakpoint and step, as in its run alone
+                t = self.sims[k].t
+                b = t_end
                 if ev_i[k] < len(evs[k]):
-                    tb = min(tb, evs[k][ev_i[k]].t)
+                    b = min(b, evs[k][ev_i[k]].t)
                 for c in ctls[k]:
-                    tb = min(tb, c.next_time(self.t))
-                nb_k[k] = tb
-            tb = min(nb_k.values())
-            h = min(self.sims[act[0]].dt, tb - self.t)
-            if tb - (self.t + h) < 1e-3 * self.sims[act[0]].dt:
-                h = tb - self.t
-            if h > eps:
-                for k in self._step(h, act):
-                    act.remove(k)
-                    rerun.append(k)
-                nstep += 1
-                self.steps += 1
-                self.t += h
-                ctx = self._accept_all(act)
-                self._check(act, ctx, fail)
-            hit = abs(self.t - tb) <= eps * max(1.0, abs(tb)) * 10
-            if hit:
-                self.t = tb
-                for k in act:
-                    self.sims[k].t = tb
-            own = [k for k in act if hit and abs(nb_k[k] - tb) <= eps * max(1.0, abs(tb)) * 10]
-            own_set = set(own)
-            plain = [k for k in act if k not in own_set]
-            if plain and nstep % self.sims[plain[0]].save_every == 0:
-                self._record(self.t, plain, recs, ctx, act)
-            if own:
-                self._record(self.t, own, recs, ctx, act)
-                jumps, new_jac, held = {}, {}, {}
-                t0 = time.perf_counter()
-                for k in list(own):
-                    sim = self.sims[k]
-                    events = evs[k]
-                    try:
-                        while ev_i[k] < len(events) and events[ev_i[k]].t <= self.t + 1e-12:
-                            events[ev_i[k]].apply(sim)
-                            ev_i[k] += 1
-                            new_jac[k] = True
-                    except SimulationError as exc:
-                        fail(k, exc)
-                        continue
-                    held[k] = [_held(c) for c in ctls[k]]
-                    if new_jac.get(k):
-                        jumps[k] = None
-                self.timing["events"] += time.perf_counter() - t0
-                own = [k for k in own if k in act]
-                changed = self._sample(self.t, own, ctls, fail)
+                    b = min(b, c.next_time(t))
+                h = min(dt, b - t)
+                if b - (t + h) < 1e-3 * dt:
+                    h = b - t
+                tb[k] = b
+                groups.setdefault(h, []).append(k)
+            stepped = set()
+            for h, grp in groups.items():
+                if h > eps:
+                    self.t = tmin
+                    for k in self._advance(h, grp):
+                        act.remove(k)
+                        rerun.append(k)
+                    for k in grp:
+                        if k in act:
+                            nstep[k] += 1
+                            stepped.add(k)
+                    self.steps += 1
+            # after the step: the members grouped by the instant they reached (a halved step
+            # reaches another one), each group evaluated once
+            at = {}
+            for k in coh:
+                if k in act:
+                    at.setdefault(self.sims[k].t, []).append(k)
+            for t_g in sorted(at):
+                G = at[t_g]
+                self.t = t_g
+                ctx = self._accept_all(G)
+                self._check([k for k in G if k in stepped], ctx, fail)
+                G = [k for k in G if k in act]
+                own = [k for k in G if abs(self.sims[k].t - tb[k]) <= eps * max(1.0, abs(tb[k])) * 10]
                 for k in own:
-                    if k in act and (k in jumps or changed.get(k)):
-                        jumps[k] = None
-                self._sync_network(list(jumps))
-                if jumps:
-                    guesses = {}
-                    fresh = [k for k in jumps if new_jac.get(k)]
-                    if fresh:
-                        self.refresh_jacobian(self.t, xp.stack([self.sims[k].z for k in fresh]), fresh)
-                    for k in jumps:
-                        sim = self.sims[k]
-                        if new_jac.get(k):
-                            sim._jump = None
-                            sim._corr = None
-                        elif sim._jump is not None and sim._jump_t > self.t - 1.5 * _gap(ctls[k]):
-                            guesses[k] = sim.z[nx:] + sim._jump
-                    paths = {k: _output_path(ctls[k], held[k]) for k in jumps}
-                    y_before = {k: self.sims[k].z[nx:] for k in jumps}
-                    self._solve_jump(self.t, list(jumps), guesses, paths, fail)
-                    jk = [k for k in jumps if k in act]
-                    for k in jk:
-                        sim = self.sims[k]
-                        if not new_jac.get(k):
-                            sim._jump = sim.z[nx:] - y_before[k]
-                            sim._jump_t = self.t
-                        sim._release_held(sim._f)
-                    ctx = self._accept_all(act)
-                    self._record(self.t, jk, recs, ctx, act)
+                    self.sims[k].t = tb[k]
+                own_set = set(own)
+                self._record([k for k in G if k not in own_set and nstep[k] % save_every == 0], recs)
+                if own:
+                    self.t = tb[own[0]]
+                    self._breakpoint(own, evs, ev_i, ctls, recs, fail)
         for k in act:
             fstats[k] = dict(self.sims[k].stats)
         results = recs.finish(B, failures, fstats)
         for k in rerun:
             results[k] = None
         return results, rerun
+
+    def _advance(self, h, rows, retry=False):
+        """One step ``h`` of members ``rows`` from :attr:`t`; a member whose Newton fails even
+        with a fresh Jacobian halves its step and retries, as :meth:`Simulator._step` does —
+        the members halving together in one sub-batch. Returns the members whose step would fall
+        below ``min_step`` (their run alone fails there: it is re-run to report that failure)."""
+        eject = self._step(h, rows, retry)
+        if not eject:
+            return []
+        again = [k for k in eject if h / 2 < self.sims[k].min_step]
+        sub = [k for k in eject if h / 2 >= self.sims[k].min_step]
+        if sub:
+            self.halved += len(sub)
+            again += self._advance(h / 2, sub, retry=True)
+        return again
+
+    def _breakpoint(self, own, evs, ev_i, ctls, recs, fail):
+        """Members ``own`` at their breakpoint :attr:`t`: record, apply their events, take their
+        controllers' samples and re-solve the network of those that jumped (as
+        :meth:`Simulator.run`)."""
+        nx = self.nx
+        self._record(own, recs)
+        jumps, new_jac, held = {}, {}, {}
+        t0 = time.perf_counter()
+        for k in list(own):
+            sim = self.sims[k]
+            events = evs[k]
+            try:
+                while ev_i[k] < len(events) and events[ev_i[k]].t <= sim.t + 1e-12:
+                    events[ev_i[k]].apply(sim)
+                    ev_i[k] += 1
+                    new_jac[k] = True
+            except SimulationError as exc:
+                fail(k, exc)
+                continue
+            held[k] = [_held(c) for c in ctls[k]]
+            if new_jac.get(k):
+                jumps[k] = None
+        self.timing["events"] += time.perf_counter() - t0
+        own = [k for k in own if k not in self._failed]
+        changed = self._sample(self.t, own, ctls, fail)
+        for k in own:
+            if k not in self._failed and (k in jumps or changed.get(k)):
+                jumps[k] = None
+        jumps = [k for k in jumps if k not in self._failed]
+        if not jumps:
+            return
+        self._sync_network(jumps)
+        guesses = {}
+        fresh = [k for k in jumps if new_jac.get(k)]
+        if fresh:
+            self.refresh_jacobian(self.t, xp.stack([self.sims[k].z for k in fresh]), fresh)
+        for k in jumps:
+            sim = self.sims[k]
+            if new_jac.get(k):
+                sim._jump = None
+                sim._corr = None
+            elif sim._jump is not None and sim._jump_t > self.t - 1.5 * _gap(ctls[k]):
+                guesses[k] = sim.z[nx:] + sim._jump
+        paths = {k: _output_path(ctls[k], held[k]) for k in jumps}
+        y_before = {k: self.sims[k].z[nx:] for k in jumps}
+        self._solve_jump(self.t, jumps, guesses, paths, fail)
+        jk = [k for k in jumps if k not in self._failed]
+        for k in jk:
+            sim = self.sims[k]
+            if not new_jac.get(k):
+                sim._jump = sim.z[nx:] - y_before[k]
+                sim._jump_t = self.t
+            sim._release_held(sim._f)
+        if jk:
+            self._accept_all(jk)
+            self._record(jk, recs)
 
     def _accept_all(self, act):
         """The context of every active member at its accepted point (one evaluation)."""
@@ -628,19 +682,25 @@ class BatchSimulator:
         self._ctx = ctx
         return ctx
 
-    def _record(self, t, rows, recs, ctx, act=None):
+    def _record(self, rows, recs):
+        """Record members ``rows`` at their times, from the context of :meth:`_accept_all`."""
         if not rows:
             return
         t0 = time.perf_counter()
-        recs.add(t, rows, xp.stack([self.sims[k].z for k in rows]), self._ctx,
-                 [self._pos[k] for k in rows])
+        recs.add(xp.asarray([self.sims[k].t for k in rows]), rows, xp.stack([self.sims[k].z for k in rows]),
+                 self._ctx, [self._pos[k] for k in rows])
         self.timing["record"] += time.perf_counter() - t0
 
     def _check(self, act, ctx, fail):
-        """Divergence and loss of synchronism, per member (as :meth:`Simulator._check`)."""
+        """Divergence and loss of synchronism of members ``act`` (rows of the context of
+        :meth:`_accept_all`), per member (as :meth:`Simulator._check`)."""
+        if not act:
+            return
         Z = xp.stack([self.sims[k].z for k in act])
         bad = ~(xp.abs(Z).max(axis=1) <= 1e6)
         d = ctx.sig["delta"]
+        if d.ndim >= 2:
+            d = d[[self._pos[k] for k in act]]
         if d.shape[-1] > 1:
             e = d - xp.stack([self.sims[k]._delta0 for k in act])
             bad |= (e.max(axis=1) - e.min(axis=1)) > self.sims[act[0]].max_spread
@@ -793,7 +853,7 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
     scenarios = [dict(s) for s in scenarios]
     dt = float(sim_kw.get("dt", 1 / 120))
     out = [None] * len(scenarios)
-    st = {"batches": 0, "rerun": 0, "alone": 0, "timing": dict.fromkeys(TIMED, 0.0)}
+    st = {"batches": 0, "rerun": 0, "halved": 0, "alone": 0, "timing": dict.fromkeys(TIMED, 0.0)}
     groups = {}
     alone = []
     for i, sc in enumerate(scenarios):
@@ -818,6 +878,7 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
             bs = BatchSimulator(system, [scenarios[i] for i in part], **sim_kw)
             res, rerun = bs.run(t_end)
             st["batches"] += 1
+            st["halved"] += bs.halved
             for key, v in bs.timing.items():
                 st["timing"][key] += v
             for j, i in enumerate(part):
