@@ -53,10 +53,6 @@ from .errors import DataError, SimulationError
 from .integrate import Simulator, _held, _output_path
 from .results import Results
 
-#: members whose times differ by less than this (relative, [s]) step together (round-off of
-#: the sums of their steps: a member that halved a step reaches the grid of the others again)
-_SAME_T = 1e-12
-
 xp = np     # the array namespace of the batched arithmetic (array API: swap for another backend)
 
 log = logging.getLogger(__name__)
@@ -542,14 +538,11 @@ class BatchSimulator:
         dt = self.sims[0].dt
         save_every = self.sims[0].save_every
         while act:
-            # the members furthest behind step next; the members at that instant step together
             live = [k for k in act if self.sims[k].t < t_end - eps]
             if not live:
                 break
-            tmin = min(self.sims[k].t for k in live)
-            coh = [k for k in live if self.sims[k].t - tmin <= _SAME_T * max(1.0, abs(tmin))]
             tb, groups = {}, {}
-            for k in coh:     # each member's next breakpoint and step, as in its run alone
+            for k in live:     # each member's next breakpoint and step, as in its run alone
                 t = self.sims[k].t
                 b = t_end
                 if ev_i[k] < len(evs[k]):
@@ -561,38 +554,38 @@ class BatchSimulator:
                     h = b - t
                 tb[k] = b
                 groups.setdefault(h, []).append(k)
-            stepped = set()
+            # the members taking the same step take it together, whatever their times (the
+            # evaluations of a batchable grid do not read the time, see batch_unsupported)
+            stepped = []
             for h, grp in groups.items():
                 if h > eps:
-                    self.t = tmin
+                    self.t = self.sims[grp[0]].t
                     for k in self._advance(h, grp):
                         act.remove(k)
                         rerun.append(k)
                     for k in grp:
                         if k in act:
                             nstep[k] += 1
-                            stepped.add(k)
+                            stepped.append(k)
                     self.steps += 1
-            # after the step: the members grouped by the instant they reached (a halved step
-            # reaches another one), each group evaluated once
+            live = [k for k in live if k in act]
+            self.t = max(self.sims[k].t for k in live) if live else self.t
+            ctx = self._accept_all(live)
+            self._check(stepped, ctx, fail)
+            live = [k for k in live if k in act]
+            own = [k for k in live if abs(self.sims[k].t - tb[k]) <= eps * max(1.0, abs(tb[k])) * 10]
+            for k in own:
+                self.sims[k].t = tb[k]
+            own_set = set(own)
+            self._record([k for k in live if k in own_set or nstep[k] % save_every == 0], recs)
             at = {}
-            for k in coh:
-                if k in act:
-                    at.setdefault(self.sims[k].t, []).append(k)
-            for t_g in sorted(at):
-                G = at[t_g]
+            for k in own:
+                at.setdefault(tb[k], []).append(k)
+            for n, (t_g, G) in enumerate(sorted(at.items())):
                 self.t = t_g
-                ctx = self._accept_all(G)
-                self._check([k for k in G if k in stepped], ctx, fail)
-                G = [k for k in G if k in act]
-                own = [k for k in G if abs(self.sims[k].t - tb[k]) <= eps * max(1.0, abs(tb[k])) * 10]
-                for k in own:
-                    self.sims[k].t = tb[k]
-                own_set = set(own)
-                self._record([k for k in G if k not in own_set and nstep[k] % save_every == 0], recs)
-                if own:
-                    self.t = tb[own[0]]
-                    self._breakpoint(own, evs, ev_i, ctls, recs, fail)
+                if n:   # the context of these members (the previous instant's re-solve replaced it)
+                    self._accept_all(G)
+                self._breakpoint(G, evs, ev_i, ctls, recs, fail)
         for k in act:
             fstats[k] = dict(self.sims[k].stats)
         results = recs.finish(B, failures, fstats)
@@ -616,11 +609,10 @@ class BatchSimulator:
         return again
 
     def _breakpoint(self, own, evs, ev_i, ctls, recs, fail):
-        """Members ``own`` at their breakpoint :attr:`t`: record, apply their events, take their
-        controllers' samples and re-solve the network of those that jumped (as
-        :meth:`Simulator.run`)."""
+        """Members ``own`` at their breakpoint :attr:`t` (recorded there; their rows in the
+        context of :meth:`_accept_all`): apply their events, take their controllers' samples,
+        re-solve the network of those that jumped and record them again (as :meth:`Simulator.run`)."""
         nx = self.nx
-        self._record(own, recs)
         jumps, new_jac, held = {}, {}, {}
         t0 = time.perf_counter()
         for k in list(own):
