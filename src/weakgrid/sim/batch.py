@@ -223,6 +223,14 @@ class BatchSimulator:
                 for k, s in enumerate(self.sims):
                     setattr(s.sys.components[c.type_name], attr, stack[k])
                 self._inputs.append((c, attr, stack))
+        # the states held at a limit: one (B, n_lim) array, each member's ``frozen`` a row view
+        self._nlim = len(system.lim_idx)
+        self.frozen = xp.zeros((self.B, self._nlim), dtype=np.int8)
+        for k, s in enumerate(self.sims):
+            s.frozen = self.frozen[k]
+        # each member's limits (fixed: limits that move with the solution are refused)
+        self.lim_hi = xp.stack([s.sys.lim_hi for s in self.sims])
+        self.lim_lo = xp.stack([s.sys.lim_lo for s in self.sims])
         nb = system.nb
         self.Y = xp.empty((self.B, 2 * nb, 2 * nb))
         self._ynet = [None] * self.B
@@ -277,12 +285,6 @@ class BatchSimulator:
             sim._alg_key = None
         self.timing["jacobian"] += time.perf_counter() - t0
 
-    def _lu(self, k, h):
-        t0 = time.perf_counter()
-        lu = self.sims[k]._iteration_lu(h)
-        self.timing["lu"] += time.perf_counter() - t0
-        return lu
-
     # ------------------------------------------------------------------ solves
     def _alg_chord(self, t, Z, rows):
         """Chord iteration on the network variables of members ``rows`` (each member's own
@@ -336,18 +338,18 @@ class BatchSimulator:
         converged members and the set of those that did not converge."""
         nx, N = self.nx, self.N
         n = len(rows)
-        lus = []
+        t0 = time.perf_counter()
+        lus = [self.sims[k]._iteration_lu(h) for k in rows]
+        self.timing["lu"] += time.perf_counter() - t0
         FZ = LV = None             # rows held at a limit (mask) and their values
-        for j, k in enumerate(rows):
-            sim = self.sims[k]
-            lus.append(self._lu(k, h))
-            if sim.frozen.any():
-                if FZ is None:
-                    FZ, LV = xp.zeros((n, N), dtype=bool), xp.zeros((n, N))
-                li = sim.sys.lim_idx
-                fz = sim.frozen != 0
-                FZ[j, li[fz]] = True
-                LV[j, li[fz]] = xp.where(sim.frozen > 0, sim.sys.lim_hi, sim.sys.lim_lo)[fz]
+        if self._nlim:
+            FR = self.frozen[rows]
+            fz = FR != 0
+            if fz.any():
+                li = self.tmpl.lim_idx
+                FZ, LV = xp.zeros((n, N), dtype=bool), xp.zeros((n, N))
+                FZ[:, li] = fz
+                LV[:, li] = xp.where(fz, xp.where(FR > 0, self.lim_hi[rows], self.lim_lo[rows]), 0.0)
         # linearly implicit predictor of every member (used by those without a guess)
         Rp = xp.zeros((n, N))
         Rp[:, :nx] = -h * Fn
@@ -359,7 +361,7 @@ class BatchSimulator:
         for j, k in enumerate(rows):
             sim = self.sims[k]
             if guess[k] is None:
-                sim._pred = Zp[j].copy()
+                sim._pred = Zp[j]
                 if corr[k] is not None:
                     Z[j] += corr[k]
                 if sim._refresh_next:
@@ -370,8 +372,10 @@ class BatchSimulator:
             Z = xp.where(FZ, LV, Z)
         if refresh:   # the chord matrix refreshed at the predicted points (all in one evaluation)
             self.refresh_jacobian(t1, Z[refresh], [rows[j] for j in refresh])
+            t0 = time.perf_counter()
             for j in refresh:
-                lus[j] = self._lu(rows[j], h)
+                lus[j] = self.sims[rows[j]]._iteration_lu(h)
+            self.timing["lu"] += time.perf_counter() - t0
             P = Zn[refresh] - self._solve(lus, refresh, Rp[refresh])
             for i, j in enumerate(refresh):
                 self.sims[rows[j]]._pred = P[i]
@@ -380,6 +384,7 @@ class BatchSimulator:
         done, failed = {}, set()
         live = xp.arange(n)
         max_iter = self.sims[rows[0]].max_iter
+        tol = self.sims[rows[0]].tol
         for it in range(max_iter):
             F, _ = self.residual(t1, Z[live], [rows[j] for j in live.tolist()])
             t0 = time.perf_counter()
@@ -391,20 +396,24 @@ class BatchSimulator:
             dz = self._solve(lus, live.tolist(), R)
             nrm = xp.abs(dz).max(axis=1)
             bad = ~xp.isfinite(nrm)
-            conv = nrm < self.sims[rows[0]].tol
-            for i in xp.nonzero(bad | conv)[0].tolist():
-                j = int(live[i])
-                k = rows[j]
-                st = self.sims[k].stats
-                st["evals"] += it + 1
-                st["newton"] += it + 1
-                if bad[i]:
-                    failed.add(k)
-                else:
-                    done[k] = (Z[j].copy(), it + 1, f[i])
-            go = ~(bad | conv)
-            Z[live[go]] -= dz[go]
-            live = live[go]
+            conv = nrm < tol
+            stop = bad | conv
+            if stop.any():
+                for i in xp.nonzero(stop)[0].tolist():
+                    j = int(live[i])
+                    k = rows[j]
+                    st = self.sims[k].stats
+                    st["evals"] += it + 1
+                    st["newton"] += it + 1
+                    if bad[i]:
+                        failed.add(k)
+                    else:
+                        done[k] = (Z[j], it + 1, f[i])
+                go = ~stop
+                Z[live[go]] -= dz[go]
+                live = live[go]
+            else:
+                Z[live] -= dz
             self.timing["newton"] += time.perf_counter() - t0
             if not len(live):
                 break
@@ -414,6 +423,32 @@ class BatchSimulator:
             self.sims[k].stats["newton"] += max_iter
             failed.add(k)
         return done, failed
+
+    def _limits(self, ks, Zd, F1):
+        """States of members ``ks`` (accepted points ``Zd``, derivatives ``F1``, one row each)
+        that newly cross a limit (as :meth:`Simulator._step`): ``(new_hi, new_lo)`` masks."""
+        s, li = self.tmpl, self.tmpl.lim_idx
+        FR = self.frozen[ks]
+        XL = Zd[:, li]
+        new_hi = (FR == 0) & (XL > self.lim_hi[ks] + 1e-9)
+        new_lo = (FR == 0) & (XL < self.lim_lo[ks] - 1e-9)
+        if s.any_pushing:
+            FL, push = F1[:, li], s.lim_pushing
+            new_hi &= ~push | (FL >= 0)
+            new_lo &= ~push | (FL <= 0)
+        return new_hi, new_lo
+
+    def _release(self, ks, F1):
+        """Release the held states of members ``ks`` whose derivative (rows of ``F1``) points
+        back inside (:meth:`Simulator._release_held`, for the batch at once)."""
+        FR = self.frozen[ks]
+        if not FR.any():
+            return
+        FL = F1[:, self.tmpl.lim_idx]
+        rel = ((FR > 0) & (FL < 0)) | ((FR < 0) & (FL > 0))
+        if rel.any():
+            FR[rel] = 0
+            self.frozen[ks] = FR
 
     def _step(self, h, act, retry=False):
         """One attempt at the step ``h`` of every member in ``act`` (as :meth:`Simulator._step`;
@@ -446,38 +481,40 @@ class BatchSimulator:
                         nxt.append(k)
                     else:
                         eject.append(k)
-                    continue
+            ok = [k for k in pending if k in done]
+            if ok and self._nlim:
+                Zd = xp.stack([done[k][0] for k in ok])
+                F1 = xp.stack([done[k][2] for k in ok])
+                new_hi, new_lo = self._limits(ok, Zd, F1)
+                hit = (new_hi | new_lo).any(axis=1)
+                for j in xp.nonzero(hit)[0].tolist():   # redo the step with them held
+                    k = ok[j]
+                    sim, s, li = self.sims[k], self.sims[k].sys, self.tmpl.lim_idx
+                    z, nh, nl = done[k][0], new_hi[j], new_lo[j]
+                    sim.frozen[nh] = 1
+                    sim.frozen[nl] = -1
+                    guess[k] = z
+                    if (s.lim_pushing & (nh | nl)).any():
+                        g = z.copy()
+                        g[li[nh]] = s.lim_hi[nh]
+                        g[li[nl]] = s.lim_lo[nl]
+                        guess[k] = sim.solve_algebraic(t + h, g)
+                        sim._refresh_jacobian(t + h, guess[k])
+                    nxt.append(k)
+                if hit.any():
+                    keep = ~hit
+                    ok = [k for k, y in zip(ok, keep.tolist()) if y]
+                    F1 = F1[keep]
+                self._release(ok, F1)
+            for k in ok:
                 z, nit, f1 = done[k]
                 sim = self.sims[k]
-                li = sim.sys.lim_idx
-                if len(li):
-                    s = sim.sys
-                    xl = z[li]
-                    new_hi = (sim.frozen == 0) & (xl > s.lim_hi + 1e-9)
-                    new_lo = (sim.frozen == 0) & (xl < s.lim_lo - 1e-9)
-                    if s.any_pushing:
-                        fl, push = f1[li], s.lim_pushing
-                        new_hi &= ~push | (fl >= 0)
-                        new_lo &= ~push | (fl <= 0)
-                    if new_hi.any() or new_lo.any():
-                        sim.frozen[new_hi] = 1
-                        sim.frozen[new_lo] = -1
-                        guess[k] = z
-                        if (s.lim_pushing & (new_hi | new_lo)).any():
-                            g = z.copy()
-                            g[li[new_hi]] = s.lim_hi[new_hi]
-                            g[li[new_lo]] = s.lim_lo[new_lo]
-                            guess[k] = sim.solve_algebraic(t + h, g)
-                            sim._refresh_jacobian(t + h, guess[k])
-                        nxt.append(k)
-                        continue
-                    sim._release_held(f1)
                 sim._corr = z - sim._pred if guess[k] is None else None
                 sim._corr_h = h
                 if nit > sim.max_iter // 2 - 1:
                     sim._refresh_next = True
-                sim.z, sim._f = z, f1.copy()
-                sim.t = sim.t + h     # its own time (the cohort's to round-off)
+                sim.z, sim._f = z, f1
+                sim.t = sim.t + h     # its own time (the batch's to round-off)
                 sim.stats["steps"] += 1
             if fresh:
                 self.refresh_jacobian(t, xp.stack([zn[k] for k in fresh]), fresh)
