@@ -288,8 +288,8 @@ class BatchSimulator:
     # ------------------------------------------------------------------ solves
     def _alg_chord(self, t, Z, rows):
         """Chord iteration on the network variables of members ``rows`` (each member's own
-        algebraic LU), as :meth:`Simulator._alg_chord`; returns ``{k: (z, F)}`` of the
-        members that converged (the others diverged or stalled)."""
+        algebraic LU), as :meth:`Simulator._alg_chord`; returns ``{k: (z, F, (ctx, row))}`` of
+        the members that converged (the others diverged or stalled)."""
         nx = self.nx
         done = {}
         live = list(range(len(rows)))
@@ -301,7 +301,7 @@ class BatchSimulator:
             if not live:
                 break
             idx = [rows[j] for j in live]
-            F, _ = self.residual(t, Z[live], idx)
+            F, ctx = self.residual(t, Z[live], idx)
             keep = []
             for i, j in enumerate(live):
                 sim = self.sims[rows[j]]
@@ -311,7 +311,7 @@ class BatchSimulator:
                 if not math.isfinite(nrm):
                     continue
                 if nrm < sim.tol:
-                    done[rows[j]] = (Z[j].copy(), F[i].copy())
+                    done[rows[j]] = (Z[j].copy(), F[i].copy(), (ctx, i))
                     sim.stats["evals"] += evals[j]   # a member that falls back counts its own
                     continue
                 grow[j] = grow[j] + 1 if nrm > 0.9 * prev[j] else 0
@@ -334,8 +334,9 @@ class BatchSimulator:
 
     def _newton(self, t1, h, Zn, Fn, rows, guess, corr):
         """One chord-Newton attempt of the trapezoidal step for members ``rows`` (as
-        :meth:`Simulator._newton`, one member per row). Returns ``{k: (z, nit, f)}`` for the
-        converged members and the set of those that did not converge."""
+        :meth:`Simulator._newton`, one member per row). Returns ``{k: (z, nit, f, (ctx, row))}``
+        for the converged members (``ctx`` the evaluation at ``z``, its row ``row``) and the set
+        of those that did not converge."""
         nx, N = self.nx, self.N
         n = len(rows)
         t0 = time.perf_counter()
@@ -386,7 +387,7 @@ class BatchSimulator:
         max_iter = self.sims[rows[0]].max_iter
         tol = self.sims[rows[0]].tol
         for it in range(max_iter):
-            F, _ = self.residual(t1, Z[live], [rows[j] for j in live.tolist()])
+            F, ctx = self.residual(t1, Z[live], [rows[j] for j in live.tolist()])
             t0 = time.perf_counter()
             f = F[:, :nx].copy()
             R = F
@@ -408,7 +409,7 @@ class BatchSimulator:
                     if bad[i]:
                         failed.add(k)
                     else:
-                        done[k] = (Z[j], it + 1, f[i])
+                        done[k] = (Z[j], it + 1, f[i], (ctx, i))
                 go = ~stop
                 Z[live[go]] -= dz[go]
                 live = live[go]
@@ -507,7 +508,7 @@ class BatchSimulator:
                     F1 = F1[keep]
                 self._release(ok, F1)
             for k in ok:
-                z, nit, f1 = done[k]
+                z, nit, f1, self._cx[k] = done[k]   # its context: Newton's evaluation at z
                 sim = self.sims[k]
                 sim._corr = z - sim._pred if guess[k] is None else None
                 sim._corr_h = h
@@ -549,6 +550,7 @@ class BatchSimulator:
         self.t = 0.0
 
         self._failed = set()
+        self._cx = {}
 
         def fail(k, exc):
             failures[k], fstats[k] = exc, dict(self.sims[k].stats)
@@ -564,10 +566,10 @@ class BatchSimulator:
             self._accept_all(act)
             self._sample(0.0, with_ctl, ctls, fail)
             self._solve_jump(0.0, [k for k in with_ctl if k in act], {}, {}, fail)
-        ctx = self._accept_all(act)
-        for j, k in enumerate(act):
-            sim = self.sims[k]
-            sim._delta0 = xp.array(ctx.sig["delta"][j], dtype=float, copy=True)
+        self._accept_all(act)
+        for k in act:
+            ctx, j = self._cx[k]
+            self.sims[k]._delta0 = xp.array(ctx.sig["delta"][j], dtype=float, copy=True)
         self._record(act, recs)
         ev_i = [0] * B
         nstep = [0] * B
@@ -607,8 +609,8 @@ class BatchSimulator:
                     self.steps += 1
             live = [k for k in live if k in act]
             self.t = max(self.sims[k].t for k in live) if live else self.t
-            ctx = self._accept_all(live)
-            self._check(stepped, ctx, fail)
+            self._accept_all(live)
+            self._check(stepped, fail)
             live = [k for k in live if k in act]
             own = [k for k in live if abs(self.sims[k].t - tb[k]) <= eps * max(1.0, abs(tb[k])) * 10]
             for k in own:
@@ -618,10 +620,8 @@ class BatchSimulator:
             at = {}
             for k in own:
                 at.setdefault(tb[k], []).append(k)
-            for n, (t_g, G) in enumerate(sorted(at.items())):
+            for t_g, G in sorted(at.items()):
                 self.t = t_g
-                if n:   # the context of these members (the previous instant's re-solve replaced it)
-                    self._accept_all(G)
                 self._breakpoint(G, evs, ev_i, ctls, recs, fail)
         for k in act:
             fstats[k] = dict(self.sims[k].stats)
@@ -646,8 +646,8 @@ class BatchSimulator:
         return again
 
     def _breakpoint(self, own, evs, ev_i, ctls, recs, fail):
-        """Members ``own`` at their breakpoint :attr:`t` (recorded there; their rows in the
-        context of :meth:`_accept_all`): apply their events, take their controllers' samples,
+        """Members ``own`` at their breakpoint :attr:`t` (recorded there, their contexts
+        kept): apply their events, take their controllers' samples,
         re-solve the network of those that jumped and record them again (as :meth:`Simulator.run`)."""
         nx = self.nx
         jumps, new_jac, held = {}, {}, {}
@@ -702,34 +702,50 @@ class BatchSimulator:
             self._record(jk, recs)
 
     def _accept_all(self, act):
-        """The context of every active member at its accepted point (one evaluation)."""
-        if not act:
-            return None
-        Z = xp.stack([self.sims[k].z for k in act])
-        F, ctx = self.residual(self.t, Z, act)
-        self._pos = {k: j for j, k in enumerate(act)}   # a member's view is made when it is read
-        self._ctx = ctx
-        return ctx
+        """The contexts of members ``act`` at their accepted points: each member keeps the one of
+        the evaluation that accepted its point (Newton's last iterate, the re-solve's last, as
+        its run alone does) in ``_cx`` (``{k: (ctx, row)}``); the members without one are
+        evaluated together, once."""
+        miss = [k for k in act if k not in self._cx]
+        if miss:
+            F, ctx = self.residual(self.t, xp.stack([self.sims[k].z for k in miss]), miss)
+            for j, k in enumerate(miss):
+                self._cx[k] = (ctx, j)
+
+    def _by_ctx(self, rows):
+        """Members ``rows`` grouped by their context: ``[(ctx, members, their rows)]``."""
+        groups = {}
+        for k in rows:
+            ctx, j = self._cx[k]
+            g = groups.setdefault(id(ctx), (ctx, [], []))
+            g[1].append(k)
+            g[2].append(j)
+        return list(groups.values())
 
     def _record(self, rows, recs):
-        """Record members ``rows`` at their times, from the context of :meth:`_accept_all`."""
+        """Record members ``rows`` at their times, from their contexts (:meth:`_accept_all`)."""
         if not rows:
             return
         t0 = time.perf_counter()
-        recs.add(xp.asarray([self.sims[k].t for k in rows]), rows, xp.stack([self.sims[k].z for k in rows]),
-                 self._ctx, [self._pos[k] for k in rows])
+        for ctx, ks, pos in self._by_ctx(rows):
+            recs.add(xp.asarray([self.sims[k].t for k in ks]), ks, xp.stack([self.sims[k].z for k in ks]),
+                     ctx, pos)
         self.timing["record"] += time.perf_counter() - t0
 
-    def _check(self, act, ctx, fail):
-        """Divergence and loss of synchronism of members ``act`` (rows of the context of
+    def _check(self, act, fail):
+        """Divergence and loss of synchronism of members ``act`` (from their contexts,
         :meth:`_accept_all`), per member (as :meth:`Simulator._check`)."""
         if not act:
             return
         Z = xp.stack([self.sims[k].z for k in act])
         bad = ~(xp.abs(Z).max(axis=1) <= 1e6)
-        d = ctx.sig["delta"]
-        if d.ndim >= 2:
-            d = d[[self._pos[k] for k in act]]
+        d = None
+        at = {k: j for j, k in enumerate(act)}
+        for ctx, ks, pos in self._by_ctx(act):
+            dg = ctx.sig["delta"]
+            if d is None:
+                d = xp.empty((len(act), dg.shape[-1]))
+            d[[at[k] for k in ks]] = dg[pos]
         if d.shape[-1] > 1:
             e = d - xp.stack([self.sims[k]._delta0 for k in act])
             bad |= (e.max(axis=1) - e.min(axis=1)) > self.sims[act[0]].max_spread
@@ -757,7 +773,7 @@ class BatchSimulator:
                 if not c.due(t):
                     continue
                 sim = self.sims[k]
-                sim._ctx = _RowCtx(self._ctx, self._pos[k], sim.sys)   # what the measurement reads
+                sim._ctx = _RowCtx(*self._cx[k], sim.sys)   # what the measurement reads
                 try:
                     if getattr(c, "batched", False):
                         m = c.measurement(sim, t)
@@ -806,9 +822,10 @@ class BatchSimulator:
         for k in rows:
             sim = self.sims[k]
             if k in done:
-                sim.z, F = done[k]
+                sim.z, F, self._cx[k] = done[k]
                 sim._f = F[:nx].copy()
                 continue
+            self._cx.pop(k, None)
             try:   # the member's own re-solve: its chord iteration again, then Newton and the rest
                 sim.t = t
                 z, F, sctx = sim.solve_algebraic(t, sim.z, return_eval=True, y_guess=guesses.get(k),
