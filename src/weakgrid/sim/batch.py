@@ -880,8 +880,10 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
         A member's failure is in its ``Results.failure``; ``"raise"`` raises the first one after
         every member has run.
     stats : dict, optional
-        Filled with ``batches``, ``rerun`` (members re-run one by one), ``alone`` (members run
-        one by one from the start) and ``timing`` (summed :attr:`BatchSimulator.timing`).
+        Filled with ``batches``, ``steps`` (batched steps, :attr:`BatchSimulator.steps`),
+        ``halved`` (halved steps taken in the batch), ``rerun`` (members re-run one by one: a
+        step below ``min_step``), ``alone`` (members run one by one from the start) and
+        ``timing`` (summed :attr:`BatchSimulator.timing`).
     **sim_kw
         :class:`Simulator` keyword arguments (``dt``, ``tol``, ``record``, ...).
 
@@ -899,7 +901,7 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
     scenarios = [dict(s) for s in scenarios]
     dt = float(sim_kw.get("dt", 1 / 120))
     out = [None] * len(scenarios)
-    st = {"batches": 0, "rerun": 0, "halved": 0, "alone": 0, "timing": dict.fromkeys(TIMED, 0.0)}
+    st = {"batches": 0, "steps": 0, "rerun": 0, "halved": 0, "alone": 0, "timing": dict.fromkeys(TIMED, 0.0)}
     groups = {}
     alone = []
     for i, sc in enumerate(scenarios):
@@ -925,6 +927,7 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
             res, rerun = bs.run(t_end)
             st["batches"] += 1
             st["halved"] += bs.halved
+            st["steps"] += bs.steps
             for key, v in bs.timing.items():
                 st["timing"][key] += v
             for j, i in enumerate(part):
