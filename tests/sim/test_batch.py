@@ -111,6 +111,22 @@ def test_a_newton_failure_stops_alone_and_a_halved_step_continues_in_the_batch()
         _same(a, b)
 
 
+def test_a_step_that_would_fall_below_min_step_reruns_the_member_alone_with_its_failure():
+    s = build_gti_upqc_sg("reduced")
+
+    def scen():
+        return [{"events": [Fault(3, 0.2, 0.25, xf=0.05)]},
+                {"events": [Fault(1, 0.2, 0.35, xf=0.03)]}]     # needs a halved step: not allowed
+    kw = dict(dt=DT, tol=1e-6, min_step=DT)
+    alone = [_alone(s, sc, 0.6, **kw) for sc in scen()]
+    assert alone[0].ok and alone[1].failure.cause == "newton"
+    st = {}
+    got = simulate_batch(s, scen(), 0.6, stats=st, **kw)
+    assert st["rerun"] == 1 and st["halved"] == 0
+    for a, b in zip(alone, got):
+        _same(a, b)
+
+
 def _K(m):
     return [float(np.clip(-0.5 * m[0] - 2.0 * m[1], -0.15, 0.15)), float(np.clip(-0.2 * m[1], -0.1, 0.1))]
 

@@ -687,7 +687,7 @@ class BatchSimulator:
                 sim._corr = None
             elif sim._jump is not None and sim._jump_t > self.t - 1.5 * _gap(ctls[k]):
                 guesses[k] = sim.z[nx:] + sim._jump
-        paths = {k: _output_path(ctls[k], held[k]) for k in jumps}
+        paths = {k: (ctls[k], held[k]) for k in jumps}   # the jump's path, made if it is needed
         y_before = {k: self.sims[k].z[nx:] for k in jumps}
         self._solve_jump(self.t, jumps, guesses, paths, fail)
         jk = [k for k in jumps if k not in self._failed]
@@ -810,7 +810,8 @@ class BatchSimulator:
     def _solve_jump(self, t, rows, guesses, paths, fail):
         """Consistent network re-solve of members ``rows`` after a jump: the batched chord
         iteration, then each member's own :meth:`Simulator.solve_algebraic` for those whose
-        chord iteration did not converge (Newton, path following, continuation)."""
+        chord iteration did not converge (Newton, path following, continuation; ``paths[k]``:
+        the member's controllers and their held outputs, for :func:`_output_path`)."""
         if not rows:
             return
         nx = self.nx
@@ -828,8 +829,9 @@ class BatchSimulator:
             self._cx.pop(k, None)
             try:   # the member's own re-solve: its chord iteration again, then Newton and the rest
                 sim.t = t
+                p = paths.get(k)
                 z, F, sctx = sim.solve_algebraic(t, sim.z, return_eval=True, y_guess=guesses.get(k),
-                                                 path=paths.get(k))
+                                                 path=_output_path(*p) if p else None)
             except SimulationError as exc:
                 fail(k, exc)
                 continue
