@@ -215,7 +215,7 @@ def batched(n=100, sizes=(1, 10, 50, 100), repeats=3, n_alone=10, tf=5.0, procs=
     pool = None
     if procs:      # 2 processes, one grid (50 scenarios, one batch) each; started before timing
         pool = mp.get_context("spawn").Pool(2)
-        pool.map(_batch_part, [(g, 2, 50, 0.05) for g in grids])     # warm: imports, first run
+        pool.map(_batch_part, [(g, 2, 50, 0.3) for g in grids])     # warm: imports, a first short run
         walls["2 proc"] = []
     for _ in range(repeats):      # interleaved: load drift hits every batch size alike
         for b in sizes:
