@@ -168,6 +168,13 @@ def test_members_with_breakpoints_off_the_step_grid_are_batched_apart():
     assert st["batches"] == 2
     for r, g in zip(ref, got):
         _same(r, g)
+    # in one batch too, each member takes its own steps (its breakpoints only): the same runs
+    st = {}
+    sc = [copy.deepcopy(x) for x in (a, b)]
+    got = simulate_batch(s, sc, 0.6, dt=DT, tol=1e-6, stats=st, exact=False)
+    assert st["batches"] == 1
+    for r, g in zip(ref, got):
+        _same(r, g)
 
 
 def test_generator_trip_runs_alone_with_the_same_result():

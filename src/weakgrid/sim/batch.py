@@ -11,22 +11,29 @@ What each member keeps of its own, so that its trajectory is the one of its one-
 
 * a :class:`Simulator` of its own (on a copy of the grid: its network, events, held limits,
   chord matrix and its LU, Jacobian refresh decisions, predictor and statistics) — the
-  batch vectorizes only the residual, the Jacobian's finite differences and the Newton
-  updates, and calls the member's own methods for everything else (its LU, the predictor,
-  the consistent re-solve after a jump when the chord iteration does not converge);
+  batch vectorizes the residual, the Jacobian's finite differences, the Newton updates and
+  the held-limit logic (one ``(B, n_lim)`` array whose rows are the members' ``frozen``), and
+  calls the member's own methods for the rest (its LU, the consistent re-solve after a jump
+  when the chord iteration does not converge);
+* its time and its steps: each member takes the steps of its run alone (its own next
+  breakpoint: events, controller samples); the members taking the same step size are advanced
+  by one Newton call whatever their times — the evaluations of a batchable grid do not read
+  the time (every component that does, a delay or a timer, has discrete memory and is refused
+  by :func:`batch_unsupported`);
 * its Newton convergence: a member whose update is below ``tol`` is left at the point it
-  evaluated (converged members are not moved by further iterations of the others);
+  evaluated (converged members are not moved by further iterations of the others), and keeps
+  that evaluation's context (what is recorded and measured at its accepted point), as its run
+  alone does;
 * its failure: a member that loses synchronism, diverges, or whose re-solve fails stops
-  alone with the failure its one-by-one run reports; a member whose step must be halved
-  (Newton fails even with a fresh Jacobian) leaves the lockstep and is re-run one-by-one
-  (the same code path, so the same result, including a Newton failure).
+  alone with the failure its one-by-one run reports; a member whose Newton fails even with a
+  fresh Jacobian halves its step in the batch (the members halving at one instant together)
+  and goes on from there on its own time grid, as :meth:`Simulator._step` does; only a step
+  that would fall below ``min_step`` (its run alone fails there) makes :func:`simulate_batch`
+  re-run the member one-by-one, to report that failure.
 
-The members step together: the step ends at the earliest breakpoint of any member (event,
-controller sample). A member's steps are then those of its one-by-one run when the members'
-breakpoints coincide or lie on the step grid (multiples of ``dt``); :func:`simulate_batch`
-groups the members by their breakpoints off that grid so that this always holds
-(``exact=True``), or lets them share steps (``exact=False``: a member's run then differs
-from its one-by-one run by the step error, not by round-off).
+:func:`simulate_batch` groups the members by their breakpoints off the step grid
+(``exact=True``) so that a batch's members keep one step size; results equal one-by-one runs
+either way.
 
 The array code uses the namespace ``xp`` (NumPy) so that an array-API backend could replace
 it for large batches; the linear solves stay per member (LAPACK through
@@ -874,10 +881,10 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
     batch_size : int
         Largest number of members advanced together.
     exact : bool
-        Group the members so that each takes the steps of its one-by-one run (by
-        :func:`breakpoint_key`): results equal to one-by-one runs to round-off. ``False``
-        batches members whose breakpoints differ (they share the union of the breakpoints:
-        more, shorter steps; results differ from one-by-one runs by the step error).
+        Group the members by their breakpoints off the step grid (:func:`breakpoint_key`), so
+        that a batch's members take equal steps. ``False`` batches them regardless: each member
+        still takes the steps of its run alone (results equal to one-by-one runs to round-off
+        either way), members at different step sizes in separate Newton calls.
     on_failure : {"return", "raise"}
         A member's failure is in its ``Results.failure``; ``"raise"`` raises the first one after
         every member has run.
