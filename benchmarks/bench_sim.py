@@ -196,9 +196,9 @@ def _batch_part(args):
 
     grid, n, b, tf = args
     sc = [s for g, s in _fault_scenarios(n) if g == grid]
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     simulate_batch(build_gti_upqc_sg(grid), sc, tf, dt=5e-3, tol=1e-6, batch_size=b)
-    return time.perf_counter() - t0
+    return time.perf_counter() - t0, time.process_time() - c0
 
 
 def batched(n=100, sizes=(1, 10, 50, 100), repeats=3, n_alone=10, tf=5.0, procs=True):
@@ -211,18 +211,19 @@ def batched(n=100, sizes=(1, 10, 50, 100), repeats=3, n_alone=10, tf=5.0, procs=
     grids = {st: build_gti_upqc_sg(st) for st in ("conventional", "reduced")}
     print(f"== batched: {n} fault scenarios (clearing on the 5-ms grid), GTI + UPQC + SG, {tf:g} s, dt 5 ms ==")
     walls = {b: [] for b in sizes}
+    cpus = {b: [] for b in sizes}     # CPU time of the process(es): what the load does not inflate
     st_all = {}
     pool = None
     if procs:      # 2 processes, one grid (50 scenarios, one batch) each; started before timing
         pool = mp.get_context("spawn").Pool(2)
         pool.map(_batch_part, [(g, 2, 50, 0.3) for g in grids])     # warm: imports, a first short run
-        walls["2 proc"] = []
+        walls["2 proc"], cpus["2 proc"] = [], []
     for _ in range(repeats):      # interleaved: load drift hits every batch size alike
         for b in sizes:
             m = n_alone if b == 1 else n
             scen = _fault_scenarios(m)
             st_b = st_all[b] = {"batches": 0, "steps": 0, "halved": 0, "rerun": 0, "timing": {}}
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             for grid in grids:
                 st = {}
                 sc = [s for g, s in scen if g == grid]
@@ -232,23 +233,26 @@ def batched(n=100, sizes=(1, 10, 50, 100), repeats=3, n_alone=10, tf=5.0, procs=
                 for k, v in st["timing"].items():
                     st_b["timing"][k] = st_b["timing"].get(k, 0.0) + v
             walls[b].append(time.perf_counter() - t0)
+            cpus[b].append(time.process_time() - c0)
         if pool is not None:
             t0 = time.perf_counter()
-            pool.map(_batch_part, [(g, n, 50, tf) for g in grids])
+            parts = pool.map(_batch_part, [(g, n, 50, tf) for g in grids])
             walls["2 proc"].append(time.perf_counter() - t0)
+            cpus["2 proc"].append(max(c for _, c in parts))   # the busier process
     if pool is not None:
         pool.close()
     rates = {}
     for b in walls:
         m = n_alone if b == 1 else n
-        w = statistics.median(walls[b])
+        w, c = statistics.median(walls[b]), statistics.median(cpus[b])
         rates[b] = m / w
         if b == "2 proc":
-            print(f"2 processes x batch 50: {m} scenarios median {w:.2f} s -> {m / w:.2f} scenarios/s")
+            print(f"2 processes x batch 50: {m} scenarios median {w:.2f} s -> {m / w:.2f} scenarios/s "
+                  f"(CPU of the busier process {c:.2f} s -> {m / c:.2f} scenarios per CPU-second of it)")
             continue
         st = st_all[b]
-        print(f"batch {b:3d}: {m} scenarios median {w:.2f} s -> {m / w:.2f} scenarios/s "
-              f"({st['batches']} batches, {st['steps']} batched steps, {st['halved']} halved steps, "
+        print(f"batch {b:3d}: {m} scenarios median {w:.2f} s -> {m / w:.2f} scenarios/s, CPU {c:.2f} s -> "
+              f"{m / c:.2f} scenarios per CPU-second ({st['batches']} batches, {st['steps']} batched steps, {st['halved']} halved steps, "
               f"{st['rerun']} re-run alone)  per batched step (last repeat): {_breakdown(st['timing'], st['steps'])}")
     for b in list(walls)[1:]:
         print(f"ratio {b} vs batch 1: {rates[b] / rates[1]:.1f}x")
@@ -269,6 +273,7 @@ def batched_controlled(tf=5.0, sizes=(1, 10, 50), repeats=3):
     s = build_gti_upqc_sg("reduced")
     print(f"== batched DigitalController T = 1 ms, {tf:g} s, dt 1 ms (medians of {repeats}, interleaved) ==")
     walls = {B: [] for B in sizes}
+    cpus = {B: [] for B in sizes}
     last = {}
     for _ in range(repeats):
         for B in sizes:    # fault impedances 0.05 + 0.01 k pu (every 10th repeats: a batch of 50)
@@ -276,17 +281,18 @@ def batched_controlled(tf=5.0, sizes=(1, 10, 50), repeats=3):
                    "controllers": [DigitalController(K, 1e-3, gti_design_states("PV"), UPQCTarget("U"),
                                                      enable=[(0.25, tf)], batched=True)]} for k in range(B)]
             bs = BatchSimulator(s, sc, dt=1e-3)
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             res, rerun = bs.run(tf)
             walls[B].append(time.perf_counter() - t0)
+            cpus[B].append(time.process_time() - c0)
             last[B] = (bs, res, rerun)
     per = {}
     for B in sizes:
         bs, res, rerun = last[B]
-        w = statistics.median(walls[B])
+        w, c = statistics.median(walls[B]), statistics.median(cpus[B])
         per[B] = w / B
         ok = sum(r is not None and r.ok for r in res)
-        print(f"{B:3d} run(s) in one batch: median {w:.2f} s, {w / B:.3f} s per run, {ok}/{B} completed, "
+        print(f"{B:3d} run(s) in one batch: median {w:.2f} s, {w / B:.3f} s per run (CPU {c / B:.3f} s), {ok}/{B} completed, "
               f"{len(rerun)} re-run alone; {bs.steps} steps, {_breakdown(bs.timing, bs.steps)}")
     print(f"    member 0 stats {last[sizes[0]][1][0].stats}")
     for B in sizes[1:]:

@@ -107,6 +107,7 @@ class _BatchRecorder:
         self.rec = Results.recorder(system, record)   # its layout (names, units, columns)
         self.sys = system
         self.blocks = []
+        self._ocols = None      # the columns of the outputs, in the order of ``rec._outs``
 
     def add(self, t, members, Z, ctx, pos):
         """Record members ``members`` (their points ``Z``, one row each) whose rows in the
@@ -123,9 +124,15 @@ class _BatchRecorder:
         bus[:, 0::4], bus[:, 1::4] = Vr, Vi
         bus[:, 2::4] = xp.hypot(Vr, Vi)
         bus[:, 3::4] = xp.arctan2(Vi, Vr)
-        for key, sl in rec._outs:
-            v = ctx.out[key]
-            row[:, sl] = v[pos] if np.ndim(v) >= 2 else v
+        if self._ocols is None:
+            self._ocols = xp.asarray([c for _, sl in rec._outs for c in range(sl.start, sl.stop)], dtype=int)
+        if len(self._ocols):    # every output of the rows in one gather
+            n = ctx.x.shape[0]
+            cols = []
+            for key, sl in rec._outs:
+                v = ctx.out[key]
+                cols.append(v if np.ndim(v) >= 2 else xp.broadcast_to(v, (n, sl.stop - sl.start)))
+            row[:, self._ocols] = xp.concatenate(cols, axis=1)[pos]
         row[:, rec._tm] = ctx.sig["tm"][pos]
         row[:, rec._vs] = ctx.sig["vs"][pos]
         if rec.sel is not None:
