@@ -243,3 +243,24 @@ def test_a_batched_policy_returning_the_wrong_rows_fails_its_members_as_a_contro
     assert all(r.failure is not None and r.failure.cause == "controller" for r in got)
     assert all(r.failure.t == pytest.approx(0.05) and r.t[-1] == pytest.approx(0.05) for r in got)
     assert "1 rows for 2" in str(got[0].failure)
+
+
+def test_every_component_that_reads_the_time_is_refused_by_the_batch():
+    """The batch advances members at different times in one Newton call (a member that halved a
+    step runs off the step grid): sound only because no batchable component reads ``ctx.t``.
+    Every component whose equations read the time must have discrete memory (``accept``),
+    which :func:`batch_unsupported` refuses."""
+    import inspect
+    import re
+
+    from weakgrid.sim.gti import GTI
+    from weakgrid.sim.system import _registry
+    from weakgrid.sim.upqc import UPQC
+
+    readers = []
+    for name, cls in dict(_registry(), GTI=GTI, UPQC=UPQC).items():
+        src = "".join(inspect.getsource(k) for k in cls.__mro__ if k.__module__.startswith("weakgrid"))
+        if re.search(r"\bctx\.t\b", src):
+            readers.append(name)
+            assert hasattr(cls, "accept"), f"{name} reads the time but has no discrete memory"
+    assert {"GGOV1", "REECA1"} <= set(readers)    # the check sees the time readers
