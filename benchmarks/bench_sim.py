@@ -17,15 +17,18 @@
 5. Batched simulation (:mod:`weakgrid.sim.batch`): the 100 fault scenarios of 2. with their
    clearing times on the 5-ms step grid (so that every member takes the steps of its run alone;
    batched and one-by-one results are equal, ``tests/sim/test_batch.py``), run by
-   ``simulate_batch`` at batch sizes 1, 10, 25, 50, 100 in one process, interleaved (the two UPQC
-   structures are two grids: a batch holds members of one grid, so 100 means two batches of 50);
+   ``simulate_batch`` at batch sizes 1, 10, 50, 100 in one process, interleaved (the two UPQC
+   structures are two grids: a batch holds members of one grid, so 100 means two batches of 50),
+   and by 2 processes (a pool started before timing), one grid's 50 scenarios in one batch each;
    medians of ``repeats``; batch size 1 on the first ``n_alone`` scenarios only (its rate is per
-   scenario).
-   Scenarios/s and the cost per batched step broken down (residual, Jacobian, LU, Newton
-   update, recording, events/samples); then the controlled run of 3. alone and 10 of them (fault
-   impedances 0.05-0.14 pu) in one batch, the same breakdown. One process, one core.
+   scenario). Scenarios/s, their ratio to batch size 1, and the cost per batched step broken
+   down (residual, Jacobian, LU, Newton update, recording, events/samples).
+   ``batched_controlled``: the controlled run of 3. with a batched policy, alone and 10 and 50 of
+   them (fault impedances 0.05-0.14 pu) in one batch, interleaved, medians; wall time per run and
+   the same breakdown. ``batched-quick``: batch 1 / 50 / 100 and controlled 1 / 10 (a loaded machine).
 
 Run:  PYTHONPATH=src python benchmarks/bench_sim.py [kundur] [scenarios] [controlled] [recording] [batched]
+      [batched_controlled] | batched-quick
 """
 
 from __future__ import annotations
@@ -185,7 +188,22 @@ def _breakdown(timing, steps):
     return "  ".join(f"{k} {v / max(steps, 1) * 1e3:.3f}" for k, v in timing.items()) + " [ms/step]"
 
 
-def batched(n=100, sizes=(1, 10, 25, 50, 100), repeats=3, n_alone=10, tf=5.0):
+def _batch_part(args):
+    """Worker of :func:`batched`'s 2-process case: one grid's scenarios in batches of ``b``."""
+    from sim_cases import build_gti_upqc_sg
+
+    from weakgrid.sim.batch import simulate_batch
+
+    grid, n, b, tf = args
+    sc = [s for g, s in _fault_scenarios(n) if g == grid]
+    t0, c0 = time.perf_counter(), time.process_time()
+    simulate_batch(build_gti_upqc_sg(grid), sc, tf, dt=5e-3, tol=1e-6, batch_size=b)
+    return time.perf_counter() - t0, time.process_time() - c0
+
+
+def batched(n=100, sizes=(1, 10, 50, 100), repeats=3, n_alone=10, tf=5.0, procs=True):
+    import multiprocessing as mp
+
     from sim_cases import build_gti_upqc_sg
 
     from weakgrid.sim.batch import simulate_batch
@@ -193,36 +211,54 @@ def batched(n=100, sizes=(1, 10, 25, 50, 100), repeats=3, n_alone=10, tf=5.0):
     grids = {st: build_gti_upqc_sg(st) for st in ("conventional", "reduced")}
     print(f"== batched: {n} fault scenarios (clearing on the 5-ms grid), GTI + UPQC + SG, {tf:g} s, dt 5 ms ==")
     walls = {b: [] for b in sizes}
+    cpus = {b: [] for b in sizes}     # CPU time of the process(es): what the load does not inflate
     st_all = {}
+    pool = None
+    if procs:      # 2 processes, one grid (50 scenarios, one batch) each; started before timing
+        pool = mp.get_context("spawn").Pool(2)
+        pool.map(_batch_part, [(g, 2, 50, 0.3) for g in grids])     # warm: imports, a first short run
+        walls["2 proc"], cpus["2 proc"] = [], []
     for _ in range(repeats):      # interleaved: load drift hits every batch size alike
         for b in sizes:
             m = n_alone if b == 1 else n
             scen = _fault_scenarios(m)
-            st_b = st_all[b] = {"batches": 0, "rerun": 0, "timing": {}}
-            t0 = time.perf_counter()
+            st_b = st_all[b] = {"batches": 0, "steps": 0, "halved": 0, "rerun": 0, "timing": {}}
+            t0, c0 = time.perf_counter(), time.process_time()
             for grid in grids:
                 st = {}
                 sc = [s for g, s in scen if g == grid]
                 simulate_batch(grids[grid], sc, tf, dt=5e-3, tol=1e-6, batch_size=b, stats=st)
-                st_b["batches"] += st["batches"]
-                st_b["rerun"] += st["rerun"]
+                for k in ("batches", "steps", "halved", "rerun"):
+                    st_b[k] += st[k]
                 for k, v in st["timing"].items():
                     st_b["timing"][k] = st_b["timing"].get(k, 0.0) + v
             walls[b].append(time.perf_counter() - t0)
+            cpus[b].append(time.process_time() - c0)
+        if pool is not None:
+            t0 = time.perf_counter()
+            parts = pool.map(_batch_part, [(g, n, 50, tf) for g in grids])
+            walls["2 proc"].append(time.perf_counter() - t0)
+            cpus["2 proc"].append(max(c for _, c in parts))   # the busier process
+    if pool is not None:
+        pool.close()
     rates = {}
-    for b in sizes:
+    for b in walls:
         m = n_alone if b == 1 else n
-        w = statistics.median(walls[b])
+        w, c = statistics.median(walls[b]), statistics.median(cpus[b])
         rates[b] = m / w
-        steps = st_all[b]["batches"] * round(tf / 5e-3)   # batched steps (a batch steps tf/dt times)
-        print(f"batch {b:3d}: {m} scenarios median {w:.2f} s -> {m / w:.2f} scenarios/s "
-              f"({st_all[b]['batches']} batches, {st_all[b]['rerun']} re-run alone)  per batched step "
-              f"(last repeat): {_breakdown(st_all[b]['timing'], steps)}")
-    for b in sizes[1:]:
-        print(f"speed-up batch {b} vs 1: {rates[b] / rates[1]:.1f}x")
+        if b == "2 proc":
+            print(f"2 processes x batch 50: {m} scenarios median {w:.2f} s -> {m / w:.2f} scenarios/s "
+                  f"(CPU of the busier process {c:.2f} s -> {m / c:.2f} scenarios per CPU-second of it)")
+            continue
+        st = st_all[b]
+        print(f"batch {b:3d}: {m} scenarios median {w:.2f} s -> {m / w:.2f} scenarios/s, CPU {c:.2f} s -> "
+              f"{m / c:.2f} scenarios per CPU-second ({st['batches']} batches, {st['steps']} batched steps, {st['halved']} halved steps, "
+              f"{st['rerun']} re-run alone)  per batched step (last repeat): {_breakdown(st['timing'], st['steps'])}")
+    for b in list(walls)[1:]:
+        print(f"ratio {b} vs batch 1: {rates[b] / rates[1]:.1f}x")
 
 
-def batched_controlled(tf=5.0, n_batch=10):
+def batched_controlled(tf=5.0, sizes=(1, 10, 50), repeats=3):
     from sim_cases import build_gti_upqc_sg
 
     from weakgrid.sim.batch import BatchSimulator
@@ -235,24 +271,38 @@ def batched_controlled(tf=5.0, n_batch=10):
                          np.clip(-0.2 * m[..., 1], -0.1, 0.1)], axis=-1)
 
     s = build_gti_upqc_sg("reduced")
-    print(f"== batched DigitalController T = 1 ms, {tf:g} s, dt 1 ms ==")
-    for B in (1, n_batch):
-        sc = [{"events": [Fault(3, 0.2, 0.25, xf=0.05 + 0.01 * k)],
-               "controllers": [DigitalController(K, 1e-3, gti_design_states("PV"), UPQCTarget("U"),
-                                                 enable=[(0.25, tf)], batched=True)]} for k in range(B)]
-        bs = BatchSimulator(s, sc, dt=1e-3)
-        t0 = time.perf_counter()
-        res, rerun = bs.run(tf)
-        w = time.perf_counter() - t0
+    print(f"== batched DigitalController T = 1 ms, {tf:g} s, dt 1 ms (medians of {repeats}, interleaved) ==")
+    walls = {B: [] for B in sizes}
+    cpus = {B: [] for B in sizes}
+    last = {}
+    for _ in range(repeats):
+        for B in sizes:    # fault impedances 0.05 + 0.01 k pu (every 10th repeats: a batch of 50)
+            sc = [{"events": [Fault(3, 0.2, 0.25, xf=0.05 + 0.01 * (k % 10))],
+                   "controllers": [DigitalController(K, 1e-3, gti_design_states("PV"), UPQCTarget("U"),
+                                                     enable=[(0.25, tf)], batched=True)]} for k in range(B)]
+            bs = BatchSimulator(s, sc, dt=1e-3)
+            t0, c0 = time.perf_counter(), time.process_time()
+            res, rerun = bs.run(tf)
+            walls[B].append(time.perf_counter() - t0)
+            cpus[B].append(time.process_time() - c0)
+            last[B] = (bs, res, rerun)
+    per = {}
+    for B in sizes:
+        bs, res, rerun = last[B]
+        w, c = statistics.median(walls[B]), statistics.median(cpus[B])
+        per[B] = w / B
         ok = sum(r is not None and r.ok for r in res)
-        print(f"{B:3d} run(s) in one batch: {w:.2f} s, {w / B:.2f} s per run, {ok}/{B} completed, "
+        print(f"{B:3d} run(s) in one batch: median {w:.2f} s, {w / B:.3f} s per run (CPU {c / B:.3f} s), {ok}/{B} completed, "
               f"{len(rerun)} re-run alone; {bs.steps} steps, {_breakdown(bs.timing, bs.steps)}")
-        print(f"    member 0 stats {res[0].stats if res[0] is not None else None}")
+    print(f"    member 0 stats {last[sizes[0]][1][0].stats}")
+    for B in sizes[1:]:
+        print(f"ratio per run, batch {B} vs 1: {per[1] / per[B]:.1f}x")
 
 
 if __name__ == "__main__":
     if sys.argv[1:2] == ["batched-quick"]:     # interleaved 1 / 50 / 100 only (a loaded machine)
-        batched(sizes=(1, 50, 100), n_alone=5)
+        batched(sizes=(1, 50, 100), n_alone=5, repeats=2)
+        batched_controlled(sizes=(1, 10), repeats=1)
         sys.exit()
     which = sys.argv[1:] or ["kundur", "scenarios", "controlled", "recording", "batched", "batched_controlled"]
     for w in which:

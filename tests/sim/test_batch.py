@@ -89,7 +89,7 @@ def test_a_member_that_loses_synchronism_stops_alone():
     assert got[0].t[-1] == pytest.approx(3.0) and got[1].t[-1] < 1.5
 
 
-def test_a_newton_failure_stops_alone_and_a_shortened_step_leaves_the_batch():
+def test_a_newton_failure_stops_alone_and_a_halved_step_continues_in_the_batch():
     s = build_gti_upqc_sg("reduced")    # one machine: its rotor angle has no spread
 
     def scen():
@@ -102,7 +102,27 @@ def test_a_newton_failure_stops_alone_and_a_shortened_step_leaves_the_batch():
     assert alone[1].failure.cause == "newton" and alone[1].failure.t == pytest.approx(0.2)
     st = {}
     got = simulate_batch(s, scen(), 1.0, stats=st, **kw)
-    assert st["batches"] == 1 and st["rerun"] == 1
+    # the member that halves its step continues from there in the batch (not re-run from t = 0),
+    # on its own time grid (off the multiples of dt), and still equals its run alone
+    assert st["batches"] == 1 and st["rerun"] == 0 and st["halved"] >= 1
+    off = np.abs(alone[2].t / DT - np.round(alone[2].t / DT)) > 1e-6
+    assert off.any() and not (np.abs(alone[0].t / DT - np.round(alone[0].t / DT)) > 1e-6).any()
+    for a, b in zip(alone, got):
+        _same(a, b)
+
+
+def test_a_step_that_would_fall_below_min_step_reruns_the_member_alone_with_its_failure():
+    s = build_gti_upqc_sg("reduced")
+
+    def scen():
+        return [{"events": [Fault(3, 0.2, 0.25, xf=0.05)]},
+                {"events": [Fault(1, 0.2, 0.35, xf=0.03)]}]     # needs a halved step: not allowed
+    kw = dict(dt=DT, tol=1e-6, min_step=DT)
+    alone = [_alone(s, sc, 0.6, **kw) for sc in scen()]
+    assert alone[0].ok and alone[1].failure.cause == "newton"
+    st = {}
+    got = simulate_batch(s, scen(), 0.6, stats=st, **kw)
+    assert st["rerun"] == 1 and st["halved"] == 0
     for a, b in zip(alone, got):
         _same(a, b)
 
@@ -146,6 +166,13 @@ def test_members_with_breakpoints_off_the_step_grid_are_batched_apart():
     st = {}
     got = simulate_batch(s, [a, b], 0.6, dt=DT, tol=1e-6, stats=st)
     assert st["batches"] == 2
+    for r, g in zip(ref, got):
+        _same(r, g)
+    # in one batch too, each member takes its own steps (its breakpoints only): the same runs
+    st = {}
+    sc = [copy.deepcopy(x) for x in (a, b)]
+    got = simulate_batch(s, sc, 0.6, dt=DT, tol=1e-6, stats=st, exact=False)
+    assert st["batches"] == 1
     for r, g in zip(ref, got):
         _same(r, g)
 
@@ -216,3 +243,24 @@ def test_a_batched_policy_returning_the_wrong_rows_fails_its_members_as_a_contro
     assert all(r.failure is not None and r.failure.cause == "controller" for r in got)
     assert all(r.failure.t == pytest.approx(0.05) and r.t[-1] == pytest.approx(0.05) for r in got)
     assert "1 rows for 2" in str(got[0].failure)
+
+
+def test_every_component_that_reads_the_time_is_refused_by_the_batch():
+    """The batch advances members at different times in one Newton call (a member that halved a
+    step runs off the step grid): sound only because no batchable component reads ``ctx.t``.
+    Every component whose equations read the time must have discrete memory (``accept``),
+    which :func:`batch_unsupported` refuses."""
+    import inspect
+    import re
+
+    from weakgrid.sim.gti import GTI
+    from weakgrid.sim.system import _registry
+    from weakgrid.sim.upqc import UPQC
+
+    readers = []
+    for name, cls in dict(_registry(), GTI=GTI, UPQC=UPQC).items():
+        src = "".join(inspect.getsource(k) for k in cls.__mro__ if k.__module__.startswith("weakgrid"))
+        if re.search(r"\bctx\.t\b", src):
+            readers.append(name)
+            assert hasattr(cls, "accept"), f"{name} reads the time but has no discrete memory"
+    assert {"GGOV1", "REECA1"} <= set(readers)    # the check sees the time readers

@@ -11,22 +11,29 @@ What each member keeps of its own, so that its trajectory is the one of its one-
 
 * a :class:`Simulator` of its own (on a copy of the grid: its network, events, held limits,
   chord matrix and its LU, Jacobian refresh decisions, predictor and statistics) — the
-  batch vectorizes only the residual, the Jacobian's finite differences and the Newton
-  updates, and calls the member's own methods for everything else (its LU, the predictor,
-  the consistent re-solve after a jump when the chord iteration does not converge);
+  batch vectorizes the residual, the Jacobian's finite differences, the Newton updates and
+  the held-limit logic (one ``(B, n_lim)`` array whose rows are the members' ``frozen``), and
+  calls the member's own methods for the rest (its LU, the consistent re-solve after a jump
+  when the chord iteration does not converge);
+* its time and its steps: each member takes the steps of its run alone (its own next
+  breakpoint: events, controller samples); the members taking the same step size are advanced
+  by one Newton call whatever their times — the evaluations of a batchable grid do not read
+  the time (every component that does, a delay or a timer, has discrete memory and is refused
+  by :func:`batch_unsupported`);
 * its Newton convergence: a member whose update is below ``tol`` is left at the point it
-  evaluated (converged members are not moved by further iterations of the others);
+  evaluated (converged members are not moved by further iterations of the others), and keeps
+  that evaluation's context (what is recorded and measured at its accepted point), as its run
+  alone does;
 * its failure: a member that loses synchronism, diverges, or whose re-solve fails stops
-  alone with the failure its one-by-one run reports; a member whose step must be halved
-  (Newton fails even with a fresh Jacobian) leaves the lockstep and is re-run one-by-one
-  (the same code path, so the same result, including a Newton failure).
+  alone with the failure its one-by-one run reports; a member whose Newton fails even with a
+  fresh Jacobian halves its step in the batch (the members halving at one instant together)
+  and goes on from there on its own time grid, as :meth:`Simulator._step` does; only a step
+  that would fall below ``min_step`` (its run alone fails there) makes :func:`simulate_batch`
+  re-run the member one-by-one, to report that failure.
 
-The members step together: the step ends at the earliest breakpoint of any member (event,
-controller sample). A member's steps are then those of its one-by-one run when the members'
-breakpoints coincide or lie on the step grid (multiples of ``dt``); :func:`simulate_batch`
-groups the members by their breakpoints off that grid so that this always holds
-(``exact=True``), or lets them share steps (``exact=False``: a member's run then differs
-from its one-by-one run by the step error, not by round-off).
+:func:`simulate_batch` groups the members by their breakpoints off the step grid
+(``exact=True``) so that a batch's members keep one step size; results equal one-by-one runs
+either way.
 
 The array code uses the namespace ``xp`` (NumPy) so that an array-API backend could replace
 it for large batches; the linear solves stay per member (LAPACK through
@@ -100,6 +107,7 @@ class _BatchRecorder:
         self.rec = Results.recorder(system, record)   # its layout (names, units, columns)
         self.sys = system
         self.blocks = []
+        self._ocols = None      # the columns of the outputs, in the order of ``rec._outs``
 
     def add(self, t, members, Z, ctx, pos):
         """Record members ``members`` (their points ``Z``, one row each) whose rows in the
@@ -116,9 +124,15 @@ class _BatchRecorder:
         bus[:, 0::4], bus[:, 1::4] = Vr, Vi
         bus[:, 2::4] = xp.hypot(Vr, Vi)
         bus[:, 3::4] = xp.arctan2(Vi, Vr)
-        for key, sl in rec._outs:
-            v = ctx.out[key]
-            row[:, sl] = v[pos] if np.ndim(v) >= 2 else v
+        if self._ocols is None:
+            self._ocols = xp.asarray([c for _, sl in rec._outs for c in range(sl.start, sl.stop)], dtype=int)
+        if len(self._ocols):    # every output of the rows in one gather
+            n = ctx.x.shape[0]
+            cols = []
+            for key, sl in rec._outs:
+                v = ctx.out[key]
+                cols.append(v if np.ndim(v) >= 2 else xp.broadcast_to(v, (n, sl.stop - sl.start)))
+            row[:, self._ocols] = xp.concatenate(cols, axis=1)[pos]
         row[:, rec._tm] = ctx.sig["tm"][pos]
         row[:, rec._vs] = ctx.sig["vs"][pos]
         if rec.sel is not None:
@@ -132,7 +146,7 @@ class _BatchRecorder:
             return [Results(xp.zeros(0), [], xp.zeros((0, 0)), [], [], failure=failures[k], stats=stats[k])
                     for k in range(B)]
         if self.blocks:
-            T = xp.concatenate([xp.full(len(m), t) for t, m, _ in self.blocks])
+            T = xp.concatenate([xp.broadcast_to(xp.asarray(t, dtype=float), (len(m),)) for t, m, _ in self.blocks])
             K = xp.concatenate([m for _, m, _ in self.blocks])
             D = xp.concatenate([d for _, _, d in self.blocks])
             order = xp.argsort(K, kind="stable")
@@ -223,11 +237,20 @@ class BatchSimulator:
                 for k, s in enumerate(self.sims):
                     setattr(s.sys.components[c.type_name], attr, stack[k])
                 self._inputs.append((c, attr, stack))
+        # the states held at a limit: one (B, n_lim) array, each member's ``frozen`` a row view
+        self._nlim = len(system.lim_idx)
+        self.frozen = xp.zeros((self.B, self._nlim), dtype=np.int8)
+        for k, s in enumerate(self.sims):
+            s.frozen = self.frozen[k]
+        # each member's limits (fixed: limits that move with the solution are refused)
+        self.lim_hi = xp.stack([s.sys.lim_hi for s in self.sims])
+        self.lim_lo = xp.stack([s.sys.lim_lo for s in self.sims])
         nb = system.nb
         self.Y = xp.empty((self.B, 2 * nb, 2 * nb))
         self._ynet = [None] * self.B
         self.timing = dict.fromkeys(TIMED, 0.0)
         self.steps = 0
+        self.halved = 0
 
     # ------------------------------------------------------------- evaluations
     def _bind_inputs(self, rows, rep=1):
@@ -276,17 +299,11 @@ class BatchSimulator:
             sim._alg_key = None
         self.timing["jacobian"] += time.perf_counter() - t0
 
-    def _lu(self, k, h):
-        t0 = time.perf_counter()
-        lu = self.sims[k]._iteration_lu(h)
-        self.timing["lu"] += time.perf_counter() - t0
-        return lu
-
     # ------------------------------------------------------------------ solves
     def _alg_chord(self, t, Z, rows):
         """Chord iteration on the network variables of members ``rows`` (each member's own
-        algebraic LU), as :meth:`Simulator._alg_chord`; returns ``{k: (z, F)}`` of the
-        members that converged (the others diverged or stalled)."""
+        algebraic LU), as :meth:`Simulator._alg_chord`; returns ``{k: (z, F, (ctx, row))}`` of
+        the members that converged (the others diverged or stalled)."""
         nx = self.nx
         done = {}
         live = list(range(len(rows)))
@@ -298,7 +315,7 @@ class BatchSimulator:
             if not live:
                 break
             idx = [rows[j] for j in live]
-            F, _ = self.residual(t, Z[live], idx)
+            F, ctx = self.residual(t, Z[live], idx)
             keep = []
             for i, j in enumerate(live):
                 sim = self.sims[rows[j]]
@@ -308,7 +325,7 @@ class BatchSimulator:
                 if not math.isfinite(nrm):
                     continue
                 if nrm < sim.tol:
-                    done[rows[j]] = (Z[j].copy(), F[i].copy())
+                    done[rows[j]] = (Z[j].copy(), F[i].copy(), (ctx, i))
                     sim.stats["evals"] += evals[j]   # a member that falls back counts its own
                     continue
                 grow[j] = grow[j] + 1 if nrm > 0.9 * prev[j] else 0
@@ -331,22 +348,23 @@ class BatchSimulator:
 
     def _newton(self, t1, h, Zn, Fn, rows, guess, corr):
         """One chord-Newton attempt of the trapezoidal step for members ``rows`` (as
-        :meth:`Simulator._newton`, one member per row). Returns ``{k: (z, nit, f)}`` for the
-        converged members and the set of those that did not converge."""
+        :meth:`Simulator._newton`, one member per row). Returns ``{k: (z, nit, f, (ctx, row))}``
+        for the converged members (``ctx`` the evaluation at ``z``, its row ``row``) and the set
+        of those that did not converge."""
         nx, N = self.nx, self.N
         n = len(rows)
-        lus = []
+        t0 = time.perf_counter()
+        lus = [self.sims[k]._iteration_lu(h) for k in rows]
+        self.timing["lu"] += time.perf_counter() - t0
         FZ = LV = None             # rows held at a limit (mask) and their values
-        for j, k in enumerate(rows):
-            sim = self.sims[k]
-            lus.append(self._lu(k, h))
-            if sim.frozen.any():
-                if FZ is None:
-                    FZ, LV = xp.zeros((n, N), dtype=bool), xp.zeros((n, N))
-                li = sim.sys.lim_idx
-                fz = sim.frozen != 0
-                FZ[j, li[fz]] = True
-                LV[j, li[fz]] = xp.where(sim.frozen > 0, sim.sys.lim_hi, sim.sys.lim_lo)[fz]
+        if self._nlim:
+            FR = self.frozen[rows]
+            fz = FR != 0
+            if fz.any():
+                li = self.tmpl.lim_idx
+                FZ, LV = xp.zeros((n, N), dtype=bool), xp.zeros((n, N))
+                FZ[:, li] = fz
+                LV[:, li] = xp.where(fz, xp.where(FR > 0, self.lim_hi[rows], self.lim_lo[rows]), 0.0)
         # linearly implicit predictor of every member (used by those without a guess)
         Rp = xp.zeros((n, N))
         Rp[:, :nx] = -h * Fn
@@ -358,7 +376,7 @@ class BatchSimulator:
         for j, k in enumerate(rows):
             sim = self.sims[k]
             if guess[k] is None:
-                sim._pred = Zp[j].copy()
+                sim._pred = Zp[j]
                 if corr[k] is not None:
                     Z[j] += corr[k]
                 if sim._refresh_next:
@@ -369,8 +387,10 @@ class BatchSimulator:
             Z = xp.where(FZ, LV, Z)
         if refresh:   # the chord matrix refreshed at the predicted points (all in one evaluation)
             self.refresh_jacobian(t1, Z[refresh], [rows[j] for j in refresh])
+            t0 = time.perf_counter()
             for j in refresh:
-                lus[j] = self._lu(rows[j], h)
+                lus[j] = self.sims[rows[j]]._iteration_lu(h)
+            self.timing["lu"] += time.perf_counter() - t0
             P = Zn[refresh] - self._solve(lus, refresh, Rp[refresh])
             for i, j in enumerate(refresh):
                 self.sims[rows[j]]._pred = P[i]
@@ -379,8 +399,9 @@ class BatchSimulator:
         done, failed = {}, set()
         live = xp.arange(n)
         max_iter = self.sims[rows[0]].max_iter
+        tol = self.sims[rows[0]].tol
         for it in range(max_iter):
-            F, _ = self.residual(t1, Z[live], [rows[j] for j in live.tolist()])
+            F, ctx = self.residual(t1, Z[live], [rows[j] for j in live.tolist()])
             t0 = time.perf_counter()
             f = F[:, :nx].copy()
             R = F
@@ -390,20 +411,24 @@ class BatchSimulator:
             dz = self._solve(lus, live.tolist(), R)
             nrm = xp.abs(dz).max(axis=1)
             bad = ~xp.isfinite(nrm)
-            conv = nrm < self.sims[rows[0]].tol
-            for i in xp.nonzero(bad | conv)[0].tolist():
-                j = int(live[i])
-                k = rows[j]
-                st = self.sims[k].stats
-                st["evals"] += it + 1
-                st["newton"] += it + 1
-                if bad[i]:
-                    failed.add(k)
-                else:
-                    done[k] = (Z[j].copy(), it + 1, f[i])
-            go = ~(bad | conv)
-            Z[live[go]] -= dz[go]
-            live = live[go]
+            conv = nrm < tol
+            stop = bad | conv
+            if stop.any():
+                for i in xp.nonzero(stop)[0].tolist():
+                    j = int(live[i])
+                    k = rows[j]
+                    st = self.sims[k].stats
+                    st["evals"] += it + 1
+                    st["newton"] += it + 1
+                    if bad[i]:
+                        failed.add(k)
+                    else:
+                        done[k] = (Z[j], it + 1, f[i], (ctx, i))
+                go = ~stop
+                Z[live[go]] -= dz[go]
+                live = live[go]
+            else:
+                Z[live] -= dz
             self.timing["newton"] += time.perf_counter() - t0
             if not len(live):
                 break
@@ -414,9 +439,36 @@ class BatchSimulator:
             failed.add(k)
         return done, failed
 
-    def _step(self, h, act):
-        """One step ``h`` of every member in ``act`` (as :meth:`Simulator._step`). Returns the
-        members that must leave the lockstep (their step has to be shortened)."""
+    def _limits(self, ks, Zd, F1):
+        """States of members ``ks`` (accepted points ``Zd``, derivatives ``F1``, one row each)
+        that newly cross a limit (as :meth:`Simulator._step`): ``(new_hi, new_lo)`` masks."""
+        s, li = self.tmpl, self.tmpl.lim_idx
+        FR = self.frozen[ks]
+        XL = Zd[:, li]
+        new_hi = (FR == 0) & (XL > self.lim_hi[ks] + 1e-9)
+        new_lo = (FR == 0) & (XL < self.lim_lo[ks] - 1e-9)
+        if s.any_pushing:
+            FL, push = F1[:, li], s.lim_pushing
+            new_hi &= ~push | (FL >= 0)
+            new_lo &= ~push | (FL <= 0)
+        return new_hi, new_lo
+
+    def _release(self, ks, F1):
+        """Release the held states of members ``ks`` whose derivative (rows of ``F1``) points
+        back inside (:meth:`Simulator._release_held`, for the batch at once)."""
+        FR = self.frozen[ks]
+        if not FR.any():
+            return
+        FL = F1[:, self.tmpl.lim_idx]
+        rel = ((FR > 0) & (FL < 0)) | ((FR < 0) & (FL > 0))
+        if rel.any():
+            FR[rel] = 0
+            self.frozen[ks] = FR
+
+    def _step(self, h, act, retry=False):
+        """One attempt at the step ``h`` of every member in ``act`` (as :meth:`Simulator._step`;
+        ``retry``: the attempt after halving, without the previous step's correction). Returns
+        the members whose Newton failed even with a fresh Jacobian (their step must be halved)."""
         t = self.t
         zn = {k: self.sims[k].z for k in act}
         fn = {k: self.sims[k]._f for k in act}
@@ -425,7 +477,7 @@ class BatchSimulator:
         corr = {}
         for k in act:
             sim = self.sims[k]
-            ok = sim._corr is not None and abs(sim._corr_h - h) <= 1e-9 * h
+            ok = not retry and sim._corr is not None and abs(sim._corr_h - h) <= 1e-9 * h
             corr[k] = sim._corr if ok else None
         pending = list(act)
         eject = []
@@ -444,38 +496,40 @@ class BatchSimulator:
                         nxt.append(k)
                     else:
                         eject.append(k)
-                    continue
-                z, nit, f1 = done[k]
+            ok = [k for k in pending if k in done]
+            if ok and self._nlim:
+                Zd = xp.stack([done[k][0] for k in ok])
+                F1 = xp.stack([done[k][2] for k in ok])
+                new_hi, new_lo = self._limits(ok, Zd, F1)
+                hit = (new_hi | new_lo).any(axis=1)
+                for j in xp.nonzero(hit)[0].tolist():   # redo the step with them held
+                    k = ok[j]
+                    sim, s, li = self.sims[k], self.sims[k].sys, self.tmpl.lim_idx
+                    z, nh, nl = done[k][0], new_hi[j], new_lo[j]
+                    sim.frozen[nh] = 1
+                    sim.frozen[nl] = -1
+                    guess[k] = z
+                    if (s.lim_pushing & (nh | nl)).any():
+                        g = z.copy()
+                        g[li[nh]] = s.lim_hi[nh]
+                        g[li[nl]] = s.lim_lo[nl]
+                        guess[k] = sim.solve_algebraic(t + h, g)
+                        sim._refresh_jacobian(t + h, guess[k])
+                    nxt.append(k)
+                if hit.any():
+                    keep = ~hit
+                    ok = [k for k, y in zip(ok, keep.tolist()) if y]
+                    F1 = F1[keep]
+                self._release(ok, F1)
+            for k in ok:
+                z, nit, f1, self._cx[k] = done[k]   # its context: Newton's evaluation at z
                 sim = self.sims[k]
-                li = sim.sys.lim_idx
-                if len(li):
-                    s = sim.sys
-                    xl = z[li]
-                    new_hi = (sim.frozen == 0) & (xl > s.lim_hi + 1e-9)
-                    new_lo = (sim.frozen == 0) & (xl < s.lim_lo - 1e-9)
-                    if s.any_pushing:
-                        fl, push = f1[li], s.lim_pushing
-                        new_hi &= ~push | (fl >= 0)
-                        new_lo &= ~push | (fl <= 0)
-                    if new_hi.any() or new_lo.any():
-                        sim.frozen[new_hi] = 1
-                        sim.frozen[new_lo] = -1
-                        guess[k] = z
-                        if (s.lim_pushing & (new_hi | new_lo)).any():
-                            g = z.copy()
-                            g[li[new_hi]] = s.lim_hi[new_hi]
-                            g[li[new_lo]] = s.lim_lo[new_lo]
-                            guess[k] = sim.solve_algebraic(t + h, g)
-                            sim._refresh_jacobian(t + h, guess[k])
-                        nxt.append(k)
-                        continue
-                    sim._release_held(f1)
                 sim._corr = z - sim._pred if guess[k] is None else None
                 sim._corr_h = h
                 if nit > sim.max_iter // 2 - 1:
                     sim._refresh_next = True
-                sim.z, sim._f = z, f1.copy()
-                sim.t = t + h
+                sim.z, sim._f = z, f1
+                sim.t = sim.t + h     # its own time (the batch's to round-off)
                 sim.stats["steps"] += 1
             if fresh:
                 self.refresh_jacobian(t, xp.stack([zn[k] for k in fresh]), fresh)
@@ -509,9 +563,13 @@ class BatchSimulator:
         self._sync_network(act)
         self.t = 0.0
 
+        self._failed = set()
+        self._cx = {}
+
         def fail(k, exc):
             failures[k], fstats[k] = exc, dict(self.sims[k].stats)
             act.remove(k)
+            self._failed.add(k)
 
         # initial point: network solved with the initial Jacobian, controllers' first samples
         Z = xp.stack([self.sims[k].z for k in act])
@@ -522,95 +580,63 @@ class BatchSimulator:
             self._accept_all(act)
             self._sample(0.0, with_ctl, ctls, fail)
             self._solve_jump(0.0, [k for k in with_ctl if k in act], {}, {}, fail)
-        ctx = self._accept_all(act)
-        for j, k in enumerate(act):
-            sim = self.sims[k]
-            sim._delta0 = xp.array(ctx.sig["delta"][j], dtype=float, copy=True)
-        self._record(0.0, act, recs, ctx)
+        self._accept_all(act)
+        for k in act:
+            ctx, j = self._cx[k]
+            self.sims[k]._delta0 = xp.array(ctx.sig["delta"][j], dtype=float, copy=True)
+        self._record(act, recs)
         ev_i = [0] * B
-        nstep = 0
+        nstep = [0] * B
         eps = 1e-12
-        while act and self.t < t_end - eps:
-            nb_k = {}
-            for k in act:
-                tb = t_end
+        dt = self.sims[0].dt
+        save_every = self.sims[0].save_every
+        while act:
+            live = [k for k in act if self.sims[k].t < t_end - eps]
+            if not live:
+                break
+            tb, groups = {}, {}
+            for k in live:     # each member's next breakpoint and step, as in its run alone
+                t = self.sims[k].t
+                b = t_end
                 if ev_i[k] < len(evs[k]):
-                    tb = min(tb, evs[k][ev_i[k]].t)
+                    b = min(b, evs[k][ev_i[k]].t)
                 for c in ctls[k]:
-                    tb = min(tb, c.next_time(self.t))
-                nb_k[k] = tb
-            tb = min(nb_k.values())
-            h = min(self.sims[act[0]].dt, tb - self.t)
-            if tb - (self.t + h) < 1e-3 * self.sims[act[0]].dt:
-                h = tb - self.t
-            if h > eps:
-                for k in self._step(h, act):
-                    act.remove(k)
-                    rerun.append(k)
-                nstep += 1
-                self.steps += 1
-                self.t += h
-                ctx = self._accept_all(act)
-                self._check(act, ctx, fail)
-            hit = abs(self.t - tb) <= eps * max(1.0, abs(tb)) * 10
-            if hit:
-                self.t = tb
-                for k in act:
-                    self.sims[k].t = tb
-            own = [k for k in act if hit and abs(nb_k[k] - tb) <= eps * max(1.0, abs(tb)) * 10]
+                    b = min(b, c.next_time(t))
+                h = min(dt, b - t)
+                if b - (t + h) < 1e-3 * dt:
+                    h = b - t
+                tb[k] = b
+                groups.setdefault(h, []).append(k)
+            # the members taking the same step take it together, whatever their times (the
+            # evaluations of a batchable grid do not read the time, see batch_unsupported)
+            stepped = []
+            for h, grp in groups.items():
+                if h > eps:
+                    self.t = self.sims[grp[0]].t
+                    for k in self._advance(h, grp):
+                        act.remove(k)
+                        rerun.append(k)
+                    for k in grp:
+                        if k in act:
+                            nstep[k] += 1
+                            stepped.append(k)
+                    self.steps += 1
+            live = [k for k in live if k in act]
+            self.t = max(self.sims[k].t for k in live) if live else self.t
+            self._accept_all(live)
+            self._check(stepped, fail)
+            live = [k for k in live if k in act]
+            own = [k for k in live if abs(self.sims[k].t - tb[k]) <= eps * max(1.0, abs(tb[k])) * 10]
+            for k in own:
+                self.sims[k].t = tb[k]
             own_set = set(own)
-            plain = [k for k in act if k not in own_set]
-            if plain and nstep % self.sims[plain[0]].save_every == 0:
-                self._record(self.t, plain, recs, ctx, act)
-            if own:
-                self._record(self.t, own, recs, ctx, act)
-                jumps, new_jac, held = {}, {}, {}
-                t0 = time.perf_counter()
-                for k in list(own):
-                    sim = self.sims[k]
-                    events = evs[k]
-                    try:
-                        while ev_i[k] < len(events) and events[ev_i[k]].t <= self.t + 1e-12:
-                            events[ev_i[k]].apply(sim)
-                            ev_i[k] += 1
-                            new_jac[k] = True
-                    except SimulationError as exc:
-                        fail(k, exc)
-                        continue
-                    held[k] = [_held(c) for c in ctls[k]]
-                    if new_jac.get(k):
-                        jumps[k] = None
-                self.timing["events"] += time.perf_counter() - t0
-                own = [k for k in own if k in act]
-                changed = self._sample(self.t, own, ctls, fail)
-                for k in own:
-                    if k in act and (k in jumps or changed.get(k)):
-                        jumps[k] = None
-                self._sync_network(list(jumps))
-                if jumps:
-                    guesses = {}
-                    fresh = [k for k in jumps if new_jac.get(k)]
-                    if fresh:
-                        self.refresh_jacobian(self.t, xp.stack([self.sims[k].z for k in fresh]), fresh)
-                    for k in jumps:
-                        sim = self.sims[k]
-                        if new_jac.get(k):
-                            sim._jump = None
-                            sim._corr = None
-                        elif sim._jump is not None and sim._jump_t > self.t - 1.5 * _gap(ctls[k]):
-                            guesses[k] = sim.z[nx:] + sim._jump
-                    paths = {k: _output_path(ctls[k], held[k]) for k in jumps}
-                    y_before = {k: self.sims[k].z[nx:] for k in jumps}
-                    self._solve_jump(self.t, list(jumps), guesses, paths, fail)
-                    jk = [k for k in jumps if k in act]
-                    for k in jk:
-                        sim = self.sims[k]
-                        if not new_jac.get(k):
-                            sim._jump = sim.z[nx:] - y_before[k]
-                            sim._jump_t = self.t
-                        sim._release_held(sim._f)
-                    ctx = self._accept_all(act)
-                    self._record(self.t, jk, recs, ctx, act)
+            self._record([k for k in live if k in own_set or nstep[k] % save_every == 0], recs)
+            at = {}
+            for k in own:
+                at.setdefault(tb[k], []).append(k)
+            for t_g, G in sorted(at.items()):
+                self.t = t_g
+                self._breakpoint(G, evs, ev_i, ctls, recs, fail)
         for k in act:
             fstats[k] = dict(self.sims[k].stats)
         results = recs.finish(B, failures, fstats)
@@ -618,29 +644,122 @@ class BatchSimulator:
             results[k] = None
         return results, rerun
 
-    def _accept_all(self, act):
-        """The context of every active member at its accepted point (one evaluation)."""
-        if not act:
-            return None
-        Z = xp.stack([self.sims[k].z for k in act])
-        F, ctx = self.residual(self.t, Z, act)
-        self._pos = {k: j for j, k in enumerate(act)}   # a member's view is made when it is read
-        self._ctx = ctx
-        return ctx
+    def _advance(self, h, rows, retry=False):
+        """One step ``h`` of members ``rows`` from :attr:`t`; a member whose Newton fails even
+        with a fresh Jacobian halves its step and retries, as :meth:`Simulator._step` does —
+        the members halving together in one sub-batch. Returns the members whose step would fall
+        below ``min_step`` (their run alone fails there: it is re-run to report that failure)."""
+        eject = self._step(h, rows, retry)
+        if not eject:
+            return []
+        again = [k for k in eject if h / 2 < self.sims[k].min_step]
+        sub = [k for k in eject if h / 2 >= self.sims[k].min_step]
+        if sub:
+            self.halved += len(sub)
+            again += self._advance(h / 2, sub, retry=True)
+        return again
 
-    def _record(self, t, rows, recs, ctx, act=None):
+    def _breakpoint(self, own, evs, ev_i, ctls, recs, fail):
+        """Members ``own`` at their breakpoint :attr:`t` (recorded there, their contexts
+        kept): apply their events, take their controllers' samples,
+        re-solve the network of those that jumped and record them again (as :meth:`Simulator.run`)."""
+        nx = self.nx
+        jumps, new_jac, held = {}, {}, {}
+        t0 = time.perf_counter()
+        for k in list(own):
+            sim = self.sims[k]
+            events = evs[k]
+            try:
+                while ev_i[k] < len(events) and events[ev_i[k]].t <= sim.t + 1e-12:
+                    events[ev_i[k]].apply(sim)
+                    ev_i[k] += 1
+                    new_jac[k] = True
+            except SimulationError as exc:
+                fail(k, exc)
+                continue
+            held[k] = [_held(c) for c in ctls[k]]
+            if new_jac.get(k):
+                jumps[k] = None
+        self.timing["events"] += time.perf_counter() - t0
+        own = [k for k in own if k not in self._failed]
+        changed = self._sample(self.t, own, ctls, fail)
+        for k in own:
+            if k not in self._failed and (k in jumps or changed.get(k)):
+                jumps[k] = None
+        jumps = [k for k in jumps if k not in self._failed]
+        if not jumps:
+            return
+        self._sync_network(jumps)
+        guesses = {}
+        fresh = [k for k in jumps if new_jac.get(k)]
+        if fresh:
+            self.refresh_jacobian(self.t, xp.stack([self.sims[k].z for k in fresh]), fresh)
+        for k in jumps:
+            sim = self.sims[k]
+            if new_jac.get(k):
+                sim._jump = None
+                sim._corr = None
+            elif sim._jump is not None and sim._jump_t > self.t - 1.5 * _gap(ctls[k]):
+                guesses[k] = sim.z[nx:] + sim._jump
+        paths = {k: (ctls[k], held[k]) for k in jumps}   # the jump's path, made if it is needed
+        y_before = {k: self.sims[k].z[nx:] for k in jumps}
+        self._solve_jump(self.t, jumps, guesses, paths, fail)
+        jk = [k for k in jumps if k not in self._failed]
+        for k in jk:
+            sim = self.sims[k]
+            if not new_jac.get(k):
+                sim._jump = sim.z[nx:] - y_before[k]
+                sim._jump_t = self.t
+            sim._release_held(sim._f)
+        if jk:
+            self._accept_all(jk)
+            self._record(jk, recs)
+
+    def _accept_all(self, act):
+        """The contexts of members ``act`` at their accepted points: each member keeps the one of
+        the evaluation that accepted its point (Newton's last iterate, the re-solve's last, as
+        its run alone does) in ``_cx`` (``{k: (ctx, row)}``); the members without one are
+        evaluated together, once."""
+        miss = [k for k in act if k not in self._cx]
+        if miss:
+            F, ctx = self.residual(self.t, xp.stack([self.sims[k].z for k in miss]), miss)
+            for j, k in enumerate(miss):
+                self._cx[k] = (ctx, j)
+
+    def _by_ctx(self, rows):
+        """Members ``rows`` grouped by their context: ``[(ctx, members, their rows)]``."""
+        groups = {}
+        for k in rows:
+            ctx, j = self._cx[k]
+            g = groups.setdefault(id(ctx), (ctx, [], []))
+            g[1].append(k)
+            g[2].append(j)
+        return list(groups.values())
+
+    def _record(self, rows, recs):
+        """Record members ``rows`` at their times, from their contexts (:meth:`_accept_all`)."""
         if not rows:
             return
         t0 = time.perf_counter()
-        recs.add(t, rows, xp.stack([self.sims[k].z for k in rows]), self._ctx,
-                 [self._pos[k] for k in rows])
+        for ctx, ks, pos in self._by_ctx(rows):
+            recs.add(xp.asarray([self.sims[k].t for k in ks]), ks, xp.stack([self.sims[k].z for k in ks]),
+                     ctx, pos)
         self.timing["record"] += time.perf_counter() - t0
 
-    def _check(self, act, ctx, fail):
-        """Divergence and loss of synchronism, per member (as :meth:`Simulator._check`)."""
+    def _check(self, act, fail):
+        """Divergence and loss of synchronism of members ``act`` (from their contexts,
+        :meth:`_accept_all`), per member (as :meth:`Simulator._check`)."""
+        if not act:
+            return
         Z = xp.stack([self.sims[k].z for k in act])
         bad = ~(xp.abs(Z).max(axis=1) <= 1e6)
-        d = ctx.sig["delta"]
+        d = None
+        at = {k: j for j, k in enumerate(act)}
+        for ctx, ks, pos in self._by_ctx(act):
+            dg = ctx.sig["delta"]
+            if d is None:
+                d = xp.empty((len(act), dg.shape[-1]))
+            d[[at[k] for k in ks]] = dg[pos]
         if d.shape[-1] > 1:
             e = d - xp.stack([self.sims[k]._delta0 for k in act])
             bad |= (e.max(axis=1) - e.min(axis=1)) > self.sims[act[0]].max_spread
@@ -668,7 +787,7 @@ class BatchSimulator:
                 if not c.due(t):
                     continue
                 sim = self.sims[k]
-                sim._ctx = _RowCtx(self._ctx, self._pos[k], sim.sys)   # what the measurement reads
+                sim._ctx = _RowCtx(*self._cx[k], sim.sys)   # what the measurement reads
                 try:
                     if getattr(c, "batched", False):
                         m = c.measurement(sim, t)
@@ -705,7 +824,8 @@ class BatchSimulator:
     def _solve_jump(self, t, rows, guesses, paths, fail):
         """Consistent network re-solve of members ``rows`` after a jump: the batched chord
         iteration, then each member's own :meth:`Simulator.solve_algebraic` for those whose
-        chord iteration did not converge (Newton, path following, continuation)."""
+        chord iteration did not converge (Newton, path following, continuation; ``paths[k]``:
+        the member's controllers and their held outputs, for :func:`_output_path`)."""
         if not rows:
             return
         nx = self.nx
@@ -717,13 +837,15 @@ class BatchSimulator:
         for k in rows:
             sim = self.sims[k]
             if k in done:
-                sim.z, F = done[k]
+                sim.z, F, self._cx[k] = done[k]
                 sim._f = F[:nx].copy()
                 continue
+            self._cx.pop(k, None)
             try:   # the member's own re-solve: its chord iteration again, then Newton and the rest
                 sim.t = t
+                p = paths.get(k)
                 z, F, sctx = sim.solve_algebraic(t, sim.z, return_eval=True, y_guess=guesses.get(k),
-                                                 path=paths.get(k))
+                                                 path=_output_path(*p) if p else None)
             except SimulationError as exc:
                 fail(k, exc)
                 continue
@@ -766,16 +888,18 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
     batch_size : int
         Largest number of members advanced together.
     exact : bool
-        Group the members so that each takes the steps of its one-by-one run (by
-        :func:`breakpoint_key`): results equal to one-by-one runs to round-off. ``False``
-        batches members whose breakpoints differ (they share the union of the breakpoints:
-        more, shorter steps; results differ from one-by-one runs by the step error).
+        Group the members by their breakpoints off the step grid (:func:`breakpoint_key`), so
+        that a batch's members take equal steps. ``False`` batches them regardless: each member
+        still takes the steps of its run alone (results equal to one-by-one runs to round-off
+        either way), members at different step sizes in separate Newton calls.
     on_failure : {"return", "raise"}
         A member's failure is in its ``Results.failure``; ``"raise"`` raises the first one after
         every member has run.
     stats : dict, optional
-        Filled with ``batches``, ``rerun`` (members re-run one by one), ``alone`` (members run
-        one by one from the start) and ``timing`` (summed :attr:`BatchSimulator.timing`).
+        Filled with ``batches``, ``steps`` (batched steps, :attr:`BatchSimulator.steps`),
+        ``halved`` (halved steps taken in the batch), ``rerun`` (members re-run one by one: a
+        step below ``min_step``), ``alone`` (members run one by one from the start) and
+        ``timing`` (summed :attr:`BatchSimulator.timing`).
     **sim_kw
         :class:`Simulator` keyword arguments (``dt``, ``tol``, ``record``, ...).
 
@@ -793,7 +917,7 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
     scenarios = [dict(s) for s in scenarios]
     dt = float(sim_kw.get("dt", 1 / 120))
     out = [None] * len(scenarios)
-    st = {"batches": 0, "rerun": 0, "alone": 0, "timing": dict.fromkeys(TIMED, 0.0)}
+    st = {"batches": 0, "steps": 0, "rerun": 0, "halved": 0, "alone": 0, "timing": dict.fromkeys(TIMED, 0.0)}
     groups = {}
     alone = []
     for i, sc in enumerate(scenarios):
@@ -818,6 +942,8 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
             bs = BatchSimulator(system, [scenarios[i] for i in part], **sim_kw)
             res, rerun = bs.run(t_end)
             st["batches"] += 1
+            st["halved"] += bs.halved
+            st["steps"] += bs.steps
             for key, v in bs.timing.items():
                 st["timing"][key] += v
             for j, i in enumerate(part):
