@@ -96,8 +96,9 @@ def test_run_file_round_trip(runs, tmp_path):
 
 
 @pytest.mark.parametrize("model, params, field", [
-    ("GENROU", dict(Sn=100, M=6.0, D=0.0, ra=0.0, xd=1.8, xq=1.7, xd1=0.3, xq1=0.55, xd2=0.25,
-                    xq2=0.25, xl=0.2, Td10=8.0, Tq10=0.4, Td20=0.03, Tq20=0.05), "GENROU"),
+    ("GENROE", dict(Sn=100, M=6.0, D=0.0, ra=0.0, xd=1.8, xq=1.7, xd1=0.3, xq1=0.55, xd2=0.25,
+                    xq2=0.25, xl=0.2, Td10=8.0, Tq10=0.4, Td20=0.03, Tq20=0.05, psse_shaft=0.0),
+     "GENROE"),
     ("GENCLS", dict(D=2.0), "D = 2"),
     ("GENCLS", dict(ra=0.01), "ra = 0.01"),
 ])
