@@ -2,7 +2,7 @@
 weakgrid.sim.emt.machine_controls).
 
 The SMIB of test_emt_dpsim.py with case 1's synchronous machine instead of the classical one:
-GENROU (case 1's data, unsaturated and without stator resistance: DPsim has neither) with
+GENROU (case 1's data, unsaturated: DPsim has no saturation) with
 case 1's EXDC2 exciter, TGOV1 governor and IEEEST stabilizer, a bolted three-phase fault at the
 machine bus from 0.1 s to 0.2 s. Oracles: the initial point is the power flow in every engine
 (DPsim's own initial field voltage equals weakgrid's ``vf0``); the electromechanical response
@@ -27,7 +27,7 @@ from weakgrid.sim.emt import simulate_dpsim  # noqa: E402
 
 pytestmark = pytest.mark.emt
 
-GEN = dict(Sn=100, M=6.0, D=0.0, ra=0.0, xl=0.15, xd=1.8, xq=1.7, xd1=0.3, xq1=0.55, xd2=0.25,
+GEN = dict(Sn=100, M=6.0, D=0.0, ra=0.003, xl=0.15, xd=1.8, xq=1.7, xd1=0.3, xq1=0.55, xd2=0.25,
            xq2=0.25, Td10=6.0, Td20=0.03, Tq10=0.4, Tq20=0.05, S10=0.0)
 EXC = dict(TR=0.01, TA=0.04, TC=1.0, TB=1.0, TE=0.8, TF1=1.0, KF1=0.03, KA=40.0, KE=1.0,
            VRMAX=7.3, VRMIN=-7.3, E1=2.8, SE1=0.04, E2=3.7, SE2=0.33)
@@ -123,7 +123,7 @@ def test_gensal_maps_without_q_transient_winding():
 
 @pytest.mark.parametrize("kw, match", [
     (dict(gen={**GEN, "S10": 0.05, "S12": 0.3}), "S10 = 0.05.*drop_saturation"),
-    (dict(gen={**GEN, "ra": 0.003}), "ra = 0.003"),
+    (dict(gen={**GEN, "D": 1.0}), "D = 1"),
     (dict(model="GENCLS", gen=dict(Sn=100, M=6.0, D=0.0, ra=0.0, xd1=0.25), governor=None,
           pss=None), "exciter EXDC2 on the classical machine"),
 ])

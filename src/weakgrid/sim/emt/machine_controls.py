@@ -8,7 +8,8 @@ TGOV1's). So weakgrid's own control components run here unchanged, stepped in Py
 
 * before DPsim step ``k`` (time ``t = k dt``) each control's :meth:`compute` is evaluated with
   the machine signals measured at ``t`` (after DPsim's step ``k - 1``): ``omega`` (``w_r``),
-  ``Pe = Vd Id + Vq Iq`` and ``Qe = Vq Id - Vd Iq`` (DPsim's ``Vdq0``, ``Idq0``), ``Vt`` and
+  ``Pe = Vd Id + Vq Iq - ra |I|²`` and ``Qe = Vq Id - Vd Iq`` at the bus (DPsim's ``Vdq0``,
+  ``Idq0``, inside the stator resistor), ``Vt`` and
   ``Ecomp`` (the terminal bus voltage magnitude), ``XadIfd = E'q + (Ld - Ld') Id`` (the field
   current of DPsim's model, from ``Edq0_t``); the bus voltages are the recorded phasors;
 * the controls' states advance by forward Euler over ``dt`` (DPsim's own shaft does the same),
@@ -92,6 +93,8 @@ class MachineControls:
         self.turbine = [(nm, g, m) for nm, g, m in self.gens if nm in by_kind["governor"]]
         self._bus = {nm: int(c.bus[i]) for c in system.components.values() if c.kind == "machine"
                      for i, nm in enumerate(c.names)}
+        self._ra = {nm: float(c.p["ra"][i]) for c in system.components.values()
+                    if c.kind == "machine" for i, nm in enumerate(c.names)}
         self._dL = {}
         for c in system.components.values():
             if c.kind == "machine":
@@ -135,7 +138,7 @@ class MachineControls:
             Vt = V[self._bus[nm]]
             sig["omega"][m] = g.attr("w_r").get()
             sig["delta"][m] = g.attr("delta").get()
-            sig["Pe"][m] = v[0] * i[0] + v[1] * i[1]
+            sig["Pe"][m] = v[0] * i[0] + v[1] * i[1] - self._ra[nm] * (i[0] ** 2 + i[1] ** 2)
             sig["Qe"][m] = v[1] * i[0] - v[0] * i[1]
             sig["Vt"][m] = sig["Ecomp"][m] = abs(Vt)
             sig["theta"][m] = np.angle(Vt)

@@ -63,9 +63,13 @@ Residual differences to weakgrid (stated, not hidden):
   unsaturated, and its power flow initialization is DPsim's own (unsaturated), so the field
   voltage ``Ef(0)`` differs from weakgrid's saturated ``vf0``.
 
+The stator resistance ``ra`` (DPsim's reduced-order machines have none) is a DPsim resistor
+between the machine and its bus: ``V = E'' - (ra + j x'') I`` is weakgrid's stator exactly,
+and DPsim's torque ``Vd Id + Vq Iq``, taken inside the resistor, the air-gap torque.
+
 Refused (DataError naming the model or the field): every other machine model (GENROE, GENSAE:
 exponential saturation, a model DPsim does not have), ``D != 0`` (DPsim's reduced-order
-machines have no damping term), ``ra != 0`` (no stator resistance parameter), ``psse_shaft = 1``
+machines have no damping term), ``psse_shaft = 1``
 (DPsim's shaft does not divide by the speed), ``S10 != 0`` (above), and an exciter on a GENCLS
 (the classical machine has no field voltage input). Exciters, governors and stabilizers run in
 weakgrid (:mod:`weakgrid.sim.emt.machine_controls`).
@@ -103,7 +107,7 @@ def check_machines(system, drop_saturation: bool = False) -> None:
             bad.append(f"{', '.join(c.names)}: machine model {c.type_name} (DPsim mapping exists "
                        f"for {', '.join(MACHINE_MAP)})")
             continue
-        why = {"D": "no damping term", "ra": "no stator resistance",
+        why = {"D": "no damping term",
                "psse_shaft": "the shaft 2H dw/dt = Tm - Te, not PSS/E's division by the speed"}
         if c.type_name in FIELD_MODELS and not drop_saturation:
             why["S10"] = ("no saturation; set S10 = 0, or pass drop_saturation=True to run the "
@@ -148,7 +152,7 @@ def dpsim_parameters(c, i):
             p["xd2"], p["xq2"], p["Td20"], p["Tq20"], 0.0)
 
 
-def build_machines(system, kit, nodes, Vpf):
+def build_machines(system, kit, nodes, Vpf, cir=None):
     """DPsim generators for the system's machines, connected to their bus nodes.
 
     Parameters
@@ -161,6 +165,9 @@ def build_machines(system, kit, nodes, Vpf):
         DPsim node per bus position.
     Vpf : ndarray of complex
         Power-flow bus voltages [V, line-to-line RMS phasors].
+    cir : weakgrid.sim.emt.topology.Circuit, optional
+        Receives the stator resistors and their internal nodes (needed when a machine has
+        ``ra > 0``).
 
     Returns
     -------
@@ -181,11 +188,37 @@ def build_machines(system, kit, nodes, Vpf):
             g = cls(nm, kit.d.LogLevel.off)
             g.set_operational_parameters_per_unit(Sb * 1e6, kv * 1e3, float(c.p["fn"][i]),
                                                   *dpsim_parameters(c, i))
-            s = complex(S[i]) * Sb * 1e6
-            g.set_initial_values(s, s.real, complex(Vpf[b]))
-            g.connect([nodes[b]])
+            node, Vt, s = nodes[b], complex(Vpf[b]), complex(S[i])
+            ra = float(c.p["ra"][i])
+            if ra > 0:
+                node, Vt, s = _stator_resistor(kit, cir, nm, nodes[b], Vt, s, ra, kv, Sb)
+            s = s * Sb * 1e6
+            g.set_initial_values(s, s.real, Vt)
+            g.connect([node])
             out[nm] = g
     return [(nm, out[nm]) for nm in system.machine_names if nm in out]
+
+
+def _stator_resistor(kit, cir, name, bus_node, Vt, S, ra, kv, Sb):
+    """The stator resistance ``ra`` [pu on Sb] as a DPsim resistor from an internal node (the
+    machine's own terminal) to its bus: ``V = E'' - (ra + j x'') I`` exactly, and DPsim's
+    ``Te = Vd Id + Vq Iq`` at the internal node is the air-gap power weakgrid's ``te`` is.
+
+    Returns the internal node, its power-flow voltage [V] and the air-gap power [pu on Sb].
+    """
+    if cir is None:
+        raise DataError(name, "ra", ra, "a stator resistance needs the circuit (build_machines(..., cir=))")
+    Vb = kv * 1e3
+    v = Vt / Vb
+    i = (S / v).conjugate()
+    v_int = v + ra * i
+    node = kit.node(f"{name}.int", v_int * Vb)
+    cir.extra_nodes.append(node)
+    res = kit.ph.Resistor(f"{name}.ra", kit.d.LogLevel.off)
+    res.set_parameters(kit.param(ra * kv ** 2 / Sb))
+    res.connect([node, bus_node])
+    cir.components.append(res)
+    return node, v_int * Vb, v_int * i.conjugate()
 
 
 def machine_bus(system) -> dict:

@@ -111,7 +111,7 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
     net = system.network
     cir = build_network(system, kit)
     bridge = UPQCBridge(system, kit, cir)
-    gens = build_machines(system, kit, cir.nodes, cir.Vpf)
+    gens = build_machines(system, kit, cir.nodes, cir.Vpf, cir)
     cir.components.extend(g for _, g in gens)
     mc = MachineControls(system, kit, gens, dt)
     mc.attach()
