@@ -38,6 +38,36 @@ def classical_smib(p=0.8, model="GENCLS", upqc_vmax=None, **params):
     return s
 
 
+#: case 1's synchronous machine and controls (src/weakgrid/data/studies/case1-weak-grid.toml), with
+#: the GENROU unsaturated (S10 = 0: DPsim has no saturation)
+CASE1_GENROU = dict(Sn=100, M=6.0, D=0.0, ra=0.003, xl=0.15, xd=1.8, xq=1.7, xd1=0.3, xq1=0.55,
+                    xd2=0.25, xq2=0.25, Td10=6.0, Td20=0.03, Tq10=0.4, Tq20=0.05, S10=0.0)
+CASE1_EXDC2 = dict(TR=0.01, TA=0.04, TC=1.0, TB=1.0, TE=0.8, TF1=1.0, KF1=0.03, KA=40.0, KE=1.0,
+                   VRMAX=7.3, VRMIN=-7.3, E1=2.8, SE1=0.04, E2=3.7, SE2=0.33)
+CASE1_TGOV1 = dict(R=0.05, VMAX=1.2, VMIN=0.0, T1=0.1, T2=0.5, T3=2.0, Dt=0.0)
+CASE1_IEEEST = dict(MODE=1, T1=0.15, T2=0.05, T3=0.15, T4=0.05, T5=2.0, T6=2.0, KS=10.0,
+                    LSMAX=0.1, LSMIN=-0.1)
+
+
+def machine_smib(model="GENROU", gen=None, exciter=("EXDC2", CASE1_EXDC2),
+                 governor=("TGOV1", CASE1_TGOV1), pss=("IEEEST", CASE1_IEEEST), p=0.8):
+    """The SMIB of :func:`classical_smib` with generator "G1" = ``model`` (case 1's GENROU by
+    default) and its exciter, governor and stabilizer (``None`` leaves one out); set up."""
+    from weakgrid.sim.sources import InfiniteBus
+    from weakgrid.sim.system import System
+
+    case = two_machine_case(x_line=0.3, p=p)
+    case["branch"][0, 2] = 0.01
+    s = System(case)
+    s.add_generator("G1", 0, (model, CASE1_GENROU if gen is None else gen), exciter=exciter,
+                    governor=governor, pss=pss)
+    src = InfiniteBus()
+    src.add_source("S2", 1)
+    s.add_component(src)
+    s.setup()
+    return s
+
+
 def gti_upqc_sg_case(p_gti=50.0):
     """GTI (bus 1) -- UPQC branch -- shunt bus r = 2 (load) -- line -- SG slack bus 3 (load)."""
     bus = np.array([

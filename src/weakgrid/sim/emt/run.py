@@ -8,6 +8,9 @@ Recorded signals (names as the phasor engine's where they exist):
   phasor; in EMT the space vector ``(2/3)(va + a vb + a² vc)`` taken to the synchronous frame
   (``e^{-j w t}``), equal to the phasor in balanced operation (a dc offset shows as a ripple
   at the nominal frequency);
+* ``<machine>.vf`` [pu], ``<machine>.tm`` [pu on Sb]: the field voltage and mechanical torque
+  weakgrid's exciter and governor hold over each step (machines with an exciter / a governor;
+  :mod:`weakgrid.sim.emt.machine_controls`);
 * EMT only, in addition: ``bus<id>.va``, ``.vb``, ``.vc`` [pu of the peak phase-to-ground base
   ``sqrt(2/3) kV``; SI: kV instantaneous], the three-phase instantaneous voltages.
 
@@ -30,6 +33,7 @@ from .controllers import _Loop, bind, sample_all
 from .dpsim_module import DOMAINS, Kit, domain_of
 from .events import build_events, removed_load, trip_terminals, tripped_machines
 from .gti import GTIBridge
+from .machine_controls import MachineControls
 from .machines import build_machines, check_machines
 from .topology import build_network, bus_base, check_devices
 from .upqc import UPQCBridge
@@ -41,7 +45,7 @@ __all__ = ["DOMAINS", "simulate_dpsim"]
 
 def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float = 1e-4,
                    events=(), controllers=(), decimate: int = 1, name: str = "weakgrid",
-                   gti_power: str = "measured") -> Results:
+                   gti_power: str = "measured", drop_saturation: bool = False) -> Results:
     """Simulate a set-up ``system`` in DPsim from ``t = 0`` to ``t_end`` [s].
 
     Parameters
@@ -71,6 +75,9 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
         ``t = 0, T, 2T, ...`` with its measurement reading DPsim's latest signals; a UPQC's
         series source and shunt converter follow the held output from the next step
         (zero-order hold).
+    drop_saturation : bool
+        Run GENROU/GENSAL machines with saturation (``S10 != 0``) unsaturated instead of
+        refusing them (DPsim's machines have no saturation; :mod:`weakgrid.sim.emt.machines`).
 
     Returns
     -------
@@ -89,7 +96,7 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
         raise DataError("simulate_dpsim", "dt", dt, f"must not exceed t_end = {t_end} s")
     if not (isinstance(decimate, int) and decimate >= 1):
         raise DataError("simulate_dpsim", "decimate", decimate, "must be an integer >= 1")
-    check_machines(system)
+    check_machines(system, drop_saturation)
     check_devices(system)
     net = system.network
     for c in system.components.values():
@@ -113,8 +120,10 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
     cir = build_network(system, kit, removed_load(system, events))
     bridge = UPQCBridge(system, kit, cir)
     gti = GTIBridge(system, kit, cir, power=gti_power)
-    gens = build_machines(system, kit, trip_terminals(system, kit, cir, events), cir.Vpf)
+    gens = build_machines(system, kit, trip_terminals(system, kit, cir, events), cir.Vpf, cir)
     cir.components.extend(g for _, g in gens)
+    mc = MachineControls(system, kit, gens, dt)
+    mc.attach()
     sw_events = build_events(system, kit, cir, events, dt)
     d = kit.d
     topo = d.SystemTopology(net.f_hz, cir.nodes + cir.extra_nodes, cir.components)
@@ -129,11 +138,12 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
         sim.add_event(ev)
     bound = bind(controllers, system, dt)
     loop = _Loop(system)
-    rec = _Recorder(system, kit, gens, cir, bridge, gti, tripped_machines(system, events))
+    rec = _Recorder(system, kit, gens, cir, bridge, gti, mc, tripped_machines(system, events))
     n_steps = int(round(t_end / dt))
     t0 = time.perf_counter()
     failure = None
     sim.start()
+    mc.start()
     rec.measure(0.0)
     rec.gti = gti.update(dt, rec._ph, rec.current, bridge.gti_draw(len(gti.items)))
     rec.add(0.0)
@@ -142,6 +152,8 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
         if bound and any((k - 1) % every == 0 for every, _ in bound):
             sample_all(bound, loop, k - 1, t, rec.latest())
         rec.upqc = bridge.update(t, rec.phasor, rec.current)
+        if mc.active:
+            mc.step(t, rec)
         sim.next()
         rec.measure(k * dt)
         if not np.isfinite(rec._ph).all():
@@ -161,9 +173,9 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
 class _Recorder:
     """Reads DPsim attributes after each step into weakgrid signal columns."""
 
-    def __init__(self, system, kit, gens, cir, bridge, gti, tripped=None):
+    def __init__(self, system, kit, gens, cir, bridge, gti, mc, tripped=None):
         net = system.network
-        self.kit, self.gens, self.nodes, self.bridge = kit, gens, cir.nodes, bridge
+        self.kit, self.gens, self.nodes, self.bridge, self.mc = kit, gens, cir.nodes, bridge, mc
         self.w = 2 * math.pi * net.f_hz
         Vb, _ = bus_base(system)
         self.Vb = Vb
@@ -187,6 +199,14 @@ class _Recorder:
             kinds.append(kind)
             fac.append(system.Sb if kind == "power" else 180 / math.pi if kind == "angle" else 1.0)
         self.gti = {n: 0.0 for n in self.gti_names}
+        for nm in mc.vf:
+            names.append(f"{nm}.vf")
+            kinds.append("pu")
+            fac.append(1.0)
+        for nm in mc.tm:
+            names.append(f"{nm}.tm")
+            kinds.append("power")
+            fac.append(system.Sb)
         if kit.three_phase:
             for b, bid in enumerate(net.bus_ids):
                 names += [f"bus{bid}.va", f"bus{bid}.vb", f"bus{bid}.vc"]
@@ -239,6 +259,7 @@ class _Recorder:
         for _, up, uq, vu, P in self.upqc:
             row += [up, uq, vu, P]
         row += [self.gti[n] for n in self.gti_names]
+        row += list(self.mc.vf.values()) + list(self.mc.tm.values())
         for abc in self._abc:
             row += list(abc)
         return row
