@@ -25,7 +25,7 @@ pytestmark = pytest.mark.emt
 T_END = 0.8
 
 
-def _study(engine, fault=False, gti_power=None):
+def _study(engine, fault=False, gti_power=None, drop_saturation=None):
     src = load_study("case1-weak-grid")
     d = copy.deepcopy(src.data)
     g = d["dynamics"]["generator"][0]
@@ -46,6 +46,8 @@ def _study(engine, fault=False, gti_power=None):
         d.setdefault("simulation", {})["engine"] = engine
     if gti_power is not None:
         d.setdefault("simulation", {})["gti_power"] = gti_power
+    if drop_saturation is not None:
+        d.setdefault("simulation", {})["drop_saturation"] = drop_saturation
     return study_from_dict(d, source=src.source)
 
 
@@ -104,15 +106,36 @@ def test_engine_field_is_validated():
 
 
 def test_unsupported_models_are_refused_before_any_run(tmp_path, capsys):
+    """Case 1's GENROU has saturation, which DPsim's machines lack: refused naming the field
+    and the study's way out, before anything is trained, run or written."""
     from weakgrid.cli.main import main
 
     out = tmp_path / "out"
     code = main(["run", "case1-weak-grid", "--engine", "dpsim-emt", "-o", str(out)])
     err = capsys.readouterr().err
     assert code != 0
-    for model in ("GENROU", "EXDC2", "TGOV1", "IEEEST"):
-        assert model in err, model
+    assert "GENROU S10" in err and "drop_saturation = true" in err
     assert not out.exists()                  # nothing trained, run or written
+
+
+def test_drop_saturation_is_the_studys_choice():
+    """[simulation] drop_saturation = true lets the planning check pass a saturated GENROU
+    (it is validated as a boolean); without it the check refuses it."""
+    from weakgrid.sim.emt import check_supported
+    from weakgrid.study.build import build_setup
+    from weakgrid.study.controllers import controller_variant
+    from weakgrid.study.runner import Run
+    from weakgrid.study.studyfile import load_study
+
+    st = load_study("case1-weak-grid")
+    sc = next(iter(st.scenarios()))
+    run = Run.of(st, sc, "none")
+    setup = build_setup(st, run.load, run.upqc, controller_variant(st, run.controller))
+    with pytest.raises(DataError, match="S10"):
+        check_supported(setup.system, (), "dpsim-dp")
+    check_supported(setup.system, (), "dpsim-dp", drop_saturation=True)
+    with pytest.raises(ParameterError, match="simulation.drop_saturation"):
+        _study("dpsim-dp", drop_saturation="yes")
 
 
 def test_engine_option_overrides_the_study():

@@ -559,6 +559,10 @@ _add(Table("simulation", "Numerical settings of every run of the study.", (
           "DPsim source delivered (energy-consistent), or the GTI model's own power at the "
           "measured voltage (blind to the coupling's current transients; documentation: "
           "Engines).", default="measured", choices=("measured", "model")),
+    Field("drop_saturation", B, "DPsim engines: run a GENROU or GENSAL whose data have "
+          "saturation (S10 ≠ 0) unsaturated — DPsim's machines have none — instead of refusing "
+          "it; the choice is the study's, written in its runs' parameters (documentation: "
+          "Engines).", default=False),
     Field("notes", LS, "Notes on the settings."),
 ), example='[simulation]\nrecord = ["*.omega", "bus*.v"]'))
 

@@ -152,7 +152,7 @@ def record_list(study, aliases: dict):
     """The simulator's ``record`` argument of a study's runs: ``None`` (every signal) unless
     ``[simulation] record`` selects some (names or fnmatch patterns); the signals the
     figures and metrics use (``aliases``) are always added."""
-    rec = (study.data.get("simulation") or {}).get("record")
+    rec = _sim(study).get("record")
     if rec is None:
         return None
     if isinstance(rec, str):
@@ -273,7 +273,7 @@ def _plausible_step(setup, e, w):
 
 def sim_engine(study) -> str:
     """The engine of ``study``'s runs: ``[simulation] engine`` (default ``"phasor"``)."""
-    return (study.data.get("simulation") or {}).get("engine") or "phasor"
+    return _sim(study).get("engine") or "phasor"
 
 
 def dpsim_measure(setup):
@@ -286,6 +286,11 @@ def dpsim_measure(setup):
     return sg_signals(setup.source, setup.shunt_bus)
 
 
+def _sim(study) -> dict:
+    """The study's ``[simulation]`` table (empty if it has none)."""
+    return study.data.get("simulation") or {}
+
+
 def check_engine(study, setup, events) -> None:
     """Refuse, before any run, a model or event of ``setup`` that ``study``'s engine cannot
     run (the DPsim engines: :func:`weakgrid.sim.emt.check_supported`; the phasor engine runs
@@ -294,7 +299,8 @@ def check_engine(study, setup, events) -> None:
     if engine != "phasor":
         from ..sim.emt import check_supported
 
-        check_supported(setup.system, events, engine)
+        check_supported(setup.system, events, engine,
+                        drop_saturation=_sim(study).get("drop_saturation", False))
 
 
 def sim_settings(study, dt_factor: float = 1.0) -> tuple[float, float | None]:
@@ -309,7 +315,7 @@ def sim_settings(study, dt_factor: float = 1.0) -> tuple[float, float | None]:
     step and the tolerance, and ``|m(T) − m(T/2)|`` measures the error of the study's
     setting, tolerance included.
     """
-    sim = study.data.get("simulation") or {}
+    sim = _sim(study)
     base = float(sim.get("dt") or study.data["design"]["T"])
     tol = sim.get("tol") if float(dt_factor) == 1.0 else None
     return base * float(dt_factor), (None if tol is None else float(tol))
@@ -374,8 +380,8 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
 
         dt = dpsim_step(dt)
         res = simulate_dpsim(setup.system, run.t_end, engine=engine, dt=dt, events=events,
-                             controllers=[dc], gti_power=(study.data.get("simulation") or {})
-                             .get("gti_power", "measured"))
+                             controllers=[dc], gti_power=_sim(study).get("gti_power", "measured"),
+                             drop_saturation=_sim(study).get("drop_saturation", False))
         if record is not None:
             res = res.subset([n for n in res.names if any(fnmatch.fnmatchcase(n, p)
                                                           for p in record)])
@@ -469,7 +475,9 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     info = {"design": setup.design.to_dict(), "derivation": setup.derivation.to_dict(),
             "controller": choice.info, "Sb_mva": setup.Sb_mva,
             "sim": {"dt": float(dt), "tol": None if tol is None else float(tol),
-                    "engine": engine}}
+                    "engine": engine,
+                    **({k: _sim(study)[k] for k in ("gti_power", "drop_saturation")
+                        if k in _sim(study)} if engine != "phasor" else {})}}
     return RunRecord(run, metrics, series, info, samples=flat_columns(samples), results=res,
                      aliases=aliases)
 

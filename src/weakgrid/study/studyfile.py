@@ -449,6 +449,10 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
             _choice(sim, "engine", "simulation", ENGINES)
         if "gti_power" in sim:
             _choice(sim, "gti_power", "simulation", ("measured", "model"))
+        if "drop_saturation" in sim and not isinstance(sim["drop_saturation"], bool):
+            raise ParameterError("simulation.drop_saturation", sim["drop_saturation"],
+                                 "give true (run saturated machines unsaturated in DPsim) or "
+                                 "false (refuse them)")
         if "tol" in sim:
             _num(sim, "tol", "simulation", positive=True)
             if not 1e-13 <= sim["tol"] <= 1e-4:

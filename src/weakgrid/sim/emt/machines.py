@@ -111,7 +111,7 @@ def check_machines(system, drop_saturation: bool = False) -> None:
                "psse_shaft": "the shaft 2H dw/dt = Tm - Te, not PSS/E's division by the speed"}
         if c.type_name in FIELD_MODELS and not drop_saturation:
             why["S10"] = ("no saturation; set S10 = 0, or pass drop_saturation=True to run the "
-                          "machine unsaturated")
+                          "machine unsaturated: in a study, [simulation] drop_saturation = true")
         for fld, reason in why.items():
             nz = [(nm, v) for nm, v in zip(c.names, c.p[fld]) if v != 0]
             if nz:

@@ -32,11 +32,13 @@ def dpsim_step(dt: float, dt_max: float = DT_MAX) -> float:
     return dt / math.ceil(dt / dt_max - 1e-9)
 
 
-def check_supported(system, events=(), engine: str = "dpsim-emt") -> None:
+def check_supported(system, events=(), engine: str = "dpsim-emt",
+                    drop_saturation: bool = False) -> None:
     """Raise :class:`DataError` if ``system`` (set up) or ``events`` has anything the DPsim
-    engine ``engine`` does not map (refused by name, never substituted)."""
+    engine ``engine`` does not map (refused by name, never substituted); ``drop_saturation``
+    as in :func:`weakgrid.sim.emt.simulate_dpsim`."""
     domain_of(engine)
-    check_machines(system)
+    check_machines(system, drop_saturation)
     check_devices(system)
     net = system.network
     check_network(system, removed_load(system, events))
