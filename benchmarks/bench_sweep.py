@@ -68,6 +68,7 @@ ratios themselves are noisy: 0.75x-1.72x), the engine before (``--dask-defaults`
 
 Run:  PYTHONPATH=src python benchmarks/bench_sweep.py [n_ratings] [--dask-defaults]
       PYTHONPATH=src python benchmarks/bench_sweep.py --study [--repeats N] [--workers W]
+          [--only sweep|reproduce]
 
 ``--study``: the commands users wait for, batched against the scalar path (issue #21), each
 pair measured in one run of this script, a fresh output folder and cache each time, each in a
@@ -372,13 +373,15 @@ def _same_table(a, b):
         return False
 
 
-def study_commands(repeats=1, workers=2):
+def study_commands(repeats=1, workers=2, only=None):
     """The case-1 quick sweep and ``reproduce --quick``, scalar against batched (see the
     module's text); prints the medians and ratios."""
     print(f"== study commands, scalar vs batched, {workers} workers, medians of {repeats} ==")
     print(f"load average before: {os.getloadavg()}  (cores: {os.cpu_count()})")
     for label, fn in (("case-1 quick sweep (12 runs)", _case1_quick_sweep),
                       ("reproduce --quick", _reproduce_quick)):
+        if only and only not in label:
+            continue
         times = {"scalar": [], "batched": []}
         same = True
         for k in range(repeats):
@@ -403,7 +406,8 @@ def _option(name, default):
 
 if __name__ == "__main__":
     if "--study" in sys.argv:
-        study_commands(_option("--repeats", 1), _option("--workers", 2))
+        only = sys.argv[sys.argv.index("--only") + 1] if "--only" in sys.argv else None
+        study_commands(_option("--repeats", 1), _option("--workers", 2), only)
         sys.exit(0)
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     main(int(args[0]) if args else 8, dask_defaults="--dask-defaults" in sys.argv)
