@@ -403,14 +403,16 @@ def prepare_run(study, run: Run, trained=None, dt=None, design_load=None, design
                     record_list(study, setup.signals), xs, ys)
 
 
-def simulate_prepared(preps, batched: bool = True) -> list:
+def simulate_prepared(preps, batched: bool = True, stats: dict | None = None) -> list:
     """Simulate prepared runs (:func:`prepare_run`); ``[(Results, wall [s])]`` in order.
 
     ``batched``: the runs with equal :meth:`Prepared.sim_key` go to one
     :func:`weakgrid.sim.batch.simulate_batch` call (members equal their one-by-one runs to
     round-off; a failed member keeps its own failure; the wall time of a batch is shared
     equally by its members); otherwise each is simulated alone. A run that fails returns its
-    failure in ``Results.failure``."""
+    failure in ``Results.failure``. ``stats``: filled with the batches' statistics summed
+    (:func:`weakgrid.sim.batch.simulate_batch`: ``batches``, ``rerun``, ``alone``, ``timing``).
+    """
     from ..sim.batch import simulate_batch
 
     out = [None] * len(preps)
@@ -425,9 +427,18 @@ def simulate_prepared(preps, batched: bool = True) -> list:
                             events=p0.events, controllers=[p0.dc], on_failure="return",
                             record=p0.record)]
         else:
+            st: dict = {}
             res = simulate_batch(p0.setup.system, [preps[i].scenario() for i in rows],
                                  p0.run.t_end, batch_size=len(rows), dt=p0.dt, tol=p0.tol,
-                                 record=p0.record, on_failure="return")
+                                 record=p0.record, on_failure="return", stats=st)
+            if stats is not None:
+                for k, v in st.items():
+                    if isinstance(v, dict):
+                        acc = stats.setdefault(k, {})
+                        for kk, vv in v.items():
+                            acc[kk] = acc.get(kk, 0.0) + vv
+                    else:
+                        stats[k] = stats.get(k, 0) + v
         wall = (time.perf_counter() - t0) / len(rows)
         for i, r in zip(rows, res):
             out[i] = (r, wall)
