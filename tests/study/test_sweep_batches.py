@@ -123,3 +123,27 @@ def test_a_studys_runs_simulated_together_equal_their_runs_alone():
             for k in d_a:
                 np.testing.assert_allclose(d_b[k], d_a[k], rtol=1e-8, atol=1e-10)
     assert together[0].metrics["speed_peak_dev_pu"] != together[3].metrics["speed_peak_dev_pu"]
+
+
+def test_a_member_rerun_alone_keeps_the_samples_of_its_own_run():
+    """A batch member whose step had to be halved is re-run alone: its controller's log starts
+    again, while the policy's own log of design states still holds the batched attempt's
+    samples before the rerun's. The record takes the rerun's (the last ones), as alone."""
+    import numpy as np
+
+    from weakgrid.study.runner import Run, finish_run, prepare_run, simulate_prepared
+
+    st = load_study("case1-weak-grid")
+    sc = dict(next(s for s in st.scenarios() if s["id"] == "c1-high-conv"), t_end=0.35)
+    run = Run.of(st, sc, "nonlinear-29")
+    prep = prepare_run(st, run)
+    res, wall = simulate_prepared([prep], batched=False)[0]
+    ref = finish_run(prep, res, wall)
+    n = len(prep.xs)
+    assert n > 10
+    prep.xs[:0] = [x + 1.0 for x in prep.xs[: n // 2]]      # an abandoned batched attempt
+    prep.ys[:0] = [y + 1.0 for y in prep.ys[: n // 2]]
+    again = finish_run(prep, res, wall)
+    for k in ("x_design[0]", "x_design[1]", "y_measured[0]", "running_cost"):
+        np.testing.assert_array_equal(again.samples[k], ref.samples[k])
+    assert again.metrics["running_cost_18"] == ref.metrics["running_cost_18"]
