@@ -811,14 +811,21 @@ def breakpoint_key(scenario, dt):
     as alone."""
     from .events import flatten
 
-    off = []
-    for ev in flatten(list(scenario.get("events", ()))):
-        q = ev.t / dt
-        if abs(q - round(q)) > 1e-9 * max(1.0, abs(q)):
-            off.append(round(ev.t, 12))
+    off = off_grid([ev.t for ev in flatten(list(scenario.get("events", ())))], dt)
     ctl = tuple(sorted((round(getattr(c, "T", 0.0), 12), round(getattr(c, "t0", 0.0), 12))
                        for c in scenario.get("controllers", ())))
-    return tuple(sorted(set(off))), ctl
+    return off, ctl
+
+
+def off_grid(times, dt) -> tuple:
+    """The instants of ``times`` [s] that are not multiples of the step ``dt`` [s], sorted,
+    rounded to 1e-12 s (what separates members in :func:`breakpoint_key`)."""
+    off = set()
+    for t in times:
+        q = t / dt
+        if abs(q - round(q)) > 1e-9 * max(1.0, abs(q)):
+            off.add(round(t, 12))
+    return tuple(sorted(off))
 
 
 def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failure="return",

@@ -2,11 +2,12 @@
 
 A batched simulator (:func:`weakgrid.sim.batch.simulate_batch`) advances many scenarios of the
 same grid at once (issue #21). A sweep hands it the runs that share :func:`batch_key` — the
-study, the load level and UPQC structure of the run's scenario, the simulated time and the
-step factor — and they may differ in anything else: the UPQC rating (a batchable parameter of
-the device, :attr:`weakgrid.sim.component.Component.batch_params`), fault times, the
-controller and the load it is designed at. Members whose grids still differ (a controller
-that takes the UPQC out: the PQ baseline) are put in separate batches by the simulator.
+study, the load level and UPQC structure of the run's scenario, the grid variant of its
+controller (the PQ and no-PSS baselines change the grid), the simulated time, the step factor
+and the event times off the step grid (members step together) — and they may differ in
+anything else: the UPQC rating (a batchable parameter of the device,
+:attr:`weakgrid.sim.component.Component.batch_params`), fault times on the step grid, the
+controller and the load it is designed at.
 
 :func:`simulate_many` prepares every run of a batch (its grid, events and digital
 controller: :func:`weakgrid.study.sweep.prepare_point`), simulates them together
@@ -25,20 +26,41 @@ import os
 
 from ..dotted import get_path
 
-__all__ = ["batch_key", "simulate_many", "batch_size_for", "STUDY_BATCHES"]
+__all__ = ["batch_key", "event_breakpoints", "simulate_many", "batch_size_for",
+           "STUDY_BATCHES"]
 
 log = logging.getLogger(__name__)
 
 
 def batch_key(inputs: dict) -> tuple:
-    """The grid a sweep run (the input of :func:`weakgrid.study.sweep.run_point`) needs:
-    ``(study name, scenario's load level, UPQC structure, t_end [s], step factor)``. Runs
-    with equal keys share one batched simulation."""
+    """The grid and the steps a sweep run (the input of :func:`weakgrid.study.sweep.run_point`)
+    needs: ``(study name, scenario's load level, UPQC structure, the controller's grid variant,
+    t_end [s], step factor, event times off the step grid)``. Runs with equal keys share one
+    batched simulation, in lockstep."""
+    from types import SimpleNamespace
+
+    from .controllers import controller_variant
+
     study = inputs["study"]
     sc = get_path(study, f"scenarios.{inputs['scenario']}")
     t_end = inputs.get("t_end") or sc.get("t_end")
+    factor = float(inputs.get("dt_factor") or 1.0)
+    sim = study.get("simulation") or {}
+    dt = float(sim.get("dt") or study["design"]["T"]) * factor   # as runner.sim_settings
     return (study["study"]["name"], sc.get("load"), sc.get("upqc"),
-            None if t_end is None else float(t_end), float(inputs.get("dt_factor") or 1.0))
+            controller_variant(SimpleNamespace(data=study), inputs["controller"]),
+            None if t_end is None else float(t_end), factor,
+            event_breakpoints(sc.get("events") or (), dt))
+
+
+def event_breakpoints(events, dt: float) -> tuple:
+    """The times [s] of a study scenario's events (``t_on``, ``t_off``, ``t``) off the step
+    grid ``dt`` [s] (:func:`weakgrid.sim.batch.off_grid`): runs whose off-grid times differ
+    do not step together, so they are batched apart."""
+    from ..sim.batch import off_grid
+
+    return off_grid([float(e[k]) for e in events for k in ("t_on", "t_off", "t")
+                     if isinstance(e, dict) and e.get(k) is not None], dt)
 
 
 def simulate_many(runs: list) -> list:

@@ -165,14 +165,16 @@ def _run_batch_task(study, runs, trained):
 
 def _run_batches(todo, workers):
     """``todo`` (study, run, trained, key) in batches of runs that can share a batched
-    simulation (one study, load level, UPQC structure and final time), at least one batch
-    per worker (:func:`weakgrid.study.batches.batch_size_for`); lists of rows of ``todo``."""
+    simulation (one study, load level, UPQC structure, grid variant, final time and event
+    times off the step grid), at least one batch per worker (:func:`weakgrid.study.batches.batch_size_for`); lists of rows of ``todo``."""
     from ..sweep import group
-    from .batches import batch_size_for
+    from .batches import batch_size_for, event_breakpoints
+    from .runner import sim_settings
 
     def key(item):
         st, run, _, _ = item
-        return (id(st), run.load, run.upqc, run.t_end)
+        return (id(st), run.load, run.upqc, controller_variant(st, run.controller), run.t_end,
+                event_breakpoints(run.events, sim_settings(st)[0]))
     return [list(b.rows) for b in group(todo, key, batch_size_for(len(todo), workers))]
 
 
