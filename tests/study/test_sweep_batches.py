@@ -149,3 +149,30 @@ def test_a_member_rerun_alone_keeps_the_samples_of_its_own_run():
     for k in ("x_design[0]", "x_design[1]", "y_measured[0]", "running_cost"):
         np.testing.assert_array_equal(again.samples[k], ref.samples[k])
     assert again.metrics["running_cost_18"] == ref.metrics["running_cost_18"]
+
+
+def test_a_batch_whose_simulator_raises_runs_its_members_one_by_one(monkeypatch):
+    """Not a member's failure (those are in its Results): the batch's runs are simulated one
+    by one instead, each with its own row as in the scalar path."""
+    import weakgrid.sim.batch as batch
+    from weakgrid.study.batches import simulate_many
+    from weakgrid.study.sweep import run_point
+
+    pts = [p.inputs for p in sweep_points(_failing_sweep(), quick=True)
+           if p.params["controller"] == "nonlinear-29"][:2]
+    want = [run_point(i) for i in pts]
+
+    def broken(*a, **k):
+        raise RuntimeError("no batch today")
+
+    monkeypatch.setattr(batch, "simulate_batch", broken)
+    got = simulate_many(pts)
+    for w, g in zip(want, got):
+        w, g = dict(w), dict(g)
+        w.pop("sim_wall_s"), g.pop("sim_wall_s")
+        assert g.keys() == w.keys()
+        for k, v in w.items():
+            if isinstance(v, float):
+                assert g[k] == pytest.approx(v, rel=1e-12, abs=0, nan_ok=True), k
+            else:
+                assert g[k] == v, k
