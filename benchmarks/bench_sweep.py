@@ -68,6 +68,7 @@ ratios themselves are noisy: 0.75x-1.72x), the engine before (``--dask-defaults`
 
 Run:  PYTHONPATH=src python benchmarks/bench_sweep.py [n_ratings] [--dask-defaults]
       PYTHONPATH=src python benchmarks/bench_sweep.py --study [--repeats N] [--workers W]
+          [--only sweep|reproduce|breakdown]
 
 ``--study``: the commands users wait for, batched against the scalar path (issue #21), each
 pair measured in one run of this script, a fresh output folder and cache each time, each in a
@@ -76,15 +77,15 @@ alternated between repeats, medians of ``--repeats`` (default 1):
 
 * the case-1 quick sweep (``weakgrid sweep case1-weak-grid --quick``: 12 runs) on ``W``
   workers (default 2; 0 = serially in this process);
-* ``weakgrid reproduce --quick`` (its runs, trainings, figures, report and the maps' sweeps).
+* ``weakgrid reproduce --quick`` (its runs, trainings, figures, report and the maps' sweeps);
+* ``--only breakdown``: where a batch's time goes, in this process (prepare, simulate one by
+  one and together, finish; the batched step's parts).
 
 The scalar path is one task per run (:func:`weakgrid.sweep.execute`); the batched path groups
 a sweep's runs by grid (:func:`weakgrid.study.batches.batch_key`) and hands each batch to
-:func:`weakgrid.study.batches.simulate_many`, a task per batch — today a loop over the batch's
-runs, so the two measure the same simulations (the ratio shows the cost of batching the
-tasks); once ``simulate_many`` advances a batch in one simulator pass, the same command
-measures the batched simulator's gain. The tables of both paths are checked equal (times
-aside).
+:func:`weakgrid.study.batches.simulate_many`, a task per batch, which simulates the batch's
+runs in one :func:`weakgrid.sim.batch.simulate_batch` pass (the ratings as per-member
+parameters). The tables of both paths are checked equal (times aside).
 
 ``--dask-defaults``: the cluster with Dask's default settings and the runs in the sweep's
 order (the engine before the changes above), for a comparison on the same machine.
@@ -372,13 +373,15 @@ def _same_table(a, b):
         return False
 
 
-def study_commands(repeats=1, workers=2):
+def study_commands(repeats=1, workers=2, only=None):
     """The case-1 quick sweep and ``reproduce --quick``, scalar against batched (see the
     module's text); prints the medians and ratios."""
     print(f"== study commands, scalar vs batched, {workers} workers, medians of {repeats} ==")
     print(f"load average before: {os.getloadavg()}  (cores: {os.cpu_count()})")
     for label, fn in (("case-1 quick sweep (12 runs)", _case1_quick_sweep),
                       ("reproduce --quick", _reproduce_quick)):
+        if only and only not in label:
+            continue
         times = {"scalar": [], "batched": []}
         same = True
         for k in range(repeats):
@@ -395,6 +398,44 @@ def study_commands(repeats=1, workers=2):
     print(f"load average after: {os.getloadavg()}")
 
 
+def batch_breakdown(repeats=3):
+    """Where a batch's time goes, in this process: the high-load half of the case-1 quick
+    sweep (6 runs: 2 ratings × 3 controllers, one batch of the batched sweep) prepared (grid,
+    events, controller; the trained controllers are built once before), simulated one by one
+    and together, finished (metrics); medians of ``repeats``, and the batched step's parts."""
+    from weakgrid.study.runner import simulate_prepared
+    from weakgrid.study.sweep import finish_point, prepare_point
+
+    pts = [p.inputs for p in sweep_points(load_study("case1-weak-grid"), quick=True)
+           if p.params["scenarios.c1-high-conv.load"] == "high"]
+    [prepare_point(i) for i in pts]            # the trainings and design models, once
+    out = {"prepare": [], "scalar": [], "batched": [], "finish": []}
+    stats = {}
+    for k in range(repeats):
+        for path in ("scalar", "batched")[::1 if k % 2 == 0 else -1]:
+            t0 = time.perf_counter()
+            preps = [prepare_point(i) for i in pts]
+            t1 = time.perf_counter()
+            sims = simulate_prepared(preps, batched=path == "batched",
+                                     stats=stats if path == "batched" else None)
+            t2 = time.perf_counter()
+            [finish_point(i, p, *s) for i, p, s in zip(pts, preps, sims)]
+            t3 = time.perf_counter()
+            out["prepare"].append(t1 - t0)
+            out[path].append(t2 - t1)
+            out["finish"].append(t3 - t2)
+    med = {k: statistics.median(v) for k, v in out.items()}
+    print(f"== one batch of the case-1 quick sweep ({len(pts)} runs), in one process, medians "
+          f"of {repeats} ==")
+    print(f"prepare {med['prepare']:.2f} s, simulate one by one {med['scalar']:.2f} s, "
+          f"together {med['batched']:.2f} s ({med['scalar'] / med['batched']:.2f}x), finish "
+          f"{med['finish']:.2f} s")
+    tim = stats.get("timing", {})
+    tot = sum(tim.values()) or 1.0
+    print("batched step, share of its timed parts: " + ", ".join(
+        f"{k} {v / repeats:.2f} s ({100 * v / tot:.0f} %)" for k, v in tim.items()))
+
+
 def _option(name, default):
     if name in sys.argv:
         return int(sys.argv[sys.argv.index(name) + 1])
@@ -403,7 +444,11 @@ def _option(name, default):
 
 if __name__ == "__main__":
     if "--study" in sys.argv:
-        study_commands(_option("--repeats", 1), _option("--workers", 2))
+        only = sys.argv[sys.argv.index("--only") + 1] if "--only" in sys.argv else None
+        if only == "breakdown":
+            batch_breakdown(_option("--repeats", 3))
+        else:
+            study_commands(_option("--repeats", 1), _option("--workers", 2), only)
         sys.exit(0)
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     main(int(args[0]) if args else 8, dask_defaults="--dask-defaults" in sys.argv)

@@ -4,6 +4,7 @@ the case-1 quick sweep, and a batched sweep's table equal to the one-by-one swee
 import copy
 
 import pandas as pd
+import pytest
 
 from weakgrid.study.batches import batch_key
 from weakgrid.study.studyfile import load_study, study_from_dict
@@ -13,22 +14,23 @@ from weakgrid.sweep import group
 TIMES = ["wall_s", "sim_wall_s"]
 
 
-def test_the_case1_quick_sweep_is_one_batch_per_load_and_controller():
+def test_the_case1_quick_sweep_is_one_batch_per_load():
+    """The ratings and the controllers of one load share a batch (the rating is a per-member
+    parameter of the batched simulator); the two loads are two grids."""
     st = load_study("case1-weak-grid")
     pts = sweep_points(st, quick=True)
     batches = group(pts, key=lambda p: batch_key(p.inputs))
     load = "scenarios.c1-high-conv.load"
-    assert len(pts) == 12 and len(batches) == 6
+    assert len(pts) == 12 and len(batches) == 2
     for b in batches:
         members = [pts[i].params for i in b.rows]
-        assert len({(m[load], m["controller"]) for m in members}) == 1
-        assert sorted(m["upqc.rating"] for m in members) == [0.15, 0.6]
-        name, run_load, upqc, ctl, *_ = b.key
-        assert (name, run_load, ctl) == ("case1-weak-grid", members[0][load],
-                                         members[0]["controller"])
-        assert upqc == "conventional"
-    assert [pts[b.rows[0]].params["controller"] for b in batches[:3]] == \
-        ["hji", "nonlinear-29", "hji-bounded"]          # the sweep's order
+        assert len({m[load] for m in members}) == 1
+        assert sorted({m["upqc.rating"] for m in members}) == [0.15, 0.6]
+        assert sorted({m["controller"] for m in members}) == \
+            sorted(["hji", "nonlinear-29", "hji-bounded"])
+        name, run_load, upqc, *_ = b.key
+        assert (name, run_load, upqc) == ("case1-weak-grid", members[0][load], "conventional")
+    assert [pts[b.rows[0]].params[load] for b in batches] == ["high", "low"]   # sweep order
 
 
 def test_a_batched_study_sweep_gives_the_scalar_table(tmp_path):
@@ -39,8 +41,138 @@ def test_a_batched_study_sweep_gives_the_scalar_table(tmp_path):
                              "t_end": 0.4})
     d["sweep"].pop("maps", None)
     st = study_from_dict(d)
-    scalar = run_study_sweep(st, tmp_path / "scalar", quick=True, workers=0, progress=False)
+    scalar = run_study_sweep(st, tmp_path / "scalar", quick=True, workers=0, progress=False,
+                             batched=False)
     batched = run_study_sweep(st, tmp_path / "batched", quick=True, workers=0, progress=False,
                               batched=True)
     assert len(scalar) == 4
     pd.testing.assert_frame_equal(scalar.drop(columns=TIMES), batched.drop(columns=TIMES))
+
+
+def _failing_sweep():
+    """Case 1, two controllers (the PQ baseline takes the UPQC out: another grid), points
+    that run, one whose fault has no network solution (Newton) and one whose grid collapses
+    under the (29) controller, two ratings."""
+    d = copy.deepcopy(load_study("case1-weak-grid").data)
+    d["sweep"].pop("maps", None)
+    ev = "scenarios.c1-high-conv.events.0"
+    d["sweep"].update(mode="points", controllers=["nonlinear-29", "pq"], quick={
+        "t_end": 0.4, "axes": {"upqc.rating": [0.15, 0.6, 0.15, 0.6],
+                               f"{ev}.bus": [3, 3, 4, 4], f"{ev}.xf": [0.1, 0.1, 0.005, 0.1],
+                               f"{ev}.t_off": [0.25, 0.25, 0.25, 0.35]}})
+    return study_from_dict(d)
+
+
+def test_a_batched_sweep_with_failing_members_gives_the_scalar_tables(tmp_path, monkeypatch):
+    """The table (and its Parquet file) of the batched sweep equals the scalar one's, failed
+    rows and their causes included; the runs of one grid were simulated together."""
+    import weakgrid.sim.batch as batch
+
+    sizes = []
+    real = batch.simulate_batch
+
+    def counting(system, scenarios, *a, **kw):
+        sizes.append(len(scenarios))
+        return real(system, scenarios, *a, **kw)
+
+    st = _failing_sweep()
+    scalar = run_study_sweep(st, tmp_path / "scalar", quick=True, workers=0, progress=False,
+                             batched=False)
+    assert sizes == []
+    monkeypatch.setattr(batch, "simulate_batch", counting)
+    batched = run_study_sweep(st, tmp_path / "batched", quick=True, workers=0, progress=False)
+    # one call per grid variant (the PQ baseline has no UPQC) and fault clearing time off the
+    # step grid (0.25 s: 3 points; 0.35 s: 1 point, simulated alone)
+    assert sorted(sizes) == [3, 3]
+    assert len(scalar) == 8
+    failed = scalar[scalar["status"] == "failed"]
+    causes = " ".join(failed["failure"])
+    assert len(failed) == 3 and "newton" in causes and "voltage collapse" in causes
+    pd.testing.assert_frame_equal(scalar.drop(columns=TIMES), batched.drop(columns=TIMES),
+                                  rtol=1e-8)
+    files = [pd.read_parquet(p / f"{st.name}-sweep-quick.parquet")
+             for p in (tmp_path / "scalar", tmp_path / "batched")]
+    pd.testing.assert_frame_equal(files[0].drop(columns=TIMES), files[1].drop(columns=TIMES),
+                                  rtol=1e-8)
+
+
+def test_a_studys_runs_simulated_together_equal_their_runs_alone():
+    """`weakgrid run`/`reproduce`'s path (run_scenarios): the records of runs of one study
+    simulated in batches are those of the runs alone (metrics, series, controller samples);
+    the three controllers make three grids (UPQC, PQ baseline, no PSS)."""
+    import numpy as np
+
+    from weakgrid.study.runner import Run, run_scenarios
+
+    st = load_study("case1-weak-grid")
+    sc = dict(next(s for s in st.scenarios() if s["id"] == "c1-high-conv"), t_end=0.4)
+    runs = [Run.of(st, sc, c) for c in ("nonlinear-29", "pq", "none")]
+    runs.append(Run.of(st, dict(sc, events=[dict(sc["events"][0], t_off=0.3)]),
+                       "nonlinear-29"))
+    alone = run_scenarios(st, runs, batched=False)
+    together = run_scenarios(st, runs, batched=True)
+    for a, b in zip(alone, together):
+        ma, mb = (dict(r.metrics) for r in (a, b))
+        ma.pop("wall_s"), mb.pop("wall_s")
+        assert ma.keys() == mb.keys()
+        for k in ma:
+            if isinstance(ma[k], float):
+                assert mb[k] == pytest.approx(ma[k], rel=1e-8, abs=1e-12, nan_ok=True), k
+            else:
+                assert mb[k] == ma[k], k
+        for d_a, d_b in ((a.series, b.series), (a.samples, b.samples)):
+            assert d_a.keys() == d_b.keys()
+            for k in d_a:
+                np.testing.assert_allclose(d_b[k], d_a[k], rtol=1e-8, atol=1e-10)
+    assert together[0].metrics["speed_peak_dev_pu"] != together[3].metrics["speed_peak_dev_pu"]
+
+
+def test_a_member_rerun_alone_keeps_the_samples_of_its_own_run():
+    """A batch member whose step had to be halved is re-run alone: its controller's log starts
+    again, while the policy's own log of design states still holds the batched attempt's
+    samples before the rerun's. The record takes the rerun's (the last ones), as alone."""
+    import numpy as np
+
+    from weakgrid.study.runner import Run, finish_run, prepare_run, simulate_prepared
+
+    st = load_study("case1-weak-grid")
+    sc = dict(next(s for s in st.scenarios() if s["id"] == "c1-high-conv"), t_end=0.35)
+    run = Run.of(st, sc, "nonlinear-29")
+    prep = prepare_run(st, run)
+    res, wall = simulate_prepared([prep], batched=False)[0]
+    ref = finish_run(prep, res, wall)
+    n = len(prep.xs)
+    assert n > 10
+    prep.xs[:0] = [x + 1.0 for x in prep.xs[: n // 2]]      # an abandoned batched attempt
+    prep.ys[:0] = [y + 1.0 for y in prep.ys[: n // 2]]
+    again = finish_run(prep, res, wall)
+    for k in ("x_design[0]", "x_design[1]", "y_measured[0]", "running_cost"):
+        np.testing.assert_array_equal(again.samples[k], ref.samples[k])
+    assert again.metrics["running_cost_18"] == ref.metrics["running_cost_18"]
+
+
+def test_a_batch_whose_simulator_raises_runs_its_members_one_by_one(monkeypatch):
+    """Not a member's failure (those are in its Results): the batch's runs are simulated one
+    by one instead, each with its own row as in the scalar path."""
+    import weakgrid.sim.batch as batch
+    from weakgrid.study.batches import simulate_many
+    from weakgrid.study.sweep import run_point
+
+    pts = [p.inputs for p in sweep_points(_failing_sweep(), quick=True)
+           if p.params["controller"] == "nonlinear-29"][:2]
+    want = [run_point(i) for i in pts]
+
+    def broken(*a, **k):
+        raise RuntimeError("no batch today")
+
+    monkeypatch.setattr(batch, "simulate_batch", broken)
+    got = simulate_many(pts)
+    for w, g in zip(want, got):
+        w, g = dict(w), dict(g)
+        w.pop("sim_wall_s"), g.pop("sim_wall_s")
+        assert g.keys() == w.keys()
+        for k, v in w.items():
+            if isinstance(v, float):
+                assert g[k] == pytest.approx(v, rel=1e-12, abs=0, nan_ok=True), k
+            else:
+                assert g[k] == v, k

@@ -123,6 +123,14 @@ def add_cluster_arguments(p):
                         "local cluster")
 
 
+def add_batch_argument(p):
+    """``--no-batch``: simulate every run alone (the scalar path) instead of the runs of one
+    grid together (:mod:`weakgrid.sim.batch`; the same results, the comparison's baseline)."""
+    p.add_argument("--no-batch", dest="batched", action="store_false",
+                   help="simulate every run alone (one task per run), not the runs of one "
+                        "grid together in batches (the default; the same results)")
+
+
 _SCHEMES = ("tcp", "tls", "ucx", "ws", "wss")
 
 

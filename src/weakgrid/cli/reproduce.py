@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import (HelpFormatter, add_cluster_arguments, add_force_argument, check_cluster,
+from ._common import (HelpFormatter, add_batch_argument, add_cluster_arguments,
+                      add_force_argument, check_cluster,
                       output_folder, show_progress)
 
 NAME = "reproduce"
@@ -24,6 +25,7 @@ def add_parser(sub):
     p.add_argument("--quick", action="store_true",
                    help="shorter runs and the essential subset of scenarios")
     add_cluster_arguments(p)
+    add_batch_argument(p)
     add_force_argument(p, overwrite="files in the output folder", limits=False)
     p.set_defaults(func=run)
     return p
@@ -35,7 +37,8 @@ def run(args) -> int:
 
     check_cluster(args)
     summary = reproduce(args.output, quick=args.quick, scheduler=args.scheduler,
-                        workers=args.workers, progress=show_progress(args), force=args.force)
+                        workers=args.workers, progress=show_progress(args), force=args.force,
+                        batched=args.batched)
     width = max((len(c["id"]) for c in summary["claims"]), default=0)
     print("\nclaims of the paper:")
     for c in summary["claims"]:

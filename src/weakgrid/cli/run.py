@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import (HelpFormatter, add_cluster_arguments, add_force_argument, check_cluster,
+from ._common import (HelpFormatter, add_batch_argument, add_cluster_arguments,
+                      add_force_argument, check_cluster,
                       output_folder)
 
 from ._common import show_progress
@@ -32,6 +33,7 @@ def add_parser(sub):
     p.add_argument("--list", action="store_true", help="list the shipped studies")
     add_engine_argument(p)
     add_cluster_arguments(p)
+    add_batch_argument(p)
     add_force_argument(p, overwrite="files in the output folder", limits=False)
     p.set_defaults(func=run)
     return p
@@ -58,7 +60,8 @@ def run(args) -> int:
     out = args.output or Path(f"{st.name}-output")
     summary = run_studies([st], out, quick=args.quick, title=st.data["study"]["title"] or st.name,
                           scheduler=args.scheduler, workers=args.workers,
-                          progress=show_progress(args), force=args.force)
+                          progress=show_progress(args), force=args.force,
+                          batched=args.batched)
     for d in summary["designs"]:
         print(f"  design {d['load']} {d['upqc']}: a = {d['a']}, V̄r = {d['Vr_bar']}, "
               f"ϕs0 = {d['phi_s0']}; modes {d['modes']}")

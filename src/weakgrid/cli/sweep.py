@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import (HelpFormatter, add_cluster_arguments, add_force_argument, check_cluster,
+from ._common import (HelpFormatter, add_batch_argument, add_cluster_arguments,
+                      add_force_argument, check_cluster,
                       output_folder, show_progress)
 
 from ._study import add_study_argument, study_of
@@ -31,6 +32,7 @@ def add_parser(sub):
     p.add_argument("--output", "-o", type=output_folder, default=None,
                    help="output folder (default: <study>-sweep)")
     add_cluster_arguments(p)
+    add_batch_argument(p)
     p.add_argument("--quick", action="store_true", help="the sweep's [sweep.quick] axes")
     p.add_argument("--signals", action="store_true",
                    help="keep every run's signals (Parquet, in the cache folder)")
@@ -61,7 +63,7 @@ def run(args) -> int:
     try:
         table = run_study_sweep(st, out, quick=args.quick, scheduler=args.scheduler,
                                 workers=args.workers, progress=show_progress(args),
-                                force=args.force, maps=args.maps)
+                                force=args.force, maps=args.maps, batched=args.batched)
     except SweepInterrupted as exc:
         print(f"weakgrid sweep: {exc}")
         return 130

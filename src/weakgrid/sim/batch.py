@@ -39,8 +39,15 @@ The array code uses the namespace ``xp`` (NumPy) so that an array-API backend co
 it for large batches; the linear solves stay per member (LAPACK through
 :mod:`weakgrid.sim.linsolve`, exactly the one-by-one factorization and solve).
 
-Scope: dense networks (``nb <= system.DENSE_NETWORK_MAX``), members that share every device
-parameter (events and controllers differ), events that change the network (:class:`Fault`,
+Per-member parameters: a member may bring its own grid (``scenario["system"]``, e.g. built by a
+sweep at its point) that differs from the others only in the parameters its components declare
+batchable (:attr:`Component.batch_params`, e.g. the UPQC's rating ``Vmax``): these are held as
+``(B, n)`` arrays, a row per member, bound into the evaluating copy like the controllers'
+inputs. Members whose grids differ in anything else (:func:`system_fingerprint`) go to different
+batches.
+
+Scope: dense networks (``nb <= system.DENSE_NETWORK_MAX``), members whose grids differ only in
+batchable parameters, events that change the network (:class:`Fault`,
 :class:`LineTrip`, :class:`LoadStep`). A member outside it (a :class:`GeneratorTrip`, a model
 whose limits move with the solution or with discrete memory) is run one-by-one by
 :func:`simulate_batch`; the results are the same, only slower.
@@ -49,8 +56,10 @@ whose limits move with the solution or with discrete memory) is run one-by-one b
 from __future__ import annotations
 
 import copy
+import hashlib
 import logging
 import math
+import pickle
 import time
 from collections.abc import Mapping
 
@@ -182,6 +191,52 @@ def batch_unsupported(system, events=()) -> str | None:
     return None
 
 
+def system_fingerprint(system) -> str:
+    """A digest of everything of a set-up ``system`` but its batchable parameters
+    (:attr:`Component.batch_params`): grids with equal fingerprints can be members of one batch,
+    each with its own values of those parameters."""
+    saved = []
+    for c in system.comps:
+        for name in getattr(c, "batch_params", ()):
+            if name in c.p:
+                saved.append((c, name, c.p[name], [v.get(name) for v in c._values]))
+                c.p[name] = None
+                for v in c._values:
+                    v[name] = None
+    try:
+        blob = pickle.dumps(system, protocol=pickle.HIGHEST_PROTOCOL)
+    finally:
+        for c, name, val, vals in saved:
+            c.p[name] = val
+            for v, x in zip(c._values, vals):
+                v[name] = x
+    return hashlib.sha256(blob).hexdigest()
+
+
+def member_params(systems) -> list:
+    """``[(component index, name, (B, n) array)]``: the batchable parameters whose values differ
+    between the member grids ``systems`` (equal :func:`system_fingerprint`), a row per member."""
+    out = []
+    for j, c in enumerate(systems[0].comps):
+        for name in getattr(c, "batch_params", ()):
+            if name not in c.p:
+                continue
+            rows = [xp.asarray(s.comps[j].p[name], dtype=float) for s in systems]
+            if any(not xp.array_equal(r, rows[0]) for r in rows[1:]):
+                out.append((j, name, xp.stack(rows)))
+    return out
+
+
+def _member_system(system, scenario):
+    """The grid of a member: its own (``scenario["system"]``, set up) or the batch's."""
+    s = scenario.get("system")
+    if s is None:
+        return system
+    if not s.is_setup:
+        s.setup()
+    return s
+
+
 class BatchSimulator:
     """Advance ``B`` members (copies of one set-up grid, each with its events and controllers)
     together from ``t = 0`` (see the module docstring).
@@ -191,9 +246,11 @@ class BatchSimulator:
     system : System
         The grid, set up; each member simulates a deep copy (the argument is not changed).
     scenarios : list of dict
-        One per member: ``{"events": [...], "controllers": [...]}`` (both optional), the
-        arguments of :meth:`Simulator.run`. Event and controller objects must not be shared
-        between members (they hold per-run state).
+        One per member: ``{"events": [...], "controllers": [...], "system": System}`` (all
+        optional), the arguments of :meth:`Simulator.run` and the member's own grid (default
+        ``system``; it may differ from ``system`` only in batchable parameters:
+        :func:`system_fingerprint`). Event and controller objects must not be shared between
+        members (they hold per-run state).
     **sim_kw
         Keyword arguments of :class:`Simulator` (``dt``, ``tol``, ``max_iter``,
         ``max_angle_spread``, ``save_every``, ``record``; ``linear_solver`` must be dense).
@@ -221,11 +278,21 @@ class BatchSimulator:
         self.scen = [dict(s) for s in scenarios]
         self.B = len(self.scen)
         self.sims = []
-        for sc in self.scen:
-            why = batch_unsupported(system, sc.get("events", ()))
+        own = [_member_system(system, sc) for sc in self.scen]
+        fp = system_fingerprint(system) if any(s is not system for s in own) else None
+        for k, (sc, msys) in enumerate(zip(self.scen, own)):
+            why = batch_unsupported(msys, sc.get("events", ()))
             if why:
                 raise DataError("simulate_batch", "events", why, "run this scenario one by one (Simulator.run)")
-            self.sims.append(Simulator(copy.deepcopy(system), **sim_kw))
+            if msys is not system and system_fingerprint(msys) != fp:
+                raise DataError("simulate_batch", f"scenarios[{k}].system", "a different grid",
+                                "a member's grid may differ from the batch's only in batchable "
+                                "parameters (Component.batch_params); batch it with its own grid "
+                                "(simulate_batch groups them)")
+            self.sims.append(Simulator(copy.deepcopy(msys), **sim_kw))
+        # batchable parameters that differ: one (B, n) array each, bound like the inputs
+        self._params = [(self.tmpl.comps[j], name, stack)
+                        for j, name, stack in member_params([s.sys for s in self.sims])]
         self.nx, self.N = system.nx, system.N
         # controller outputs and other inputs a member changes: one (B, n) array per attribute,
         # each member's component holding a row view of it (Component.batch_inputs)
@@ -257,6 +324,9 @@ class BatchSimulator:
         for c, attr, stack in self._inputs:
             a = stack[rows]
             setattr(c, attr, a if rep == 1 else xp.repeat(a, rep, axis=0))
+        for c, name, stack in self._params:
+            a = stack[rows]
+            c.p[name] = a if rep == 1 else xp.repeat(a, rep, axis=0)
 
     def _sync_network(self, rows):
         for k in rows:
@@ -863,14 +933,21 @@ def breakpoint_key(scenario, dt):
     as alone."""
     from .events import flatten
 
-    off = []
-    for ev in flatten(list(scenario.get("events", ()))):
-        q = ev.t / dt
-        if abs(q - round(q)) > 1e-9 * max(1.0, abs(q)):
-            off.append(round(ev.t, 12))
+    off = off_grid([ev.t for ev in flatten(list(scenario.get("events", ())))], dt)
     ctl = tuple(sorted((round(getattr(c, "T", 0.0), 12), round(getattr(c, "t0", 0.0), 12))
                        for c in scenario.get("controllers", ())))
-    return tuple(sorted(set(off))), ctl
+    return off, ctl
+
+
+def off_grid(times, dt) -> tuple:
+    """The instants of ``times`` [s] that are not multiples of the step ``dt`` [s], sorted,
+    rounded to 1e-12 s (what separates members in :func:`breakpoint_key`)."""
+    off = set()
+    for t in times:
+        q = t / dt
+        if abs(q - round(q)) > 1e-9 * max(1.0, abs(q)):
+            off.add(round(t, 12))
+    return tuple(sorted(off))
 
 
 def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failure="return",
@@ -882,7 +959,10 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
     system : System
         The grid (set up); every scenario runs on a deep copy of it.
     scenarios : list of dict
-        ``{"events": [...], "controllers": [...]}`` per scenario (fresh objects per scenario).
+        ``{"events": [...], "controllers": [...], "system": System}`` per scenario (fresh
+        objects per scenario; ``system``: the scenario's own grid, default the argument).
+        Scenarios whose grids differ only in batchable parameters share batches, each with
+        its own values (:func:`system_fingerprint`).
     t_end : float
         Final time [s].
     batch_size : int
@@ -920,11 +1000,16 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
     st = {"batches": 0, "steps": 0, "rerun": 0, "halved": 0, "alone": 0, "timing": dict.fromkeys(TIMED, 0.0)}
     groups = {}
     alone = []
+    fps = {}    # per grid object: its fingerprint (only when some scenario brings its own grid)
+    own = any(sc.get("system") is not None for sc in scenarios)
     for i, sc in enumerate(scenarios):
-        if batch_unsupported(system, sc.get("events", ())):
+        msys = _member_system(system, sc)
+        if batch_unsupported(msys, sc.get("events", ())):
             alone.append(i)
             continue
-        key = breakpoint_key(sc, dt) if exact else None
+        if id(msys) not in fps:
+            fps[id(msys)] = system_fingerprint(msys) if own else None
+        key = (fps[id(msys)],) + ((breakpoint_key(sc, dt),) if exact else ())
         groups.setdefault(key, []).append(i)
 
     def one(i):
@@ -932,14 +1017,15 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
         for c in sc.get("controllers", ()):
             if hasattr(c, "log_t"):
                 c.log_t, c.log_u = [], []
-        sim = Simulator(copy.deepcopy(system), **sim_kw)
+        sim = Simulator(copy.deepcopy(_member_system(system, sc)), **sim_kw)
         return sim.run(t_end, events=sc.get("events", ()), controllers=sc.get("controllers", ()),
                        on_failure="return")
 
     for members in groups.values():
         for a in range(0, len(members), batch_size):
             part = members[a:a + batch_size]
-            bs = BatchSimulator(system, [scenarios[i] for i in part], **sim_kw)
+            bs = BatchSimulator(_member_system(system, scenarios[part[0]]),
+                                [scenarios[i] for i in part], **sim_kw)
             res, rerun = bs.run(t_end)
             st["batches"] += 1
             st["halved"] += bs.halved

@@ -121,6 +121,11 @@ class Component:
     #: arrays over the instances that the batch simulator (:mod:`weakgrid.sim.batch`) holds per
     #: member, with a leading batch axis when the members are evaluated together
     batch_inputs: tuple[str, ...] = ()
+    #: parameters (names of :attr:`params`) that the members of a batch may hold with different
+    #: values (:mod:`weakgrid.sim.batch`): read from ``self.p`` only when evaluating (nothing is
+    #: derived from them at setup), so a ``(B, n)`` array of them broadcasts as the batched
+    #: variables do. A parameter outside this list that differs puts members in different batches
+    batch_params: tuple[str, ...] = ()
     #: outputs that record zero once an instance is disconnected (its power and currents)
     injection_outputs: tuple[str, ...] = ()
     #: per instance 1.0 (connected) or 0.0 (disconnected by a generator trip); None: all connected

@@ -75,6 +75,9 @@ class UPQC(Component):
 
     #: the series-voltage commands [pu] a controller holds: per member in a batch
     batch_inputs = ("u_p", "u_q")
+    #: the device's rating, current limit and dc link may differ per member of a batch (a
+    #: sweep over the rating)
+    batch_params = ("Vmax", "Imax", "Cdc", "kp_dc", "ki_dc", "Rsh")
 
     kind = "device"
     order = 3
@@ -155,7 +158,6 @@ class UPQC(Component):
         self._uniq = len(set(self.r.tolist()) | set(self.b1.tolist())) == 2 * n
         self._all_conv = bool(self._conv.all())
         self._any_chi = bool((self.p["chi"] > 0).any())
-        self._imax = np.where(self.p["Imax"] > 0, self.p["Imax"], np.inf)
         self._uniq_g = len(set(self.gti_i[self.reduced].tolist())) == int(self.reduced.sum())
 
     def set_input(self, name, Vup, Vuq):
@@ -218,9 +220,10 @@ class UPQC(Component):
         if self._any_conv:
             err = p["Vdc0"] - Vdc
             Id = (Pdc + p["kp_dc"] * err + ctx.x[..., self.sl(1)]) / vr_safe
-            over = np.abs(Id) > self._imax
+            imax = np.where(p["Imax"] > 0, p["Imax"], np.inf)   # 0: no limit
+            over = np.abs(Id) > imax
             if over.any():
-                Id = np.clip(Id, -self._imax, self._imax)
+                Id = np.clip(Id, -imax, imax)
             if not self._all_conv:
                 Id = np.where(conv, Id, 0.0)
                 over = over & conv

@@ -1,50 +1,117 @@
-"""A study sweep's runs in batches of one grid: the seam for a batched simulator.
+"""A study sweep's runs in batches of one grid, advanced by the batched simulator.
 
-A batched simulator advances many scenarios of the same grid at once (issue #21). A sweep
-hands it the runs that share :func:`batch_key` — the study, the load level and UPQC structure
-of the run's scenario, the controller, the design load, the simulated time and the step
-factor — and they may differ in anything else (the UPQC rating, fault times, ...).
-:func:`simulate_many` is the hook: today it runs the batch's runs one by one with
-:func:`weakgrid.study.sweep.run_point` (the scalar path); a batched simulator replaces its body
-and nothing else changes (the cache, the table, the maps). The grouping itself is
-:func:`weakgrid.sweep.batches.group` (pure, order-preserving), used by
+A batched simulator (:func:`weakgrid.sim.batch.simulate_batch`) advances many scenarios of the
+same grid at once (issue #21). A sweep hands it the runs that share :func:`batch_key` — the
+study, the load level and UPQC structure of the run's scenario, the grid variant of its
+controller (the PQ and no-PSS baselines change the grid), the simulated time, the step factor
+and the event times off the step grid (members step together) — and they may differ in
+anything else: the UPQC rating (a batchable parameter of the device,
+:attr:`weakgrid.sim.component.Component.batch_params`), fault times on the step grid, the
+controller and the load it is designed at.
+
+:func:`simulate_many` prepares every run of a batch (its grid, events and digital
+controller: :func:`weakgrid.study.sweep.prepare_point`), simulates them together
+(:func:`weakgrid.study.runner.simulate_prepared`) and finishes each (its metrics and
+signals: :func:`weakgrid.study.sweep.finish_point`). A run that raises in any part is that
+run's row alone, as in the one-by-one path (:func:`weakgrid.study.sweep.run_point`). The
+grouping itself is :func:`weakgrid.sweep.batches.group` (pure, order-preserving), used by
 :func:`weakgrid.sweep.run_sweep` with ``batch = STUDY_BATCHES``.
 """
 
 from __future__ import annotations
 
+import logging
+import math
+import os
+
 from ..dotted import get_path
 
-__all__ = ["batch_key", "simulate_many", "STUDY_BATCHES"]
+__all__ = ["batch_key", "event_breakpoints", "simulate_many", "batch_size_for",
+           "STUDY_BATCHES"]
+
+log = logging.getLogger(__name__)
 
 
 def batch_key(inputs: dict) -> tuple:
-    """The grid a sweep run (the input of :func:`weakgrid.study.sweep.run_point`) needs:
-    ``(study name, scenario's load level, UPQC structure, controller, design load, t_end
-    [s], step factor)``. Runs with equal keys can share one batched simulation."""
+    """The grid and the steps a sweep run (the input of :func:`weakgrid.study.sweep.run_point`)
+    needs: ``(study name, scenario's load level, UPQC structure, the controller's grid variant,
+    t_end [s], step factor, event times off the step grid)``. Runs with equal keys share one
+    batched simulation, in lockstep."""
+    from types import SimpleNamespace
+
+    from .controllers import controller_variant
+
     study = inputs["study"]
     sc = get_path(study, f"scenarios.{inputs['scenario']}")
     t_end = inputs.get("t_end") or sc.get("t_end")
-    return (study["study"]["name"], sc.get("load"), sc.get("upqc"), inputs["controller"],
-            inputs.get("design_load"), None if t_end is None else float(t_end),
-            float(inputs.get("dt_factor") or 1.0))
+    factor = float(inputs.get("dt_factor") or 1.0)
+    sim = study.get("simulation") or {}
+    dt = float(sim.get("dt") or study["design"]["T"]) * factor   # as runner.sim_settings
+    return (study["study"]["name"], sc.get("load"), sc.get("upqc"),
+            controller_variant(SimpleNamespace(data=study), inputs["controller"]),
+            None if t_end is None else float(t_end), factor,
+            event_breakpoints(sc.get("events") or (), dt))
+
+
+def event_breakpoints(events, dt: float) -> tuple:
+    """The times [s] of a study scenario's events (``t_on``, ``t_off``, ``t``) off the step
+    grid ``dt`` [s] (:func:`weakgrid.sim.batch.off_grid`): runs whose off-grid times differ
+    do not step together, so they are batched apart."""
+    from ..sim.batch import off_grid
+
+    return off_grid([float(e[k]) for e in events for k in ("t_on", "t_off", "t")
+                     if isinstance(e, dict) and e.get(k) is not None], dt)
 
 
 def simulate_many(runs: list) -> list:
     """Run a batch of sweep runs (inputs of :func:`weakgrid.study.sweep.run_point`, one grid:
     equal :func:`batch_key`) and return one result per run, in order: what ``run_point``
     returns (metrics, or metrics and signals), or the exception the run raised (a failed run
-    stays its own row). Today one by one, the scalar path; the batched simulator plugs in
-    here."""
-    from .sweep import run_point
+    stays its own row). The runs are simulated together
+    (:func:`weakgrid.study.runner.simulate_prepared`)."""
+    from .runner import simulate_prepared
+    from .sweep import finish_point, prepare_point
 
-    out = []
-    for inputs in runs:
+    out: list = [None] * len(runs)
+    preps = {}
+    for i, inputs in enumerate(runs):
         try:
-            out.append(run_point(inputs))
+            preps[i] = prepare_point(inputs)
         except Exception as exc:  # a failing run is its own row, whatever it raised
-            out.append(exc)
+            out[i] = exc
+    rows = list(preps)
+    try:
+        sims = simulate_prepared([preps[i] for i in rows], batched=True)
+    except Exception as exc:   # not a member's failure (those are in Results.failure)
+        log.warning("the batched simulation of %d runs raised %r; running them one by one",
+                    len(rows), exc)
+        sims = []
+        for i in rows:
+            try:
+                prep = prepare_point(runs[i])   # fresh controller and events
+                preps[i] = prep
+                sims.append(simulate_prepared([prep], batched=False)[0])
+            except Exception as exc1:
+                sims.append(exc1)
+    for i, sim in zip(rows, sims):
+        if isinstance(sim, Exception):
+            out[i] = sim
+            continue
+        try:
+            out[i] = finish_point(runs[i], preps[i], *sim)
+        except Exception as exc:
+            out[i] = exc
     return out
+
+
+def batch_size_for(n_runs: int, workers: int | None) -> int | None:
+    """The largest batch of a sweep of ``n_runs`` runs on ``workers`` processes (None: one
+    per core; 0: serially): at least one batch per worker, so that the batches still spread
+    over the workers; None (no limit) when serial."""
+    if workers == 0:
+        return None
+    w = workers or os.cpu_count() or 1
+    return max(1, math.ceil(n_runs / w))
 
 
 #: ``batch`` argument of :func:`weakgrid.sweep.run_sweep` for a study's sweep.

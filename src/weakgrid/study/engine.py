@@ -31,7 +31,7 @@ from ..design import design_mode, machine_mode, mode_states, modes
 from ..fileio import write_json_atomic
 from ..manifest import Manifest
 from ..models import load_preset
-from .batches import STUDY_BATCHES
+from .batches import STUDY_BATCHES, batch_size_for
 from .build import build_setup
 from .cache import inputs_key, load_run, remove_stale, save_run
 from .claims import judge_all
@@ -40,7 +40,7 @@ from .figures import figure_specs, write_figures
 from .protocol import controller_name, protocol_of
 from .report import who_did_best, write_html, write_tables
 from ..sweep import open_client, run_sweep
-from .runner import Run, RunRecord, check_engine, make_events, run_scenario
+from .runner import Run, RunRecord, check_engine, make_events, run_scenario, run_scenarios
 from .sweep import _axes, describe_sweep, run_point, sweep_points
 from .sweep_estimate import estimate_sweep, run_cost
 from .sweep_maps import draw_maps, map_summaries, metric_uncertainty
@@ -157,6 +157,27 @@ def _run_task(study, run, trained):
     return run_scenario(study, run, trained)
 
 
+def _run_batch_task(study, runs, trained):
+    """Runs of one study, load and UPQC structure on a worker, simulated together
+    (:func:`weakgrid.study.runner.run_scenarios`): their records, in order."""
+    return run_scenarios(study, runs, trained, batched=True)
+
+
+def _run_batches(todo, workers):
+    """``todo`` (study, run, trained, key) in batches of runs that can share a batched
+    simulation (one study, load level, UPQC structure, grid variant, final time and event
+    times off the step grid), at least one batch per worker (:func:`weakgrid.study.batches.batch_size_for`); lists of rows of ``todo``."""
+    from ..sweep import group
+    from .batches import batch_size_for, event_breakpoints
+    from .runner import sim_settings
+
+    def key(item):
+        st, run, _, _ = item
+        return (id(st), run.load, run.upqc, controller_variant(st, run.controller), run.t_end,
+                event_breakpoints(run.events, sim_settings(st)[0]))
+    return [list(b.rows) for b in group(todo, key, batch_size_for(len(todo), workers))]
+
+
 def planned_files(out: Path, plan, quick: bool, maps: bool) -> list[Path]:
     """Every file :func:`run_studies` writes into ``out`` for ``plan`` (the sweep cache's
     hash-named files aside)."""
@@ -194,7 +215,7 @@ def check_events(plan) -> None:
 
 
 def run_studies(studies, output, quick=False, log=None, title=None, progress=True,
-                scheduler=None, workers=None, maps=True, force=False, batched=False) -> dict:
+                scheduler=None, workers=None, maps=True, force=False, batched=True) -> dict:
     """Run every (scenario, controller) of ``studies`` and write everything to ``output``.
 
     The runs (and the sweeps of the studies that have a ``[sweep]`` table, drawn as maps
@@ -207,8 +228,10 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
     Every run's events are built on its grid while planning (:func:`check_events`): a bad
     event stops the command before any training or write.
 
-    ``batched``: the maps' sweep runs in batches of one grid
-    (:func:`weakgrid.study.batches.simulate_many`; default: a task per run, the scalar path).
+    ``batched`` (default): the runs of one study, load level and UPQC structure are simulated
+    together (:func:`weakgrid.study.runner.run_scenarios`, a task per batch) and so are the
+    maps' sweep runs of one grid (:func:`weakgrid.study.batches.simulate_many`); ``False``: a
+    task per run, the scalar path (the same results but the wall times).
 
     Returns a summary dict (claims, metrics, figures, report, designs, maps).
     """
@@ -314,28 +337,39 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
     with contextlib.ExitStack() as stack:
         client = None if serial or not n_tasks else \
             stack.enter_context(open_client(scheduler, workers))
+        def keep(run, rkey, rec):
+            records[run.id] = rec
+            save_run(rec, runs_dir, rkey)    # kept as soon as it is finished
+            manifest.record(runs_dir / f"{run.id}{x}" for x in (".parquet", ".json"))
+            rec.results = None               # every signal is in its run file now
+            bar.set_postfix_str(run.id)
+            bar.update(1)
+
+        batches = _run_batches(todo, 0 if client is None else workers) if batched else \
+            [[i] for i in range(len(todo))]
         if client is not None and todo:
             from distributed import as_completed
 
-            futs = {client.submit(_run_task, st, run, {k: v for k, v in tr.items()
-                                                       if k == run.design_key},
-                                  pure=False): (run, rkey) for st, run, tr, rkey in todo}
+            futs = {}
+            for rows in batches:
+                st = todo[rows[0]][0]
+                runs = [todo[i][1] for i in rows]
+                tr = {k: v for i in rows for k, v in todo[i][2].items()
+                      if k in {r.design_key for r in runs}}
+                fut = client.submit(_run_batch_task, st, runs, tr, pure=False) if batched \
+                    else client.submit(_run_task, st, runs[0], tr, pure=False)
+                futs[fut] = rows
             for fut in as_completed(list(futs)):
-                run, rkey = futs[fut]
-                records[run.id] = rec = fut.result()
-                save_run(rec, runs_dir, rkey)    # kept as soon as it is finished
-                manifest.record(runs_dir / f"{run.id}{x}" for x in (".parquet", ".json"))
-                rec.results = None               # every signal is in its run file now
-                bar.set_postfix_str(run.id)
-                bar.update(1)
+                recs = fut.result()
+                for i, rec in zip(futs[fut], recs if batched else [recs]):
+                    keep(todo[i][1], todo[i][3], rec)
         else:
-            for st, run, trained, rkey in todo:
-                bar.set_postfix_str(run.id)
-                records[run.id] = rec = run_scenario(st, run, trained)
-                save_run(rec, runs_dir, rkey)
-                manifest.record(runs_dir / f"{run.id}{x}" for x in (".parquet", ".json"))
-                rec.results = None               # every signal is in its run file now
-                bar.update(1)
+            for rows in batches:
+                st, trained = todo[rows[0]][0], todo[rows[0]][2]
+                runs = [todo[i][1] for i in rows]
+                bar.set_postfix_str(runs[0].id)
+                for i, rec in zip(rows, run_scenarios(st, runs, trained, batched=batched)):
+                    keep(todo[i][1], todo[i][3], rec)
         metrics = [records[run.id].metrics for _, run, _, _ in all_runs]
         bar.close()
         if n_kept:
@@ -349,7 +383,9 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                                     workers=0 if serial else None, client=client,
                                     progress=progress, log=log, cost=run_cost,
                                     table_path=out / _sweep_file(quick),
-                                    desc="maps", batch=STUDY_BATCHES if batched else None)
+                                    desc="maps", batch=STUDY_BATCHES if batched else None,
+                                    batch_size=batch_size_for(len(pts), 0 if serial else
+                                                              workers) if batched else None)
     map_list, sweeps, uncertainty = [], [], {}
     for st in swept:
         sub = sweep_table[sweep_table["scenario"].isin(st.data["sweep"]["scenarios"])]

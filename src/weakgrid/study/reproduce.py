@@ -20,11 +20,12 @@ def paper_studies():
 
 
 def reproduce(output="reproduce-output", quick=False, log=None, scheduler=None,
-              workers=None, progress=True, force=False, batched=False) -> dict:
+              workers=None, progress=True, force=False, batched=True) -> dict:
     """Run the paper's case studies (and their sweeps, as maps) and write everything to
     ``output``; simulations run on a Dask cluster (see :func:`run_studies`; ``progress``:
     its progress bar on stderr; ``force``: overwrite files there that weakgrid did not
-    write; ``batched``: the maps' sweep in batches of one grid, :mod:`weakgrid.study.batches`)."""
+    write; ``batched``: the runs and the maps' sweep in batches of one grid (the default;
+    ``False``: one by one), :mod:`weakgrid.study.batches`)."""
     return run_studies(paper_studies(), output, quick=quick, log=log,
                        title="reproduction of Nazaripouya & Mehraeen (2015)",
                        scheduler=scheduler, workers=workers, progress=progress, force=force,

@@ -21,8 +21,10 @@ from .failure import failure_text
 from .metrics import (SETTLING_BANDS, backswing, control_cost, definition_spread, itae,
                       running_cost, settling_time, stability_verdict)
 
-__all__ = ["Run", "RunRecord", "run_scenario", "enable_windows", "make_events", "sim_settings",
-           "derive_series", "flat_columns", "record_list"]
+__all__ = ["Run", "RunRecord", "Prepared", "run_scenario", "run_scenarios", "prepare_run",
+           "simulate_prepared",
+           "finish_run", "enable_windows", "make_events", "sim_settings", "derive_series",
+           "flat_columns", "record_list"]
 
 Q_DESIGN = 0.01 * np.eye(2)  # the paper's state weight of (18), for the running cost metric
 R_DESIGN = np.eye(2)
@@ -321,9 +323,58 @@ def sim_settings(study, dt_factor: float = 1.0) -> tuple[float, float | None]:
     return base * float(dt_factor), (None if tol is None else float(tol))
 
 
+@dataclass
+class Prepared:
+    """A run made ready to simulate (:func:`prepare_run`): its grid, events and controller.
+
+    Attributes
+    ----------
+    setup : weakgrid.study.build.Setup
+        The grid at the run's load, set up (``setup.system`` is what is simulated).
+    events : list
+        The simulator events of the run's scenario.
+    dc : weakgrid.sim.controllers.DigitalController
+        The run's digital controller (it logs its samples; ``xs``/``ys`` the design states and
+        measured signals of its active samples).
+    dt, tol : float
+        Integration step [s] and Newton tolerance [pu] (``tol`` None: the simulator's default).
+    record : list of str or None
+        The simulator's ``record`` argument (:func:`record_list`).
+    engine : str
+        The study's engine (:func:`sim_engine`): ``"phasor"`` or a DPsim engine (its runs
+        are simulated alone, at ``dt`` already divided by :func:`weakgrid.sim.emt.dpsim_step`).
+    """
+
+    study: object
+    run: Run
+    setup: object
+    dload: str
+    ctl: object
+    choice: object
+    dc: object
+    events: list
+    dt: float
+    tol: float | None
+    record: list | None
+    xs: list
+    ys: list
+    engine: str = "phasor"
+
+    def scenario(self) -> dict:
+        """The run as a member of :func:`weakgrid.sim.batch.simulate_batch`."""
+        return {"system": self.setup.system, "events": self.events, "controllers": [self.dc]}
+
+    def sim_key(self) -> tuple:
+        """Runs with equal keys can be simulated together (same final time, step, tolerance
+        and recorded signals; their grids are compared by the batch simulator itself)."""
+        return (self.run.t_end, self.dt, self.tol,
+                None if self.record is None else tuple(self.record))
+
+
 def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
                  design=None, tol=None) -> RunRecord:
-    """Simulate ``run`` of ``study`` and compute its metrics.
+    """Simulate ``run`` of ``study`` and compute its metrics: :func:`prepare_run`, the
+    simulation, :func:`finish_run`.
 
     Parameters
     ----------
@@ -341,6 +392,24 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     design : DesignModel, optional
         The design model (10) at ``design_load`` if already derived (a sweep caches it).
     """
+    prep = prepare_run(study, run, trained, dt=dt, design_load=design_load, design=design,
+                       tol=tol)
+    res, wall = simulate_prepared([prep], batched=False)[0]
+    return finish_run(prep, res, wall)
+
+
+def run_scenarios(study, runs, trained=None, batched: bool = True) -> list:
+    """:func:`run_scenario` of every run of ``runs`` (one study, the study's step), their
+    simulations together when ``batched`` (:func:`simulate_prepared`); the records in order,
+    each equal to its run alone but the wall time."""
+    preps = [prepare_run(study, r, trained) for r in runs]
+    return [finish_run(p, *sim) for p, sim in zip(preps, simulate_prepared(preps, batched))]
+
+
+def prepare_run(study, run: Run, trained=None, dt=None, design_load=None, design=None,
+                tol=None) -> Prepared:
+    """Build the grid, the events and the digital controller of ``run`` (the arguments of
+    :func:`run_scenario`); nothing is simulated."""
     setup = build_setup(study, run.load, run.upqc, controller_variant(study, run.controller))
     events = make_events(setup, run)
     check_engine(study, setup, events)     # a model the engine lacks: refused before training
@@ -368,34 +437,92 @@ def run_scenario(study, run: Run, trained=None, dt=None, design_load=None,
     measure = setup.measure_signals if engine == "phasor" else dpsim_measure(setup)
     dc = DigitalController(K, T=T, measure=measure, target=target,
                            enable=enable_windows(run.bypass, run.t_end), name=run.controller)
-    t0 = time.perf_counter()
     if dt is None:
         dt, tol = sim_settings(study)
-    record = record_list(study, setup.signals)
-    if engine == "phasor":
-        res = simulate(setup.system, run.t_end, dt=dt, tol=tol, events=events, controllers=[dc],
-                       on_failure="return", record=record)
-    else:
-        from ..sim.emt import dpsim_step, simulate_dpsim
+    if engine != "phasor":       # DPsim: the run's step in parts of at most DT_MAX
+        from ..sim.emt import dpsim_step
 
         dt = dpsim_step(dt)
-        res = simulate_dpsim(setup.system, run.t_end, engine=engine, dt=dt, events=events,
-                             controllers=[dc], gti_power=_sim(study).get("gti_power", "measured"),
-                             drop_saturation=_sim(study).get("drop_saturation", False))
-        if record is not None:
-            res = res.subset([n for n in res.names if any(fnmatch.fnmatchcase(n, p)
-                                                          for p in record)])
-    wall = time.perf_counter() - t0
+    return Prepared(study, run, setup, dload, ctl, choice, dc, events, float(dt), tol,
+                    record_list(study, setup.signals), xs, ys, engine)
+
+
+def simulate_prepared(preps, batched: bool = True, stats: dict | None = None) -> list:
+    """Simulate prepared runs (:func:`prepare_run`); ``[(Results, wall [s])]`` in order.
+
+    ``batched``: the runs with equal :meth:`Prepared.sim_key` go to one
+    :func:`weakgrid.sim.batch.simulate_batch` call (members equal their one-by-one runs to
+    round-off; a failed member keeps its own failure; the wall time of a batch is shared
+    equally by its members); otherwise each is simulated alone. A run that fails returns its
+    failure in ``Results.failure``. ``stats``: filled with the batches' statistics summed
+    (:func:`weakgrid.sim.batch.simulate_batch`: ``batches``, ``rerun``, ``alone``, ``timing``).
+    """
+    from ..sim.batch import simulate_batch
+
+    out = [None] * len(preps)
+    groups: dict = {}
+    for i, p in enumerate(preps):     # DPsim runs are simulated alone
+        groups.setdefault(p.sim_key() if batched and p.engine == "phasor" else i, []).append(i)
+    for rows in groups.values():
+        p0 = preps[rows[0]]
+        t0 = time.perf_counter()
+        if len(rows) == 1:
+            res = [_simulate_alone(p0)]
+        else:
+            st: dict = {}
+            res = simulate_batch(p0.setup.system, [preps[i].scenario() for i in rows],
+                                 p0.run.t_end, batch_size=len(rows), dt=p0.dt, tol=p0.tol,
+                                 record=p0.record, on_failure="return", stats=st)
+            if stats is not None:
+                for k, v in st.items():
+                    if isinstance(v, dict):
+                        acc = stats.setdefault(k, {})
+                        for kk, vv in v.items():
+                            acc[kk] = acc.get(kk, 0.0) + vv
+                    else:
+                        stats[k] = stats.get(k, 0) + v
+        wall = (time.perf_counter() - t0) / len(rows)
+        for i, r in zip(rows, res):
+            out[i] = (r, wall)
+    return out
+
+
+def _simulate_alone(p: Prepared):
+    """One prepared run on its study's engine (phasor: :func:`weakgrid.sim.integrate.simulate`;
+    DPsim: :func:`weakgrid.sim.emt.simulate_dpsim` at the step of :func:`prepare_run`)."""
+    if p.engine == "phasor":
+        return simulate(p.setup.system, p.run.t_end, dt=p.dt, tol=p.tol, events=p.events,
+                        controllers=[p.dc], on_failure="return", record=p.record)
+    from ..sim.emt import simulate_dpsim
+
+    sim = _sim(p.study)
+    res = simulate_dpsim(p.setup.system, p.run.t_end, engine=p.engine, dt=p.dt, events=p.events,
+                         controllers=[p.dc], gti_power=sim.get("gti_power", "measured"),
+                         drop_saturation=sim.get("drop_saturation", False))
+    if p.record is not None:
+        res = res.subset([n for n in res.names if any(fnmatch.fnmatchcase(n, q)
+                                                      for q in p.record)])
+    return res
+
+
+def finish_run(prep: Prepared, res, wall: float) -> RunRecord:
+    """The metrics, series and samples of a prepared run from its simulation ``res``
+    (:class:`weakgrid.sim.results.Results`) that took ``wall`` seconds."""
+    study, run, setup, dc = prep.study, prep.run, prep.setup, prep.dc
+    dload, ctl, choice, xs, ys = prep.dload, prep.ctl, prep.choice, prep.xs, prep.ys
+    dt, tol, T, engine = prep.dt, prep.tol, setup.design.T, prep.engine
     # controller samples: times and (bypass-aware) outputs actually applied
     tk = np.asarray(dc.log_t)
     uk = np.asarray(dc.log_u).reshape(-1, 2)
     xk = np.full((len(tk), 2), np.nan)
-    # measurements were logged only when active; align them by the active mask
-    active = np.array([dc.active(t) for t in tk])
-    xk[active] = np.asarray(xs).reshape(-1, 2)[: active.sum()]
+    # measurements were logged only when active; align them by the active mask (the last
+    # ones: a batch member re-run alone logged its batched samples before, dc.log_* not)
+    active = np.array([dc.active(t) for t in tk], bool)
+    na = int(active.sum())
+    xk[active] = np.asarray(xs[len(xs) - na:]).reshape(-1, 2)
     ny = len(setup.state_map.signals)
     yk = np.full((len(tk), ny), np.nan)
-    yk[active] = np.asarray(ys).reshape(-1, ny)[: active.sum()]
+    yk[active] = np.asarray(ys[len(ys) - na:]).reshape(-1, ny)
     t = res.t
     series = {"t": t}
     aliases = {k: n for k, n in setup.signals.items() if n in res}

@@ -39,7 +39,7 @@ from .studyfile import get_path, set_path, study_from_dict
 from .fields import keys
 
 __all__ = ["SWEEP_KEYS", "validate_sweep", "sweep_points", "describe_sweep", "run_point",
-           "run_study_sweep", "claim_sweep_outputs"]
+           "prepare_point", "finish_point", "run_study_sweep", "claim_sweep_outputs"]
 
 SWEEP_KEYS = keys("sweep")      # the fields: weakgrid.study.fields
 
@@ -282,11 +282,24 @@ def run_point(inputs: dict):
     ``controller`` (name), ``design_load`` (or None: the run's own load), ``t_end`` (or None),
     ``signals`` (bool), ``dt_factor`` (integration step = factor × the study's step; 0.5 for
     the numerical uncertainty check, run with the simulator's default tolerance for that
-    step: :func:`weakgrid.study.runner.sim_settings`). A run that loses stability or whose Newton iteration fails returns
-    ``status = "failed"`` with its cause.
+    step: :func:`weakgrid.study.runner.sim_settings`). A run that loses stability or whose
+    Newton iteration fails returns ``status = "failed"`` with its cause. The three parts
+    (:func:`prepare_point`, the simulation, :func:`finish_point`) are what
+    :func:`weakgrid.study.batches.simulate_many` runs for a batch of points.
     """
+    from .runner import simulate_prepared
+
+    prep = prepare_point(inputs)
+    res, wall = simulate_prepared([prep], batched=False)[0]
+    return finish_point(inputs, prep, res, wall)
+
+
+def prepare_point(inputs: dict):
+    """The point's run made ready to simulate (:func:`weakgrid.study.runner.prepare_run`):
+    its study built from ``inputs``, its design model and trained controller (cached per
+    worker process)."""
     from .controllers import controller_kind
-    from .runner import Run, run_scenario, sim_settings
+    from .runner import Run, prepare_run, sim_settings
 
     st = study_from_dict(inputs["study"], source=f"sweep:{inputs['study']['study']['name']}")
     sc = next((s for s in st.scenarios() if s["id"] == inputs["scenario"]), None)
@@ -302,7 +315,15 @@ def run_point(inputs: dict):
     if controller_kind(st, name) == "hji":
         trained[(dload, run.upqc)] = _trained(st, design, [dload, run.upqc])
     dt, tol = sim_settings(st, float(inputs.get("dt_factor") or 1.0))
-    rec = run_scenario(st, run, trained, dt=dt, tol=tol, design_load=dload, design=design)
+    return prepare_run(st, run, trained, dt=dt, tol=tol, design_load=dload, design=design)
+
+
+def finish_point(inputs: dict, prep, res, wall: float):
+    """The point's row (metrics; and its run file's table with ``signals``) from its
+    simulation ``res`` that took ``wall`` seconds."""
+    from .runner import finish_run
+
+    rec = finish_run(prep, res, wall)
     m = dict(rec.metrics)
     for k in ("id", "case", "controller", "load", "upqc", "wall_s"):
         m.pop(k, None)
@@ -338,18 +359,19 @@ def claim_sweep_outputs(study, output, quick=False, maps=False, force=False,
 
 def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
                     progress=True, log=None, cache_dir=None, force=False,
-                    maps=False, batched=False) -> pd.DataFrame:
+                    maps=False, batched=True) -> pd.DataFrame:
     """Run the study's sweep; write ``<output>/<study>-sweep.parquet``; return the table.
 
     The cache (``<output>/cache`` unless given) keeps every finished run: an interrupted
     sweep resumes, a repeated one runs nothing. The table (and the maps' files, ``maps``)
     are listed in the folder's manifest before they are written; a file of another origin
     in the way stops the sweep before any run unless ``force``
-    (:class:`weakgrid.manifest.Manifest`). ``batched``: the runs of one grid go to
-    :func:`weakgrid.study.batches.simulate_many` together, a task per batch (default: a task
-    per run, the scalar path).
+    (:class:`weakgrid.manifest.Manifest`). ``batched`` (default): the runs of one grid go to
+    :func:`weakgrid.study.batches.simulate_many` together, a task per batch (at least one
+    batch per worker: :func:`weakgrid.study.batches.batch_size_for`); ``False``: a task per
+    run, the scalar path (the same table).
     """
-    from .batches import STUDY_BATCHES
+    from .batches import STUDY_BATCHES, batch_size_for
     from .sweep_estimate import run_cost
 
     out = Path(output)
@@ -360,6 +382,7 @@ def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
     table = run_sweep(pts, run_point, cache_dir=cache_dir or out / "cache",
                       scheduler=scheduler, workers=workers, progress=progress, log=log,
                       cost=run_cost, table_path=table_path, desc=f"sweep {study.name}",
-                      batch=STUDY_BATCHES if batched else None)
+                      batch=STUDY_BATCHES if batched else None,
+                      batch_size=batch_size_for(len(pts), workers) if batched else None)
     Manifest(out).record([table_path])   # its content, as written
     return table
