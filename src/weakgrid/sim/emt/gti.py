@@ -80,6 +80,14 @@ class GTIBridge:
         self.items = []
         if g is None or g.n == 0:
             return
+        if power == "measured" and g.pq.any():
+            i = int(np.nonzero(g.pq)[0][0])
+            raise DataError(g.element(i), "mode", "pq", "with gti_power = 'measured' its PQ "
+                            "loops act on the current of an ideal source behind 1/B and are "
+                            "unstable with the network's inductor dynamics (docs/engines.md: a "
+                            "pair at +218 ± 551j 1/s on the test grid), so the run would show "
+                            "that instability, not the PQ baseline; use gti_power = 'model' or "
+                            "the energy mode")
         net = system.network
         w = 2 * math.pi * net.f_hz
         Vb, Zb = bus_base(system)
