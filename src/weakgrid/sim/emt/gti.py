@@ -26,6 +26,12 @@ evaluated between DPsim steps from the *measured* terminal quantities:
   dc link's sight of those transients does (docs/engines.md: on the case-1 grid it is the whole
   difference to the phasor engine).
 
+``measured`` is the physics of this circuit, not a co-simulation artefact: on a test grid it
+converges in the step to the same circuit written as one ODE without delay
+(``tests/sim/test_emt_gti_reference.py``; docs/engines.md). A GTI in ``pq`` mode is refused
+with ``measured`` power: its P loop is unstable with the network's inductor dynamics, so the run
+would show that instability rather than the PQ baseline.
+
 Time stepping (stated, not hidden): at ``t_k`` the GTI states ``x_k`` and the measurements
 give the derivatives; the states advance by forward Euler, ``x_{k+1} = x_k + dt f_k``, and the
 new set point ``Es_k`` (from ``x_k`` and ``theta_r(t_k)``) is held by the DPsim source over
