@@ -26,6 +26,12 @@ evaluated between DPsim steps from the *measured* terminal quantities:
   dc link's sight of those transients does (docs/engines.md: on the case-1 grid it is the whole
   difference to the phasor engine).
 
+``measured`` is the physics of this circuit, not a co-simulation artefact: on a test grid it
+converges in the step to the same circuit written as one ODE without delay
+(``tests/sim/test_emt_gti_reference.py``; docs/engines.md). A GTI in ``pq`` mode is refused
+with ``measured`` power: its P loop is unstable with the network's inductor dynamics, so the run
+would show that instability rather than the PQ baseline.
+
 Time stepping (stated, not hidden): at ``t_k`` the GTI states ``x_k`` and the measurements
 give the derivatives; the states advance by forward Euler, ``x_{k+1} = x_k + dt f_k``, and the
 new set point ``Es_k`` (from ``x_k`` and ``theta_r(t_k)``) is held by the DPsim source over
@@ -80,6 +86,14 @@ class GTIBridge:
         self.items = []
         if g is None or g.n == 0:
             return
+        if power == "measured" and g.pq.any():
+            i = int(np.nonzero(g.pq)[0][0])
+            raise DataError(g.element(i), "mode", "pq", "with gti_power = 'measured' its PQ "
+                            "loops act on the current of an ideal source behind 1/B and are "
+                            "unstable with the network's inductor dynamics (docs/engines.md: a "
+                            "pair at +218 ± 551j 1/s on the test grid), so the run would show "
+                            "that instability, not the PQ baseline; use gti_power = 'model' or "
+                            "the energy mode")
         net = system.network
         w = 2 * math.pi * net.f_hz
         Vb, Zb = bus_base(system)

@@ -65,7 +65,8 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
         The ac power a GTI's dc link pays (:mod:`weakgrid.sim.emt.gti`): the power its DPsim
         source delivered (``"measured"``, energy-consistent), or weakgrid's GTI model's own
         ``Re(Es conj(-jB(Es - V)))`` at the measured voltage (``"model"``, the dc link blind to
-        the coupling's current transients).
+        the coupling's current transients). A GTI in ``pq`` mode needs ``"model"``
+        (refused with ``"measured"``: unstable with the network's inductors, docs/engines.md).
     decimate : int
         Record every ``decimate``-th step.
     name : str
