@@ -25,7 +25,7 @@ pytestmark = pytest.mark.emt
 T_END = 0.8
 
 
-def _study(engine, fault=False, gti_power=None, drop_saturation=None):
+def _study(engine, fault=False, gti_power=None, drop_saturation=None, dpsim_dt_max=None):
     src = load_study("case1-weak-grid")
     d = copy.deepcopy(src.data)
     g = d["dynamics"]["generator"][0]
@@ -48,6 +48,8 @@ def _study(engine, fault=False, gti_power=None, drop_saturation=None):
         d.setdefault("simulation", {})["gti_power"] = gti_power
     if drop_saturation is not None:
         d.setdefault("simulation", {})["drop_saturation"] = drop_saturation
+    if dpsim_dt_max is not None:
+        d.setdefault("simulation", {})["dpsim_dt_max"] = dpsim_dt_max
     return study_from_dict(d, source=src.source)
 
 
@@ -136,6 +138,41 @@ def test_drop_saturation_is_the_studys_choice():
     check_supported(setup.system, (), "dpsim-dp", drop_saturation=True)
     with pytest.raises(ParameterError, match="simulation.drop_saturation"):
         _study("dpsim-dp", drop_saturation="yes")
+
+
+def test_pq_gti_with_measured_power_is_refused_at_planning():
+    """The PQ-mode GTI with gti_power = 'measured' is unstable in DPsim (docs/engines.md): the
+    planning check refuses it naming the GTI's mode, before any run; 'model' passes."""
+    from weakgrid.sim.emt import check_supported
+    from weakgrid.study.build import build_setup
+    from weakgrid.study.controllers import controller_variant
+    from weakgrid.study.runner import Run
+
+    st = _study("dpsim-dp")
+    sc = next(iter(st.scenarios()))
+    run = Run.of(st, sc, "pq")
+    setup = build_setup(st, run.load, run.upqc, controller_variant(st, "pq"))
+    with pytest.raises(DataError, match="mode"):
+        check_supported(setup.system, (), "dpsim-dp")
+    check_supported(setup.system, (), "dpsim-dp", gti_power="model")
+
+
+def test_dpsim_step_is_the_studys_choice():
+    """[simulation] dpsim_dt_max divides the run's step into parts of at most it (validated:
+    positive, at most 1e-3 s)."""
+    from weakgrid.study.runner import Run, prepare_run, sim_settings
+
+    for dmax in (1e-4, 2e-5):
+        st = _study("dpsim-dp", dpsim_dt_max=dmax)
+        sc = next(iter(st.scenarios()))
+        prep = prepare_run(st, Run.of(st, sc, "none"))
+        dt, _ = sim_settings(st)
+        n = round(dt / prep.dt)
+        assert prep.dt <= dmax * (1 + 1e-9) and n * prep.dt == pytest.approx(dt)
+        assert dt / (n - 1) > dmax                   # the fewest parts
+    for bad in (0.0, 0.01, "fine"):
+        with pytest.raises(ParameterError, match="simulation.dpsim_dt_max"):
+            _study("dpsim-dp", dpsim_dt_max=bad)
 
 
 def test_engine_option_overrides_the_study():

@@ -552,13 +552,17 @@ _add(Table("simulation", "Numerical settings of every run of the study.", (
           "keep (the figures' signals always).", default=Said("every signal")),
     Field("engine", S, "The simulator of every run: weakgrid's phasor engine, or the same grid "
           "in DPsim's electromagnetic transients or dynamic phasors (the extra `weakgrid[emt]`; "
-          "its step: the run's step divided into the fewest equal parts of at most 1e-4 s; "
+          "its step: the run's step divided into the fewest equal parts of at most dpsim_dt_max; "
           "a model or event DPsim lacks is refused by name before any run; "
           "documentation: Engines).", default="phasor", choices=_engines),
     Field("gti_power", S, "DPsim engines: the ac power a GTI's dc link pays — the power its "
           "DPsim source delivered (energy-consistent), or the GTI model's own power at the "
           "measured voltage (blind to the coupling's current transients; documentation: "
           "Engines).", default="measured", choices=("measured", "model")),
+    Field("dpsim_dt_max", {**_POS, "maximum": 1e-3}, "DPsim engines: the longest DPsim step; "
+          "the run's step is divided into the fewest equal parts of at most this. EMT needs a "
+          "step well below the period; a GTI's dc link through a fault converges at 2e-5 s or "
+          "less (documentation: Engines).", unit="s", default=1e-4),
     Field("drop_saturation", B, "DPsim engines: run a GENROU or GENSAL whose data have "
           "saturation (S10 ≠ 0) unsaturated — DPsim's machines have none — instead of refusing "
           "it; the choice is the study's, written in its runs' parameters (documentation: "

@@ -301,8 +301,10 @@ def check_engine(study, setup, events) -> None:
     if engine != "phasor":
         from ..sim.emt import check_supported
 
+        sim = _sim(study)
         check_supported(setup.system, events, engine,
-                        drop_saturation=_sim(study).get("drop_saturation", False))
+                        drop_saturation=sim.get("drop_saturation", False),
+                        gti_power=sim.get("gti_power", "measured"))
 
 
 def sim_settings(study, dt_factor: float = 1.0) -> tuple[float, float | None]:
@@ -439,10 +441,10 @@ def prepare_run(study, run: Run, trained=None, dt=None, design_load=None, design
                            enable=enable_windows(run.bypass, run.t_end), name=run.controller)
     if dt is None:
         dt, tol = sim_settings(study)
-    if engine != "phasor":       # DPsim: the run's step in parts of at most DT_MAX
-        from ..sim.emt import dpsim_step
+    if engine != "phasor":       # DPsim: the run's step in parts of at most dpsim_dt_max
+        from ..sim.emt import DT_MAX, dpsim_step
 
-        dt = dpsim_step(dt)
+        dt = dpsim_step(dt, _sim(study).get("dpsim_dt_max", DT_MAX))
     return Prepared(study, run, setup, dload, ctl, choice, dc, events, float(dt), tol,
                     record_list(study, setup.signals), xs, ys, engine)
 

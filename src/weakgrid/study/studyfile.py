@@ -449,6 +449,12 @@ def study_from_dict(d: dict, source: str = "", base_dir=None) -> Study:
             _choice(sim, "engine", "simulation", ENGINES)
         if "gti_power" in sim:
             _choice(sim, "gti_power", "simulation", ("measured", "model"))
+        if "dpsim_dt_max" in sim:
+            _num(sim, "dpsim_dt_max", "simulation", positive=True)
+            if sim["dpsim_dt_max"] > 1e-3:
+                raise ParameterError("simulation.dpsim_dt_max", sim["dpsim_dt_max"], "give a "
+                                     "DPsim step of at most 1e-3 s (EMT needs a step well "
+                                     "below the 50/60 Hz period; 1e-4 s is the default)")
         if "drop_saturation" in sim and not isinstance(sim["drop_saturation"], bool):
             raise ParameterError("simulation.drop_saturation", sim["drop_saturation"],
                                  "give true (run saturated machines unsaturated in DPsim) or "

@@ -62,6 +62,23 @@ _KINDS = {"Vc": "pu", "phi_hat": "angle", "Vs": "pu", "ks": "pu", "phi_s": "angl
           "P_series": "power"}
 
 
+def check_gti(system, power: str = "measured") -> None:
+    """Refuse what the DPsim GTI cannot run: an unknown ``power`` coupling, or a PQ-mode GTI
+    with ``power="measured"`` (its PQ loops act on the current of an ideal source behind
+    ``1/B`` and are unstable with the network's inductor dynamics; docs/engines.md)."""
+    if power not in ("measured", "model"):
+        raise DataError("simulate_dpsim", "gti_power", power, "use 'measured' or 'model'")
+    g = system.components.get("GTI")
+    if power == "measured" and g is not None and g.n and g.pq.any():
+        i = int(np.nonzero(g.pq)[0][0])
+        raise DataError(g.element(i), "mode", "pq", "with gti_power = 'measured' its PQ "
+                        "loops act on the current of an ideal source behind 1/B and are "
+                        "unstable with the network's inductor dynamics (docs/engines.md: a "
+                        "pair at +218 ± 551j 1/s on the test grid), so the run would show "
+                        "that instability, not the PQ baseline; use gti_power = 'model' or "
+                        "the energy mode")
+
+
 class GTIBridge:
     """Every GTI of a system as a DPsim source behind its coupling reactance, driven by
     weakgrid's GTI equations between steps.
@@ -78,22 +95,14 @@ class GTIBridge:
     def __init__(self, system, kit, cir, power="measured"):
         from .topology import bus_base
 
-        if power not in ("measured", "model"):
-            raise DataError("simulate_dpsim", "gti_power", power, "use 'measured' or 'model'")
+        check_gti(system, power)
         self.power = power
         self.system, self.kit = system, kit
         self.g = g = system.components.get("GTI")
         self.items = []
         if g is None or g.n == 0:
             return
-        if power == "measured" and g.pq.any():
-            i = int(np.nonzero(g.pq)[0][0])
-            raise DataError(g.element(i), "mode", "pq", "with gti_power = 'measured' its PQ "
-                            "loops act on the current of an ideal source behind 1/B and are "
-                            "unstable with the network's inductor dynamics (docs/engines.md: a "
-                            "pair at +218 ± 551j 1/s on the test grid), so the run would show "
-                            "that instability, not the PQ baseline; use gti_power = 'model' or "
-                            "the energy mode")
+        check_gti(system, power)
         net = system.network
         w = 2 * math.pi * net.f_hz
         Vb, Zb = bus_base(system)

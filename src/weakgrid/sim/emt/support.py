@@ -18,6 +18,7 @@ from ..errors import DataError
 from ..events import Fault, GeneratorTrip, LoadStep
 from .dpsim_module import domain_of
 from .events import BOLTED_MAX, removed_load, _unit
+from .gti import check_gti
 from .machines import check_machines
 from .topology import check_devices, check_network
 
@@ -33,12 +34,13 @@ def dpsim_step(dt: float, dt_max: float = DT_MAX) -> float:
 
 
 def check_supported(system, events=(), engine: str = "dpsim-emt",
-                    drop_saturation: bool = False) -> None:
+                    drop_saturation: bool = False, gti_power: str = "measured") -> None:
     """Raise :class:`DataError` if ``system`` (set up) or ``events`` has anything the DPsim
     engine ``engine`` does not map (refused by name, never substituted); ``drop_saturation``
-    as in :func:`weakgrid.sim.emt.simulate_dpsim`."""
+    and ``gti_power`` as in :func:`weakgrid.sim.emt.simulate_dpsim`."""
     domain_of(engine)
     check_machines(system, drop_saturation)
+    check_gti(system, gti_power)
     check_devices(system)
     net = system.network
     check_network(system, removed_load(system, events))
