@@ -17,6 +17,13 @@ Measurements of the paper's design states from the simulated grid
 Each is a measurement of signals (:func:`gti_signals`, :func:`sg_signals`) composed with a
 measurement mapping of :mod:`weakgrid.sim.design_states` (:func:`gti_state_map`,
 :func:`sg_state_map`): the part a device runs, exported to C with the controller.
+
+A measurement function ``measure(sim, t, z, ctx)`` may also carry ``measure.key`` (what it
+measures: equal keys measure the same signals) and ``measure.rows(fns, sims, t, ctx, pos)``:
+the measurements of rows ``pos`` of a batched evaluation context ``ctx`` (one per member,
+``sims`` their simulators, ``fns`` their measurement functions) as an ``(n, m)`` array equal
+row by row to each member's own call, or None when they cannot be taken together. The batch
+simulator uses it to measure all its members at a sampling instant in one gather.
 """
 
 from __future__ import annotations
@@ -183,7 +190,10 @@ class DigitalController:
         ``K`` also takes a ``(B, n)`` array of ``B`` measurement vectors and returns the
         ``(B, target.size)`` outputs (a trained network evaluated row-wise, a linear feedback on
         arrays): the batch simulator (:mod:`weakgrid.sim.batch`) then calls it once for all the
-        members it samples at an instant that share this ``K``.
+        members it samples at an instant that share this ``K``, measures them in one gather
+        when ``measure`` can read rows of a batched context (it has ``key`` and ``rows``, as the
+        measurements of :func:`gti_signals`, :func:`sg_signals` and :func:`mapped` do) and holds
+        their outputs at once when the target names its slots (:meth:`UPQCTarget.slots`).
     """
 
     def __init__(self, K, T, measure, target, enable=None, bypass=None, name="controller", t0=0.0,
