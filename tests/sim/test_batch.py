@@ -315,3 +315,29 @@ def test_batched_measurements_equal_each_members_own():
             one = s.evaluate(0.0, Z[k])
             sims[k]._ctx = one
             assert np.array_equal(got[i], fns[k](sims[k], 0.0, Z[k], one))
+
+
+def _three_outputs(m):
+    return np.zeros(np.shape(m)[:-1] + (3,))
+
+
+def _nan_outputs(m):
+    return np.full(np.shape(m)[:-1] + (2,), np.nan)
+
+
+@pytest.mark.parametrize("K", [_three_outputs, _nan_outputs])
+def test_a_batched_policy_with_bad_outputs_fails_each_member_as_its_run_alone(K):
+    """Outputs of the wrong width or not finite: every member stops with the failure (cause,
+    time, message) of its run alone, where the same policy gets one measurement vector."""
+    s = build_gti_upqc_sg("reduced")
+
+    def scen(batched):
+        return [{"events": [Fault(3, 0.2, 0.25, xf=x)],
+                 "controllers": [DigitalController(K, DT, gti_design_states("PV"), UPQCTarget("U"),
+                                                   enable=[(0.3, 1.0)], batched=batched)]}
+                for x in (0.05, 0.1)]
+    alone = [_alone(s, sc, 0.5, dt=DT, tol=1e-6) for sc in scen(False)]
+    got = simulate_batch(s, scen(True), 0.5, dt=DT, tol=1e-6)
+    for a, b in zip(alone, got):
+        assert a.failure is not None and a.failure.cause == "controller"
+        _same(a, b)
