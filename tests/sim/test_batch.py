@@ -264,3 +264,80 @@ def test_every_component_that_reads_the_time_is_refused_by_the_batch():
             readers.append(name)
             assert hasattr(cls, "accept"), f"{name} reads the time but has no discrete memory"
     assert {"GGOV1", "REECA1"} <= set(readers)    # the check sees the time readers
+
+
+def test_controlled_at_T_1ms_batched_samples_equal_one_by_one():
+    """The T = 1 ms digital controller (bench_sim's controlled run, shortened): the batched
+    samples (one measurement gather, one policy call, one hold for the batch) equal each
+    member's run alone, including a member whose controller is enabled later (its bypass held
+    while the others are sampled) and one with a scalar policy (sampled alone in the batch)."""
+    s = build_gti_upqc_sg("reduced")
+    tf, T = 0.4, 1e-3
+
+    def scen(batched):
+        K = _VectorPolicy() if batched else _K
+        return [{"events": [Fault(3, 0.2, 0.25, xf=x)],
+                 "controllers": [DigitalController(pol, T, gti_design_states("PV"), UPQCTarget("U"),
+                                                   enable=[(t_on, tf)], batched=batched and pol is K)]}
+                for pol, x, t_on in ((K, 0.05, 0.25), (K, 0.1, 0.3), (K, 0.08, 0.25), (_K2, 0.05, 0.25))]
+    alone_sc, sc = scen(False), scen(True)
+    alone = [_alone(s, c, tf, dt=T, tol=1e-6) for c in alone_sc]
+    got = simulate_batch(s, sc, tf, dt=T, tol=1e-6)
+    for a, b, ca, cb in zip(alone, got, alone_sc, sc):
+        assert a.ok and b.ok
+        _same(a, b)
+        da, db = ca["controllers"][0], cb["controllers"][0]
+        assert da.log_t == db.log_t
+        assert np.array_equal(np.array(da.log_u), np.array(db.log_u))
+    u0, u2 = (np.array(sc[k]["controllers"][0].log_u) for k in (0, 2))
+    assert u0.shape == u2.shape and np.abs(u0 - u2).max() > 1e-4      # the members' outputs differ
+    assert sc[0]["controllers"][0].K.calls <= round((tf - 0.25) / T) + 2    # one call per instant
+
+
+def test_batched_measurements_equal_each_members_own():
+    """``measure.rows`` (one gather for rows of a batched context, the state map's
+    ``map_rows``) gives each member's own measurement bit for bit."""
+    from weakgrid.sim.controllers import sg_design_states
+
+    s = build_gti_upqc_sg("reduced")
+    sims = [Simulator(copy.deepcopy(s), dt=DT) for _ in range(3)]
+    Z = np.stack([sm.z for sm in sims])
+    Z[1, :] *= 1.01
+    Z[2, :] *= 0.98
+    ctx = s.evaluate(0.0, Z)
+    mach = s.machine_names[0]
+    bus = int(s.network.bus_ids[0])
+    for make in (lambda: gti_design_states("PV"), lambda: sg_design_states(mach, bus, ws=377.0)):
+        fns = [make() for _ in sims]
+        pos = [2, 0, 1]
+        got = fns[0].rows(fns, [sims[k] for k in pos], 0.0, ctx, pos)
+        for i, k in enumerate(pos):
+            one = s.evaluate(0.0, Z[k])
+            sims[k]._ctx = one
+            assert np.array_equal(got[i], fns[k](sims[k], 0.0, Z[k], one))
+
+
+def _three_outputs(m):
+    return np.zeros(np.shape(m)[:-1] + (3,))
+
+
+def _nan_outputs(m):
+    return np.full(np.shape(m)[:-1] + (2,), np.nan)
+
+
+@pytest.mark.parametrize("K", [_three_outputs, _nan_outputs])
+def test_a_batched_policy_with_bad_outputs_fails_each_member_as_its_run_alone(K):
+    """Outputs of the wrong width or not finite: every member stops with the failure (cause,
+    time, message) of its run alone, where the same policy gets one measurement vector."""
+    s = build_gti_upqc_sg("reduced")
+
+    def scen(batched):
+        return [{"events": [Fault(3, 0.2, 0.25, xf=x)],
+                 "controllers": [DigitalController(K, DT, gti_design_states("PV"), UPQCTarget("U"),
+                                                   enable=[(0.3, 1.0)], batched=batched)]}
+                for x in (0.05, 0.1)]
+    alone = [_alone(s, sc, 0.5, dt=DT, tol=1e-6) for sc in scen(False)]
+    got = simulate_batch(s, scen(True), 0.5, dt=DT, tol=1e-6)
+    for a, b in zip(alone, got):
+        assert a.failure is not None and a.failure.cause == "controller"
+        _same(a, b)

@@ -844,8 +844,9 @@ class BatchSimulator:
 
     def _sample(self, t, rows, ctls, fail):
         """Take the due samples of members ``rows``; ``{k: changed}``. The ``j``-th controllers
-        of the members that share one ``K`` declared ``batched`` are evaluated by one call of
-        ``K`` on the stacked measurements; the others one by one (:meth:`DigitalController.sample`)."""
+        of the members that share one ``K`` declared ``batched`` are sampled together
+        (:meth:`_sample_group`: one measurement, one call of ``K``, one hold for all of them);
+        the others one by one (:meth:`DigitalController.sample`)."""
         t0 = time.perf_counter()
         changed = {k: False for k in rows}
         for j in range(max((len(ctls[k]) for k in rows), default=0)):
@@ -856,40 +857,127 @@ class BatchSimulator:
                 c = ctls[k][j]
                 if not c.due(t):
                     continue
+                key = c.batch_key() if hasattr(c, "batch_key") else None
+                if key is not None:
+                    groups.setdefault(key, []).append(k)
+                    continue
                 sim = self.sims[k]
                 sim._ctx = _RowCtx(*self._cx[k], sim.sys)   # what the measurement reads
                 try:
-                    if getattr(c, "batched", False):
-                        m = c.measurement(sim, t)
-                        if m is not None:
-                            groups.setdefault(id(c.K), []).append((k, c, m))
-                            continue
-                        changed[k] |= c.hold(t, c.bypass)
-                    else:
-                        changed[k] |= c.sample(sim, t, sim.z)
+                    changed[k] |= c.sample(sim, t, sim.z)
                 except SimulationError as exc:
                     fail(k, exc)
                     del changed[k]
-            for members in groups.values():
-                c0 = members[0][1]
-                try:
-                    U = xp.asarray(c0.K(xp.stack([xp.asarray(m, dtype=float) for _, _, m in members])),
-                                   dtype=float)
-                    if U.shape[0] != len(members):
-                        raise ValueError(f"a batched policy returned {U.shape[0]} rows for {len(members)}")
-                except Exception as exc:
-                    for k, c, _ in members:
-                        fail(k, SimulationError(t, "controller", f"'{c.name}' raised {exc!r}"))
-                        del changed[k]
-                    continue
-                for (k, c, m), u in zip(members, U):
-                    try:
-                        changed[k] |= c.hold(t, u, m)
-                    except SimulationError as exc:
-                        fail(k, exc)
-                        del changed[k]
+            for ks in groups.values():
+                self._sample_group(t, ks, [ctls[k][j] for k in ks], changed, fail)
         self.timing["events"] += time.perf_counter() - t0
         return changed
+
+    def _sample_group(self, t, ks, cs, changed, fail):
+        """Sample the controllers ``cs`` of members ``ks`` (one each, sharing a batched ``K``):
+        the measurements of the enabled ones stacked (:meth:`_measure`), ``K`` called once on
+        them, each output checked, and every output (the bypass of the disabled) held at once
+        (:meth:`_hold`); each member's samples equal its run alone."""
+        on = [i for i, c in enumerate(cs) if c.active(t)]
+        hk, hc, hu = [], [], []
+        for i in sorted(set(range(len(cs))) - set(on)):
+            hk.append(ks[i])
+            hc.append(cs[i])
+            hu.append(cs[i].bypass)
+        if on:
+            mk, mc, M = self._measure(t, [ks[i] for i in on], [cs[i] for i in on], fail)
+            if mk:
+                try:
+                    U = xp.asarray(mc[0].K(M), dtype=float)
+                    if U.ndim != 2 or U.shape[0] != len(mk):
+                        raise ValueError(f"a batched policy returned {U.shape[0] if U.ndim else 0} rows "
+                                         f"for {len(mk)} (an array of shape {U.shape})")
+                except Exception as exc:
+                    for k, c in zip(mk, mc):
+                        fail(k, SimulationError(t, "controller", f"'{c.name}' raised {exc!r}"))
+                        del changed[k]
+                    mk = []
+                ok = (xp.isfinite(U).all(axis=1) if mk and U.shape[1] == mc[0].target.size
+                      else xp.zeros(len(mk), dtype=bool))
+                for i, (k, c) in enumerate(zip(mk, mc)):
+                    if not ok[i]:    # its own message (as its run alone)
+                        try:
+                            c.check(t, U[i], M[i])
+                        except SimulationError as exc:
+                            fail(k, exc)
+                            del changed[k]
+                            continue
+                    hk.append(k)
+                    hc.append(c)
+                    hu.append(U[i])
+        if hk:
+            for k, ch in zip(hk, self._hold(t, hk, hc, hu)):
+                changed[k] |= ch
+
+    def _measure(self, t, ks, cs, fail):
+        """The measurements of controllers ``cs`` of members ``ks`` at their accepted points:
+        one gather per context when the measurement reads rows of a batched context (its
+        ``rows``), else one by one. Returns the members measured, their controllers and the
+        ``(n, m)`` measurements."""
+        fns = [c.measure for c in cs]
+        rows_of = getattr(fns[0], "rows", None)
+        at = {k: i for i, k in enumerate(ks)}
+        if rows_of is not None:
+            blocks = []
+            for ctx, g, pos in self._by_ctx(ks):
+                Y = rows_of([fns[at[k]] for k in g], [self.sims[k] for k in g], t, ctx, pos)
+                if Y is None:
+                    break
+                blocks.append(([at[k] for k in g], xp.asarray(Y, dtype=float)))
+            else:
+                if len(blocks) == 1:      # one context: the rows in the members' order
+                    return list(ks), list(cs), blocks[0][1]
+                M = xp.empty((len(ks), blocks[0][1].shape[1]))
+                for idx, Y in blocks:
+                    M[idx] = Y
+                return list(ks), list(cs), M
+        mk, mc, M = [], [], []
+        for k, c in zip(ks, cs):
+            sim = self.sims[k]
+            sim._ctx = _RowCtx(*self._cx[k], sim.sys)   # what the measurement reads
+            try:
+                m = c.measurement(sim, t)
+            except SimulationError as exc:
+                fail(k, exc)
+                continue
+            mk.append(k)
+            mc.append(c)
+            M.append(xp.asarray(m, dtype=float))
+        return mk, mc, (xp.stack(M) if M else xp.zeros((0, 0)))
+
+    def _hold(self, t, ks, cs, U):
+        """Hold output ``U[i]`` (checked) on the target of controller ``cs[i]`` of member
+        ``ks[i]`` from sample ``t`` on; whether each held output changed. The targets that
+        name their slots in the members' batched inputs (``target.slots()``, e.g. the UPQC's
+        ``u_p``, ``u_q``) are read and written for all the members at once."""
+        for c, u in zip(cs, U):
+            c.logged(t, u)
+        slots = getattr(cs[0].target, "slots", None)
+        slots = slots() if slots is not None else None
+        where = {(c.type_name, attr): stack for c, attr, stack in self._inputs}
+        if slots is None or any(s[:2] not in where for s in slots) or \
+                any(getattr(c.target, "slots", lambda: None)() != slots for c in cs[1:]):
+            out = []
+            for c, u in zip(cs, U):
+                ch = not xp.array_equal(c.target.get(), u)
+                if ch:
+                    c.target.apply(u)
+                out.append(ch)
+            return out
+        U = xp.stack([xp.asarray(u, dtype=float) for u in U])
+        rows = xp.asarray(ks)
+        old = xp.stack([where[(typ, attr)][rows, i] for typ, attr, i in slots], axis=1)
+        ch = (old != U).any(axis=1)
+        if ch.any():
+            r = rows[ch]
+            for e, (typ, attr, i) in enumerate(slots):
+                where[(typ, attr)][r, i] = U[ch, e]
+        return ch.tolist()
 
     def _solve_jump(self, t, rows, guesses, paths, fail):
         """Consistent network re-solve of members ``rows`` after a jump: the batched chord

@@ -17,6 +17,13 @@ Measurements of the paper's design states from the simulated grid
 Each is a measurement of signals (:func:`gti_signals`, :func:`sg_signals`) composed with a
 measurement mapping of :mod:`weakgrid.sim.design_states` (:func:`gti_state_map`,
 :func:`sg_state_map`): the part a device runs, exported to C with the controller.
+
+A measurement function ``measure(sim, t, z, ctx)`` may also carry ``measure.key`` (what it
+measures: equal keys measure the same signals) and ``measure.rows(fns, sims, t, ctx, pos)``:
+the measurements of rows ``pos`` of a batched evaluation context ``ctx`` (one per member,
+``sims`` their simulators, ``fns`` their measurement functions) as an ``(n, m)`` array equal
+row by row to each member's own call, or None when they cannot be taken together. The batch
+simulator uses it to measure all its members at a sampling instant in one gather.
 """
 
 from __future__ import annotations
@@ -50,6 +57,11 @@ class UPQCTarget:
     def apply(self, u):
         self.upqc.u_p[self.i], self.upqc.u_q[self.i] = float(u[0]), float(u[1])
 
+    def slots(self):
+        """Where each element of ``u`` is held: ``(component type, attribute, instance)``
+        (the batch simulator writes the outputs of many members at once there)."""
+        return (("UPQC", "u_p", self.i), ("UPQC", "u_q", self.i))
+
 
 def gti_signals(gti_name):
     """Measurement function returning the measured signals ``[phi_s, Vc]`` of GTI ``gti_name``
@@ -60,7 +72,19 @@ def gti_signals(gti_name):
         i = g.names.index(gti_name)
         return np.array([ctx.out["GTI.phi_s"][i], ctx.x[g.idx("Vc")[i]]])
 
+    def rows(fns, sims, t, ctx, pos):
+        g = sims[0].sys.components["GTI"]
+        i = g.names.index(gti_name)
+        return np.stack([_gather(ctx.out["GTI.phi_s"], pos, i), ctx.x[pos, g.idx("Vc")[i]]], axis=1)
+
+    measure.key, measure.rows = ("gti_signals", gti_name), rows
     return measure
+
+
+def _gather(v, pos, i):
+    """Column ``i`` of rows ``pos`` of a batched context array ``v`` (a 1-D ``v`` holds one
+    value per instance for every row)."""
+    return v[pos, i] if np.ndim(v) >= 2 else np.full(len(pos), v[i])
 
 
 def gti_state_map(system, gti_name) -> GTIStateMap:
@@ -81,6 +105,14 @@ def sg_signals(machine_name, upqc_bus):
         b = s.network.index_of(upqc_bus)
         return np.array([ctx.sig["delta"][m], float(np.angle(ctx.V[b])), ctx.sig["omega"][m]])
 
+    def rows(fns, sims, t, ctx, pos):
+        s = sims[0].sys
+        m = s.machine_number(machine_name)
+        b = s.network.index_of(upqc_bus)
+        return np.stack([_gather(ctx.sig["delta"], pos, m), np.angle(ctx.V[pos, b]),
+                         _gather(ctx.sig["omega"], pos, m)], axis=1)
+
+    measure.key, measure.rows = ("sg_signals", machine_name, upqc_bus), rows
     return measure
 
 
@@ -98,13 +130,26 @@ def mapped(signals, state_map):
     when the first sample is taken if it is a callable of the system, else it is the map."""
     cache = {}
 
-    def measure(sim, t, z, ctx):
-        mp = cache.get(id(sim.sys))
+    def map_of(system):
+        mp = cache.get(id(system))
         if mp is None:
-            mp = cache[id(sim.sys)] = state_map(sim.sys) if not hasattr(state_map, "signals") \
+            mp = cache[id(system)] = state_map(system) if not hasattr(state_map, "signals") \
                 else state_map
-        return mp(signals(sim, t, z, ctx))
+        return mp
 
+    def measure(sim, t, z, ctx):
+        return map_of(sim.sys)(signals(sim, t, z, ctx))
+
+    measure.map_of = map_of
+    if hasattr(signals, "rows"):
+        def rows(fns, sims, t, ctx, pos):
+            maps = [f.map_of(sim.sys) for f, sim in zip(fns, sims)]
+            kind = type(maps[0])
+            if not hasattr(kind, "map_rows") or any(type(mp) is not kind for mp in maps):
+                return None      # measured one by one
+            return kind.map_rows(maps, signals.rows([signals], sims, t, ctx, pos))
+
+        measure.key, measure.rows = ("mapped",) + signals.key, rows
     return measure
 
 
@@ -145,7 +190,10 @@ class DigitalController:
         ``K`` also takes a ``(B, n)`` array of ``B`` measurement vectors and returns the
         ``(B, target.size)`` outputs (a trained network evaluated row-wise, a linear feedback on
         arrays): the batch simulator (:mod:`weakgrid.sim.batch`) then calls it once for all the
-        members it samples at an instant that share this ``K``.
+        members it samples at an instant that share this ``K``, measures them in one gather
+        when ``measure`` can read rows of a batched context (it has ``key`` and ``rows``, as the
+        measurements of :func:`gti_signals`, :func:`sg_signals` and :func:`mapped` do) and holds
+        their outputs at once when the target names its slots (:meth:`UPQCTarget.slots`).
     """
 
     def __init__(self, K, T, measure, target, enable=None, bypass=None, name="controller", t0=0.0,
@@ -204,23 +252,42 @@ class DigitalController:
             return None
         return self.measure(sim, t, sim.z if z is None else z, sim._ctx)
 
+    def batch_key(self):
+        """What the members sampled together must share for one call of ``K`` (None: sampled
+        alone, :meth:`sample`): ``K`` itself (declared ``batched``) and what is measured (the
+        ``key`` of a measurement function that can read rows of a batched context, see
+        :func:`gti_signals`; None if it cannot)."""
+        if not self.batched:
+            return None
+        return id(self.K), getattr(self.measure, "key", None)
+
+    def check(self, t, u, m):
+        """The policy's output ``u`` for measurement ``m`` as a flat float array, checked
+        (finite, ``target.size`` values); raises :class:`SimulationError` otherwise."""
+        try:
+            u = np.asarray(u, dtype=float).reshape(-1)
+        except Exception as exc:
+            raise SimulationError(t, "controller", f"'{self.name}' raised {exc!r}") from exc
+        if u.shape != (self.target.size,) or not np.all(np.isfinite(u)):
+            raise SimulationError(t, "controller",
+                                  f"'{self.name}' returned {u.tolist()} for measurements {np.asarray(m).tolist()}; "
+                                  f"expected {self.target.size} finite values")
+        return u
+
+    def logged(self, t, u):
+        """Book the output ``u`` held from sample ``t`` on (the sample count and the log)."""
+        self.k += 1
+        self.log_t.append(t)
+        self.log_u.append(u.copy())
+
     def hold(self, t, u, m=None):
         """Check the policy's output ``u`` for measurement ``m`` (None: the bypass) and hold it
         from sample ``t`` on; returns True if the held output changed. (:meth:`sample` in two
         halves, so that a batch of members can evaluate ``K`` once for all of them.)"""
         if m is not None:
-            try:
-                u = np.asarray(u, dtype=float).reshape(-1)
-            except Exception as exc:
-                raise SimulationError(t, "controller", f"'{self.name}' raised {exc!r}") from exc
-            if u.shape != (self.target.size,) or not np.all(np.isfinite(u)):
-                raise SimulationError(t, "controller",
-                                      f"'{self.name}' returned {u.tolist()} for measurements {np.asarray(m).tolist()}; "
-                                      f"expected {self.target.size} finite values")
-        self.k += 1
+            u = self.check(t, u, m)
+        self.logged(t, u)
         old = self.target.get()
-        self.log_t.append(t)
-        self.log_u.append(u.copy())
         if np.array_equal(old, u):
             return False
         self.target.apply(u)

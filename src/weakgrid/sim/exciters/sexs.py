@@ -57,7 +57,7 @@ class SEXS(MachineControl):
         x[self.sl(1)] = vf0
 
     def compute(self, ctx):
-        m = self.mach
+        m = self._mi    # a slice when the machines are contiguous (a view, no gather)
         ll, law = ctx.x[..., self._sls[0]], ctx.x[..., self._sls[1]]
         vi = self.vref0 - ctx.sig["Ecomp"][..., m] + ctx.sig["vs"][..., m]
         y = self.LL.output(ll, vi)

@@ -116,7 +116,7 @@ class HYGOV(MachineControl):
 
     def compute(self, ctx):
         p = self.p
-        m = self.mach
+        m = self._mi    # a slice when the machines are contiguous (a view, no gather)
         x1, xi, g, q = (ctx.x[..., self._sls[k]] for k in range(4))
         wd = ctx.sig["omega"][..., m] - p["wref0"]
         c = xi + x1 / p["r"]
