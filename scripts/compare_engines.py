@@ -9,8 +9,9 @@ and ``runs/<id>.parquet``); the first is the reference. Writes, atomically:
 
 - ``OUT_DIR/NAME-metrics.md`` and ``.csv``: per run id and engine the speed peak deviation
   (``speed_peak_dev_pu``), the dc-link peak deviation (``vdc_peak_dev_pu``), the speed and
-  dc-link settling times, the largest ``|Vu|`` (``vu_peak_pu``), the demanded peak, the running
-  cost of (18) (``running_cost_18``), and each one's difference from the reference in per cent;
+  dc-link settling times, the largest ``|Vu|`` (``vu_peak_pu``), the demanded peak, the peak
+  series power, the running cost of (18) (``running_cost_18``), the run's wall time, each
+  with its difference from the reference in per cent (``--metrics`` picks columns);
 - ``OUT_DIR/NAME-claims.md``: the verdict of every claim in each engine (the ``claims.json``
   each run writes);
 - ``OUT_DIR/NAME-<scenario>.png``: per scenario, one row per controller, the speed, dc-link
@@ -40,8 +41,9 @@ METRICS = (("speed_peak_dev_pu", "speed peak [pu]"),
            ("speed_settling_s", "speed settling [s]"),
            ("vdc_peak_dev_pu", "dc-link peak [pu]"),
            ("vdc_settling_s", "dc-link settling [s]"),
-           ("vu_peak_pu", "|Vu| peak [pu]"),
-           ("u_demanded_peak_pu", "demanded |u| peak [pu]"),
+           ("vu_peak_pu", "series voltage peak [pu]"),
+           ("u_demanded_peak_pu", "demanded u peak [pu]"),
+           ("p_series_peak_mw", "series power peak [MW]"),
            ("running_cost_18", "running cost (18)"),
            ("wall_s", "wall [s]"))
 COLORS = ("k", "tab:blue", "tab:red", "tab:green")
@@ -78,12 +80,13 @@ def _pct(v: float, ref: float) -> str:
     return f" ({100 * (v / ref - 1):+.0f} %)"
 
 
-def metrics_table(m: dict) -> tuple[str, pd.DataFrame]:
+def metrics_table(m: dict, only=None) -> tuple[str, pd.DataFrame]:
     """Markdown table (rows run id × engine; each non-reference value with its difference from the
-    reference engine in per cent) and the long table behind it."""
+    reference engine in per cent) and the long table behind it; ``only``: these metrics."""
     labels = list(m)
     ref = labels[0]
-    cols = [(c, h) for c, h in METRICS if any(c in df.columns for df in m.values())]
+    cols = [(c, h) for c, h in METRICS if any(c in df.columns for df in m.values())
+            and (not only or c in only)]
     ids = [i for i in m[ref].index if all(i in df.index for df in m.values())]
     rows, lines = [], []
     lines.append("| run | engine | " + " | ".join(h for _, h in cols) + " |")
@@ -147,11 +150,11 @@ def figures(out: Path, name: str, folders, m: dict, panels, scenarios, t_from, t
         fig, axes = plt.subplots(len(items), len(panels), figsize=(4.2 * len(panels),
                                  2.4 * len(items)), squeeze=False, sharex=True)
         for i, (c, rid) in enumerate(items):
+            drawn = set()
             for k, (lab, folder) in enumerate(folders):
                 p = folder / "runs" / f"{rid}.parquet"
                 if not p.is_file():
                     continue
-                sig = [s for s, _ in panels]
                 r = read_run(p)
                 t = r["t"].to_numpy()
                 keep = (t >= t_from) & (t <= t_to if t_to else True)
@@ -159,11 +162,15 @@ def figures(out: Path, name: str, folders, m: dict, panels, scenarios, t_from, t
                     if s in r.columns:
                         axes[i][j].plot(t[keep], r[s].to_numpy()[keep], STYLES[k % 4],
                                         color=COLORS[k % 4], lw=1.0, label=lab)
-                del sig
+                        drawn.add(j)
             for j, (_, title) in enumerate(panels):
                 axes[i][j].set_title(f"{c}: {title}", fontsize=9)
                 axes[i][j].grid(alpha=0.3)
                 axes[i][j].tick_params(labelsize=8)
+                if j not in drawn:           # the run has no such signal (e.g. no UPQC)
+                    axes[i][j].set_yticks([])
+                    axes[i][j].text(0.5, 0.5, "not in this run", ha="center", va="center",
+                                    transform=axes[i][j].transAxes, fontsize=8, color="0.4")
             axes[i][0].legend(fontsize=7, loc="best")
         for j in range(len(panels)):
             axes[-1][j].set_xlabel("t [s]", fontsize=8)
@@ -186,6 +193,8 @@ def main(argv=None) -> int:
     ap.add_argument("--vu", default="U.Vu", help="series-voltage magnitude signal [pu]")
     ap.add_argument("--dc", default=None, help="dc-link voltage signal [pu] (a GTI's `<gti>.Vc`)")
     ap.add_argument("--scenario", action="append", default=[], help="only these scenarios' figures")
+    ap.add_argument("--metrics", default="", help="comma-separated metrics.csv columns of the "
+                    "table (default: all of " + ", ".join(c for c, _ in METRICS) + ")")
     ap.add_argument("--from", dest="t_from", type=float, default=0.0, help="figure start [s]")
     ap.add_argument("--to", dest="t_to", type=float, default=None, help="figure end [s]")
     a = ap.parse_args(argv)
@@ -197,7 +206,11 @@ def main(argv=None) -> int:
         folders.append((lab, Path(folder)))
     m = load(folders)
     a.out.mkdir(parents=True, exist_ok=True)
-    md, long = metrics_table(m)
+    only = [c.strip() for c in a.metrics.split(",") if c.strip()]
+    unknown = sorted(set(only) - {c for c, _ in METRICS})
+    if unknown:
+        raise SystemExit(f"--metrics: unknown {unknown}; known: {[c for c, _ in METRICS]}")
+    md, long = metrics_table(m, only)
     write_text_atomic(a.out / f"{a.name}-metrics.md", md)
     write_text_atomic(a.out / f"{a.name}-metrics.csv", long.to_csv(index=False))
     write_text_atomic(a.out / f"{a.name}-claims.md", claims_table(folders))
