@@ -55,10 +55,19 @@ def load(runs: list[tuple[str, Path]]) -> dict:
     out = {}
     for label, folder in runs:
         f = folder / "metrics.csv"
-        if not f.is_file():
-            raise SystemExit(f"--run {label}={folder}: no metrics.csv there (a `weakgrid run` "
-                             "output folder is expected)")
-        out[label] = pd.read_csv(f).set_index("id")
+        if f.is_file():
+            out[label] = pd.read_csv(f).set_index("id")
+            continue
+        # a run still under way: the finished runs' metrics, each in its runs/<id>.json
+        rows = [json.loads(j.read_text(encoding="utf-8"))["metrics"]
+                for j in sorted((folder / "runs").glob("*.json"))] if (folder / "runs").is_dir() \
+            else []
+        if not rows:
+            raise SystemExit(f"--run {label}={folder}: no metrics.csv and no finished run there "
+                             "(a `weakgrid run` output folder is expected)")
+        print(f"{label}: no metrics.csv yet, {len(rows)} finished runs read from "
+              f"{folder / 'runs'}", file=sys.stderr)
+        out[label] = pd.DataFrame(rows).set_index("id")
     return out
 
 
@@ -87,13 +96,15 @@ def metrics_table(m: dict, only=None) -> tuple[str, pd.DataFrame]:
     ref = labels[0]
     cols = [(c, h) for c, h in METRICS if any(c in df.columns for df in m.values())
             and (not only or c in only)]
-    ids = [i for i in m[ref].index if all(i in df.index for df in m.values())]
+    ids = [i for i in m[ref].index if any(i in df.index for lab, df in m.items() if lab != ref)]
     rows, lines = [], []
     lines.append("| run | engine | " + " | ".join(h for _, h in cols) + " |")
     lines.append("|---|---|" + "---|" * len(cols))
     for rid in ids:
         for lab in labels:
             df = m[lab]
+            if rid not in df.index:
+                continue
             cells = []
             for c, _ in cols:
                 v = _num(df.at[rid, c]) if c in df.columns else math.nan
