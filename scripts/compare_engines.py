@@ -86,6 +86,8 @@ def _fmt(v: float) -> str:
 def _pct(v: float, ref: float) -> str:
     if not (math.isfinite(v) and math.isfinite(ref)) or ref == 0:
         return ""
+    if abs(v / ref) >= 10:                 # orders of magnitude: a factor reads better
+        return f" (×{v / ref:.3g})"
     return f" ({100 * (v / ref - 1):+.0f} %)"
 
 
