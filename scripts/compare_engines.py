@@ -46,8 +46,8 @@ METRICS = (("speed_peak_dev_pu", "speed peak [pu]"),
            ("p_series_peak_mw", "series power peak [MW]"),
            ("running_cost_18", "running cost (18)"),
            ("wall_s", "wall [s]"))
-COLORS = ("k", "tab:blue", "tab:red", "tab:green")
-STYLES = ("-", "--", ":", "-.")
+COLORS = ("k", "tab:blue", "tab:red", "tab:green", "tab:orange", "tab:purple")
+STYLES = ("-", "--", ":", "-.", (0, (5, 1)), (0, (1, 2)))
 
 
 def load(runs: list[tuple[str, Path]]) -> dict:
@@ -173,8 +173,9 @@ def figures(out: Path, name: str, folders, m: dict, panels, scenarios, t_from, t
                 keep = (t >= t_from) & (t <= t_to if t_to else True)
                 for j, (s, _) in enumerate(panels):
                     if s in r.columns:
-                        axes[i][j].plot(t[keep], r[s].to_numpy()[keep], STYLES[k % 4],
-                                        color=COLORS[k % 4], lw=1.0, label=lab)
+                        axes[i][j].plot(t[keep], r[s].to_numpy()[keep],
+                                        linestyle=STYLES[k % len(STYLES)],
+                                        color=COLORS[k % len(COLORS)], lw=1.0, label=lab)
                         drawn.add(j)
             for j, (_, title) in enumerate(panels):
                 axes[i][j].set_title(f"{c}: {title}", fontsize=9)
