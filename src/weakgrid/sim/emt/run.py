@@ -35,6 +35,7 @@ from .events import build_events, removed_load, trip_terminals, tripped_machines
 from .gti import GTIBridge
 from .machine_controls import MachineControls
 from .machines import build_machines, check_machines
+from .native_output import NativeOutput
 from .topology import build_network, bus_base, check_devices
 from .upqc import UPQCBridge
 
@@ -143,28 +144,31 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
     n_steps = int(round(t_end / dt))
     t0 = time.perf_counter()
     failure = None
-    sim.start()
-    mc.start()
-    rec.measure(0.0)
-    rec.gti = gti.update(dt, rec._ph, rec.current, bridge.gti_draw(len(gti.items)))
-    rec.add(0.0)
-    for k in range(1, n_steps + 1):
-        t = (k - 1) * dt
-        if bound and any((k - 1) % every == 0 for every, _ in bound):
-            sample_all(bound, loop, k - 1, t, rec.latest())
-        rec.upqc = bridge.update(t, rec.phasor, rec.current)
-        if mc.active:
-            mc.step(t, rec)
-        sim.next()
-        rec.measure(k * dt)
-        if not np.isfinite(rec._ph).all():
-            rec.add(k * dt)
-            failure = SimulationError(k * dt, "divergence", "a DPsim bus voltage is not finite")
-            break
+    with NativeOutput() as out:       # DPsim's C++ console lines → logging (DEBUG)
+        out.call(sim.start)
+        mc.start()
+        rec.measure(0.0)
         rec.gti = gti.update(dt, rec._ph, rec.current, bridge.gti_draw(len(gti.items)))
-        if k % decimate == 0 or k == n_steps:
-            rec.add(k * dt)
-    sim.stop()
+        rec.add(0.0)
+        k = 0
+        for k in range(1, n_steps + 1):
+            t = (k - 1) * dt
+            if bound and any((k - 1) % every == 0 for every, _ in bound):
+                sample_all(bound, loop, k - 1, t, rec.latest())
+            rec.upqc = bridge.update(t, rec.phasor, rec.current)
+            if mc.active:
+                mc.step(t, rec)
+            out.call(sim.next)
+            rec.measure(k * dt)
+            if not np.isfinite(rec._ph).all():
+                rec.add(k * dt)
+                failure = SimulationError(k * dt, "divergence",
+                                          "a DPsim bus voltage is not finite")
+                break
+            rec.gti = gti.update(dt, rec._ph, rec.current, bridge.gti_draw(len(gti.items)))
+            if k % decimate == 0 or k == n_steps:
+                rec.add(k * dt)
+        out.call(sim.stop)
     wall = time.perf_counter() - t0
     log.debug("DPsim %s: %d steps of %g s in %.2f s", domain, n_steps, dt, wall)
     return rec.finish({"steps": k if n_steps else 0, "wall_s": wall, "engine": engine,
