@@ -32,16 +32,7 @@ def sg_signals(machine_name, upqc_bus):
     shunt bus ``upqc_bus`` (external number): rotor angle [rad], bus-voltage angle [rad], speed
     [pu] — the signals of :func:`weakgrid.sim.controllers.sg_signals`."""
     keys = (f"{machine_name}.delta", f"bus{upqc_bus}.a", f"{machine_name}.omega")
-
-    def measure(sim, t, z, ctx):
-        missing = [k for k in keys if k not in ctx]
-        if missing:
-            raise DataError("sg_signals", "signal", missing[0],
-                            f"no such DPsim signal (machine '{machine_name}', bus {upqc_bus}); "
-                            f"recorded: {sorted(ctx)[:8]} ...")
-        return np.array([ctx[k] for k in keys])
-
-    return measure
+    return _reader(keys, "sg_signals", f"machine '{machine_name}', bus {upqc_bus}")
 
 
 def gti_signals(gti_name):
@@ -49,13 +40,18 @@ def gti_signals(gti_name):
     reference bus [rad] and dc-link voltage [pu], :mod:`weakgrid.sim.emt.gti`) — the signals of
     :func:`weakgrid.sim.controllers.gti_signals`."""
     keys = (f"{gti_name}.phi_s", f"{gti_name}.Vc")
+    return _reader(keys, "gti_signals", f"GTI '{gti_name}'")
+
+
+def _reader(keys, where, what):
+    """A measurement reading the signals ``keys`` of the last DPsim step (``ctx``), refusing a
+    missing one by name."""
 
     def measure(sim, t, z, ctx):
         missing = [k for k in keys if k not in ctx]
         if missing:
-            raise DataError("gti_signals", "signal", missing[0],
-                            f"no such DPsim signal (GTI '{gti_name}'); recorded: "
-                            f"{sorted(ctx)[:8]} ...")
+            raise DataError(where, "signal", missing[0], f"no such DPsim signal ({what}); "
+                            f"recorded: {sorted(ctx)[:8]} ...")
         return np.array([ctx[k] for k in keys])
 
     return measure
