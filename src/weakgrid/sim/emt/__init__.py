@@ -12,10 +12,12 @@ and machines in two domains used here:
   the carrier removed).
 
 A set-up weakgrid :class:`~weakgrid.sim.system.System` is translated element by element
-(:mod:`.topology`, :mod:`.machines`, :mod:`.events`, :mod:`.upqc`) from its own data and power
+(:mod:`weakgrid.sim.emt.topology`, :mod:`weakgrid.sim.emt.machines`,
+:mod:`weakgrid.sim.emt.events`, :mod:`weakgrid.sim.emt.upqc`) from its own data and power
 flow — the phasor engine and the DPsim engines start from the same operating point — and run
-step by step (:mod:`.run`; the machines' exciters, governors and stabilizers are weakgrid's,
-stepped beside DPsim: :mod:`.machine_controls`) into weakgrid's :class:`~weakgrid.sim.results.Results`. Models DPsim lacks
+step by step (:mod:`weakgrid.sim.emt.run`; the machines' exciters, governors and stabilizers
+are weakgrid's, stepped beside DPsim: :mod:`weakgrid.sim.emt.machine_controls`) into
+weakgrid's :class:`~weakgrid.sim.results.Results`. Models DPsim lacks
 are refused with a :class:`~weakgrid.sim.errors.DataError` naming them; nothing is substituted.
 
 ``dpsimpy`` is imported only when a DPsim run is built (:func:`.dpsim_module.dpsimpy`).

@@ -52,7 +52,8 @@ from ..events import Fault, GeneratorTrip, LoadStep
 
 #: largest fault impedance [pu on the system base] mapped to DPsim's resistive switch
 BOLTED_MAX = 1e-3
-#: damping resistor across a non-bolted fault's R–L, in units of |rf + j xf|
+#: damping resistor across a non-bolted fault's R–L, in units of the fault impedance
+#: ``abs(rf + j xf)``
 FAULT_DAMP = 1e3
 #: open-switch resistance [pu on the bus base impedance]
 OPEN_PU = 1e7

@@ -2,8 +2,9 @@
 
 :func:`check_supported` refuses (a :class:`~weakgrid.sim.errors.DataError` naming the model,
 field or event) everything :func:`weakgrid.sim.emt.simulate_dpsim` would refuse on the way —
-machines and controls (:mod:`.machines`), devices (:mod:`.topology`), the network's branches
-and the events (:mod:`.events`) — without importing ``dpsimpy``, so that a study asking for a
+machines and controls (:mod:`weakgrid.sim.emt.machines`), devices
+(:mod:`weakgrid.sim.emt.topology`), the network's branches and the events
+(:mod:`weakgrid.sim.emt.events`) — without importing ``dpsimpy``, so that a study asking for a
 DPsim engine stops at planning, before any training or run. :func:`dpsim_step` is the step a
 study's run takes in DPsim.
 """
