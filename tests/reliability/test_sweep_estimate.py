@@ -122,3 +122,22 @@ def test_estimate_counts_steps_and_cached_runs(ws, tmp_path):
     est2 = estimate_sweep(st, tmp_path / "cache", workers=0)
     assert (est2.n_runs, est2.n_cached) == (2, 1)
     assert est2.steps == pytest.approx(est.steps / 2, abs=1)
+
+
+def test_bounded_trainings_are_estimated_with_their_own_basis():
+    """An hji-bounded training fits the problem's [basis] bounded (12 terms for case 1, the
+    paper's basis 8): the estimate prices it with that basis, the unbounded HJI with its own."""
+    from weakgrid.study.studyfile import load_study
+    from weakgrid.study.sweep import sweep_points
+    from weakgrid.study.sweep_estimate import _training, _training_key, probe
+
+    st = load_study("case1-weak-grid")
+    pts = sweep_points(st, quick=True)
+    keys = {_training_key(p.inputs) for p in pts} - {None}
+    assert {k.split(":")[0] for k in keys} == {"hji", "hji-bounded"}
+    pr = probe(pts[0].inputs)
+    assert "× 12 basis terms" in pr["train_bounded"].what and "× 8 basis terms" in pr["train"].what
+    assert pr["train_bounded"].seconds > pr["train"].seconds
+    for k in keys:
+        want = pr["train_bounded"] if k.startswith("hji-bounded:") else pr["train"]
+        assert _training(pr, k) is want

@@ -188,7 +188,8 @@ def run_cost(inputs: dict) -> float:
 
 
 def _training_key(inputs: dict):
-    """What one HJI training of this run depends on (None: the run trains nothing)."""
+    """What one HJI training of this run depends on, ``"<kind>:<json>"`` (kind ``hji`` or
+    ``hji-bounded``; None: the run trains nothing)."""
     from .controllers import controller_kind
 
     d = inputs["study"]
@@ -203,14 +204,21 @@ def _training_key(inputs: dict):
     if kind == "hji-bounded":
         opts = d["controllers"].get(inputs["controller"], {})
         extra = (opts if isinstance(opts, dict) else {}).get("u_bound", d["upqc"]["rating"])
-    return canonical_json([design, dload, sc["upqc"], kind, extra])
+    return f"{kind}:" + canonical_json([design, dload, sc["upqc"], extra])
+
+
+def _training(pr: dict, key: str):
+    """The probe's estimate of the training ``key`` (:func:`_training_key`): the bounded
+    basis's for an ``hji-bounded`` controller, the problem's own otherwise."""
+    return pr["train_bounded"] if key.startswith("hji-bounded:") else pr["train"]
 
 
 def probe(inputs: dict, steps=PROBE_STEPS) -> dict:
     """Time the study's grid of the run ``inputs`` (see the module's text).
 
     Returns ``per_step_s``, ``per_run_s``, ``n_vars`` (variables recorded per step) and
-    ``train`` (the :class:`~weakgrid.game.estimate.Estimate` of one HJI training).
+    ``train`` and ``train_bounded`` (the :class:`~weakgrid.game.estimate.Estimate` of one HJI
+    training, unbounded and rating-bounded: their bases differ).
     """
     from ..sim.controllers import DigitalController, UPQCTarget
     from ..sim.integrate import simulate
@@ -258,10 +266,12 @@ def probe(inputs: dict, steps=PROBE_STEPS) -> dict:
         if n_after > 0:
             transient = max((t3 - fixed_sim - n_quiet * per_step) / n_after, per_step)
     prob = design_problem(st, setup.design)
-    train = training_estimate(int(prob.mesh.points.shape[0]), prob.basis.size,
-                              prob.system.n_states)
+    # a rating-bounded training (hji-bounded) fits its own basis (the problem's [basis] bounded)
+    bounded = prob.with_rating(float(st.data["upqc"]["rating"]))
+    train, train_bounded = (training_estimate(int(p.mesh.points.shape[0]), p.basis.size,
+                                              p.system.n_states) for p in (prob, bounded))
     return {"per_step_s": per_step, "transient_step_s": transient, "per_run_s": per_run,
-            "n_vars": n_vars, "train": train}
+            "n_vars": n_vars, "train": train, "train_bounded": train_bounded}
 
 
 def planned_runs(study, quick: bool = False) -> int:
@@ -339,10 +349,11 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
             runs_per_key[tk] = runs_per_key.get(tk, 0) + 1
     par = max(n_par or 1, 1)
     n_train = sum(min(par, n) for n in runs_per_key.values())
+    train_s = sum(min(par, n) * _training(pr, tk).seconds for tk, n in runs_per_key.items())
     quiet = {k: _quiet_steps(p.inputs) for k, p in todo.items()}
     run_s = [pr["per_run_s"] + quiet[k] * pr["per_step_s"]
              + (n - quiet[k]) * pr["transient_step_s"] for k, n in steps.items()]
-    cpu = scale * sum(run_s) + n_train * pr["train"].seconds
+    cpu = scale * sum(run_s) + train_s
     # workers beyond the cores share them; a local cluster starts in ≈ 2 s (measured: 1.6 s,
     # then 0.4 s for a worker's first import)
     cores = max(min(par, os.cpu_count() or 1), 1)
@@ -351,7 +362,7 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
     longest = max(steps.values())
     run_bytes = 2 * 8.0 * pr["n_vars"] * longest
     sig = 8.0 * pr["n_vars"] * longest if signals else 0.0
-    extra = max(run_bytes + sig, pr["train"].bytes if runs_per_key else 0.0)
+    extra = max([run_bytes + sig] + [_training(pr, tk).bytes for tk in runs_per_key])
     if n_par is None:     # an existing cluster: its workers are elsewhere; one of them
         total = base + extra
     elif n_par == 0:      # serially in this process
