@@ -13,7 +13,9 @@ from weakgrid.models.problem import TrainingProblem
 
 
 def _lines(err):
-    return err.strip().splitlines()
+    """The non-blank lines of ``err`` (the CLI separates its error from what came before by a
+    blank line: a slow training's checkpoint warning, then the error, is two lines)."""
+    return [ln for ln in err.strip().splitlines() if ln.strip()]
 
 
 def test_disk_full_during_write_keeps_the_previous_file(ws, cli, monkeypatch):

@@ -18,6 +18,14 @@ from weakgrid.sim.controllers import DigitalController, UPQCTarget, gti_design_s
 from weakgrid.sim.errors import DataError
 from weakgrid.sim.events import Fault
 
+#: members with their own parameters equal their runs alone to round-off, amplified by the
+#: limiters: 0 with NumPy 2.x, up to 5.8e-9 pu with NumPy 1.26 (the lowest supported), whose
+#: ufuncs take other SIMD loops for a batch's rows than for a lone array (measured; 1.8e-10 on
+#: another member with AVX-512 disabled). A member run with another member's rating, the bug
+#: these tests guard against (they failed on the code before it), is off by far more. The
+#: recorded derivatives (``PV.dVc``) amplify it further: 4.1e-8 of their range with NumPy 1.26.
+ATOL_PARAMS, RTOL_PARAMS = 1e-8, 1e-6
+
 T_END = 0.8
 
 
@@ -49,7 +57,7 @@ def test_members_with_their_own_ratings_share_a_batch_and_equal_their_runs_alone
     assert st["batches"] == 1 and st["alone"] == 0 and st["rerun"] == 0
     for a, b in zip(alone, got):
         assert a.ok and b.ok
-        _same(a, b)
+        _same(a, b, atol_states=ATOL_PARAMS, rtol_outputs=RTOL_PARAMS)
     # the rating acts: the applied series voltage is clipped at each member's own Vmax (the
     # largest is not reached)
     for r, vmax in zip(got[:2], (0.02, 0.05)):
@@ -66,7 +74,7 @@ def test_the_conventional_upqcs_limits_and_dc_link_may_differ_per_member():
     got = simulate_batch(grids[0], _scen(grids), T_END, dt=DT, tol=1e-6, stats=st)
     assert st["batches"] == 1
     for a, b in zip(alone, got):
-        _same(a, b)
+        _same(a, b, atol_states=ATOL_PARAMS, rtol_outputs=RTOL_PARAMS)
     assert np.abs(got[0]["U.Vdc"] - got[1]["U.Vdc"]).max() > 1e-4
 
 
@@ -80,6 +88,6 @@ def test_a_member_differing_in_another_parameter_runs_in_its_own_batch():
     got = simulate_batch(grids[0], _scen(grids), T_END, dt=DT, tol=1e-6, stats=st)
     assert st["batches"] == 2
     for a, b in zip(alone, got):
-        _same(a, b)
+        _same(a, b, atol_states=ATOL_PARAMS, rtol_outputs=RTOL_PARAMS)
     with pytest.raises(DataError, match=r"scenarios\[1\]\.system"):
         BatchSimulator(grids[0], _scen([grids[0], other]), dt=DT)
