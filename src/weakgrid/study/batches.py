@@ -40,13 +40,13 @@ def batch_key(inputs: dict) -> tuple:
     from types import SimpleNamespace
 
     from .controllers import controller_variant
+    from .runner import sim_settings
 
     study = inputs["study"]
     sc = get_path(study, f"scenarios.{inputs['scenario']}")
     t_end = inputs.get("t_end") or sc.get("t_end")
     factor = float(inputs.get("dt_factor") or 1.0)
-    sim = study.get("simulation") or {}
-    dt = float(sim.get("dt") or study["design"]["T"]) * factor   # as runner.sim_settings
+    dt, _ = sim_settings(SimpleNamespace(data=study), factor)
     return (study["study"]["name"], sc.get("load"), sc.get("upqc"),
             controller_variant(SimpleNamespace(data=study), inputs["controller"]),
             None if t_end is None else float(t_end), factor,
