@@ -68,6 +68,21 @@ class Kit:
         a = complex(self._np.exp(-2j * self._np.pi / 3))
         return [complex(V), complex(V) * a, complex(V) * a * a]
 
+    def set_source(self, src, name: str, X: complex, init: bool = False, f=None):
+        """Set a DPsim source's phasor ``name`` (``V_ref``/``I_ref``) to ``X`` [line-to-line
+        RMS phasor]: three phases (a, b, c) in EMT, one in DP; ``init``: through
+        ``set_parameters``, with the source frequency ``f`` [Hz] in EMT."""
+        if self.three_phase:
+            X = self._np.array([[x] for x in self.phasors(X)], dtype=complex)
+            if init:
+                src.set_parameters(**{name: X, "f_src": f})
+            else:
+                src.attr(name).set(X)
+        elif init:
+            src.set_parameters(**{name: complex(X)})
+        else:
+            src.attr(name).set(complex(X))
+
     def node(self, name: str, V: complex):
         """A DPsim node initialized at the line-to-line RMS phasor ``V`` [V]."""
         return self.ns.SimNode(name, self.phase_type, self.phasors(V))

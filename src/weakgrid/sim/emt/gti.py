@@ -116,7 +116,7 @@ class GTIBridge:
             mid = kit.node(f"{nm}.Es", Es0 * Vb[b])
             cir.extra_nodes.append(mid)
             src = kit.ph.VoltageSource(f"{nm}.src", off)
-            self._set(src, Es0 * Vb[b], init=True, f=net.f_hz)
+            kit.set_source(src, "V_ref", Es0 * Vb[b], init=True, f=net.f_hz)
             src.connect([kit.gnd, mid])
             ind = kit.ph.Inductor(f"{nm}.L", off)
             ind.set_parameters(kit.param(Zb[b] / (float(g.p["B"][i]) * w)))
@@ -124,19 +124,6 @@ class GTIBridge:
             cir.components += [src, ind]
             self.items.append(dict(name=nm, i=i, bus=b, src=src, ind=ind, Es=Es0,
                                    ib=system.Sb * 1e6 / Vb[b]))
-
-    def _set(self, src, V, init=False, f=None):
-        if self.kit.three_phase:
-            a = np.exp(-2j * np.pi / 3)
-            X = np.array([[V], [V * a], [V * a * a]], dtype=complex)
-            if init:
-                src.set_parameters(V_ref=X, f_src=f)
-            else:
-                src.attr("V_ref").set(X)
-        elif init:
-            src.set_parameters(V_ref=complex(V))
-        else:
-            src.attr("V_ref").set(complex(V))
 
     def _evaluate(self, V, I, p_series=None):
         """weakgrid's GTI equations at the current states, the measured bus voltages ``V`` [pu]
@@ -173,7 +160,7 @@ class GTIBridge:
             self.x[sl] = self.x[sl] + dt * ctx.f[sl]
         for it, e in zip(self.items, Es):
             it["Es"] = complex(e)
-            self._set(it["src"], e * self.Vb[it["bus"]])
+            self.kit.set_source(it["src"], "V_ref", e * self.Vb[it["bus"]])
         return rec
 
     def _record(self, ctx):

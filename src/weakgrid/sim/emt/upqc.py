@@ -86,33 +86,15 @@ class UPQCBridge:
         cir.upqc_branches = {it["branch"] for it in self.items}
 
     # phasor → DPsim set point (EMT: three rotating phasors, same scale as the node voltages)
-    def _abc(self, X):
-        a = np.exp(-2j * np.pi / 3)
-        return np.array([[X], [X * a], [X * a * a]], dtype=complex)
-
-    def _set(self, src, name, X, init=False, f=None):
-        """Set a DPsim source's phasor ``name`` (``V_ref``/``I_ref``) to ``X``: three phases in
-        EMT, one in DP; ``init`` through ``set_parameters`` (with the source frequency)."""
-        if self.kit.three_phase:
-            X = self._abc(X)
-            if init:
-                src.set_parameters(**{name: X, "f_src": f})
-            else:
-                src.attr(name).set(X)
-        elif init:
-            src.set_parameters(**{name: complex(X)})
-        else:
-            src.attr(name).set(complex(X))
-
     def _set_v(self, src, V, init=False, f=None):
-        self._set(src, "V_ref", V, init, f)
+        self.kit.set_source(src, "V_ref", V, init, f)
 
     def _set_i(self, src, current, init=False, f=None):
         """``current`` [A, line-to-line RMS scale, ``S = V conj(I)``]. DPsim 1.4's EMT current
         source takes the line current's RMS phasor (peak ``sqrt(2) |I_ref|``, measured), a third
         of the scale's square: ``I_ref = current / sqrt(3)``; its DP one takes the scale as is."""
-        self._set(src, "I_ref", current / math.sqrt(3) if self.kit.three_phase else current,
-                  init, f)
+        self.kit.set_source(src, "I_ref", current / math.sqrt(3) if self.kit.three_phase
+                            else current, init, f)
 
     def update(self, t, phasor_of, current_of):
         """Rewrite every UPQC's set points from its held inputs and the measured phasors.
