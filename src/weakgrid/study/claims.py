@@ -43,7 +43,8 @@ import math
 from .failure import failure_kind
 from .ties import compare, run_uncertainty, unc_text
 
-__all__ = ["RULES", "judge_all", "judge_claim", "run_instability", "stability_gate"]
+__all__ = ["RULES", "STABILITY_NOTE", "judge_all", "judge_claim", "run_instability",
+           "stability_gate"]
 
 
 def _value(v):
@@ -71,6 +72,17 @@ def _combine(vs):
         return "partly"
     return "not"
 
+
+#: The rule in words, as every report states it (weakgrid.study.engine.DEFINITIONS).
+STABILITY_NOTE = (
+    "Stability first (claim table): before comparing two runs' costs, ITAE, overshoot or "
+    "settling, each run must be stable: finished (no voltage collapse, loss of synchronism, "
+    "Newton failure), SG speed and dc link neither unstable nor undamped (stability verdict), "
+    "and each back at its set-point — a signal still outside its 2 % settling band at the "
+    "end of the run AND more than half its peak deviation away from its set-point never "
+    "settles. A pair where the claim's run is not stable is 'not' (named); where only the "
+    "baseline is not stable, a win without comparing numbers (named); where both are not "
+    "stable, 'not' — both runs unstable: no comparison.")
 
 #: The signals whose stability a run is judged on: metric prefix → name in the verdict text
 #: (the runner's ``<prefix>_verdict``, ``_settling_s``, ``_final_dev_pu``, ``_peak_dev_pu``).
