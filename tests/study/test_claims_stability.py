@@ -170,3 +170,16 @@ def test_stability_contrast_uses_the_same_definition():
         r["measured"]
     m["c2-low-f100-lqr"] = stable()
     assert judge_claim(c, m)["verdict"] == "partly"
+
+
+def test_two_swings_still_decaying_are_judged_on_overshoot_alone():
+    """Both stable, neither inside its settling band at the run's end (back near the
+    set-point): no settling comparison (main gave it to the baseline), the overshoot decides."""
+    c = claim("C2-lqr")
+    c = dict(c, pairs=[c["pairs"][0]])
+    decaying = dict(speed_settling_s=math.nan, speed_peak_dev_pu=0.006, speed_final_dev_pu=3e-4)
+    m = {"c2-high-f200-hji": stable(speed_backswing_pu=0.001, **decaying),
+         "c2-high-f200-lqr": stable(speed_backswing_pu=0.002, **decaying)}
+    assert judge_claim(c, m)["verdict"] == "reproduced"
+    m["c2-high-f200-lqr"]["speed_settling_s"] = 1.0         # the baseline settles: it wins that
+    assert judge_claim(c, m)["verdict"] == "partly"
