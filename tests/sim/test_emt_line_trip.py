@@ -32,9 +32,11 @@ pytestmark = pytest.mark.emt
 T_EV, T_END = 0.1, 1.0
 R, X, B = 0.01, 0.4, 0.1
 X_TIE, XD1 = 0.1, 0.25
+#: bus 3's voltage phasor against the oracle's [pu]
+V_TOL = 3e-3
 
 
-def _grid(tap=0.0, load3=20.0, status1=1):
+def _grid(tap=0.0, load3=20.0, status1=1, b=B):
     from weakgrid.sim.sources import InfiniteBus
     from weakgrid.sim.system import System
 
@@ -43,8 +45,8 @@ def _grid(tap=0.0, load3=20.0, status1=1):
                     [3, 1, load3, 0, 0, 0, 1, 1.0, 0, 110, 1, 1.5, 0.5]], float)
     gen = np.array([[1, 80, 0, 999, -999, 1.0, 100, 1, 999, -999] + [0] * 11,
                     [2, 0, 0, 999, -999, 1.0, 100, 1, 999, -999] + [0] * 11], float)
-    branch = np.array([[3, 2, R, X, B, 0, 0, 0, tap, 0, 1, -360, 360],
-                       [3, 2, R, X, B, 0, 0, 0, tap, 0, status1, -360, 360],
+    branch = np.array([[3, 2, R, X, b, 0, 0, 0, tap, 0, 1, -360, 360],
+                       [3, 2, R, X, b, 0, 0, 0, tap, 0, status1, -360, 360],
                        [1, 3, 0.0, X_TIE, 0, 0, 0, 0, 0, 0, 1, -360, 360]], float)
     s = System({"baseMVA": 100.0, "bus": bus, "gen": gen, "branch": branch})
     s.add_machine("GENCLS", "G1", 0, Sn=100, M=6.0, D=0.0, ra=0.0, xd1=XD1)
@@ -107,32 +109,40 @@ def test_trip_swings_alike_and_settles_on_the_grid_without_the_branch(tap):
         assert exc[e] == pytest.approx(exc["phasor"], rel=0.02), exc
         assert peak[e] == pytest.approx(peak["phasor"], rel=0.01), peak
     before, after = _Oracle(_grid(tap=tap), 2, tap), _Oracle(_grid(tap=tap), 1, tap)
+    charged = _Oracle(_grid(tap=tap), 1, tap)     # the wrong trip: the branch's charging left in
+    charged.Y[1, 1] += 0.5j * B / (tap or 1.0) ** 2
     d0 = runs["phasor"]["G1.delta"][0]
-    assert abs(before.solve(d0)[1] - before.Pm) < 1e-6          # the oracle is the power flow's
+    assert abs(before.solve(d0)[1] - before.Pm) < 1e-9          # the oracle is the power flow's
     d1 = after.equilibrium(d0)
+    assert d1 - d0 > 0.05                                       # a real change of operating point
     for e, r in runs.items():
-        late = r.t > 0.3                                     # the network transients are gone
+        late = r.t > 0.3                                        # the network transients are gone
         d = r["G1.delta"][late]
-        v3 = np.array([abs(after.solve(x)[0]) for x in d])
-        assert np.max(np.abs(r["bus3.v"][late] - v3)) < 2e-3, e
-        # with the tripped branch's charging (or the branch) left in, it is not that voltage
-        v3_with = np.array([abs(before.solve(x)[0]) for x in d])
-        assert np.max(np.abs(r["bus3.v"][late] - v3_with)) > 1e-2, e
-        assert d.min() < d1 < d.max(), e                     # swinging about the new equilibrium
-        assert d1 - d0 > 0.05                                # a real change of operating point
+        err = {nm: _v3_error(r, late, o) for nm, o in (("after", after), ("before", before),
+                                                         ("charged", charged))}
+        # measured: phasor 9e-11, DP and EMT 1.6e-3; the wrong grids 9.5e-3 and 0.1
+        assert err["after"] < V_TOL, (e, err)
+        assert min(err["before"], err["charged"]) > 2 * V_TOL, (e, err)
+        assert d.min() < d1 < d.max(), e                        # swinging about the new equilibrium
+
+
+def _v3_error(r, mask, oracle):
+    """Largest distance [pu] of bus 3's voltage phasor from the oracle's at G1's angle."""
+    V = r["bus3.v"][mask] * np.exp(1j * r["bus3.a"][mask])
+    return float(np.max(np.abs(V - [oracle.solve(x)[0] for x in r["G1.delta"][mask]])))
 
 
 def test_reclose_returns_to_the_original_grid():
-    """Tripped at 0.1 s, re-closed at 0.3 s (its charging re-energized from the buses): the
-    three engines swing alike and end on the grid with both branches."""
+    """Tripped at 0.1 s, re-closed at 0.3 s (re-energized from both buses at once): the three
+    engines swing alike and end on the grid with both branches."""
     runs = _three([LineTrip(1, T_EV), LineTrip(1, 0.3, close=True)])
     exc = {e: np.max(np.abs(r["G1.omega"] - 1.0)) for e, r in runs.items()}
     both = _Oracle(_grid(), 2, 0.0)
     for e, r in runs.items():
         assert exc[e] == pytest.approx(exc["phasor"], rel=0.02), exc
-        late = r.t > 0.5
-        v3 = np.array([abs(both.solve(x)[0]) for x in r["G1.delta"][late]])
-        assert np.max(np.abs(r["bus3.v"][late] - v3)) < 2e-3, e
+        # the re-energized branch's dc offset decays with its L/R (0.1 s): measured 1.1e-2 pu
+        # over 0.4-0.5 s, 1.3e-3 over 0.6-0.7 s (DP and EMT alike)
+        assert _v3_error(r, r.t > 0.6, both) < V_TOL, e
 
 
 def test_closing_a_branch_out_of_service():
@@ -141,12 +151,22 @@ def test_closing_a_branch_out_of_service():
     runs = {"phasor": simulate(_grid(status1=0), 0.6, dt=1e-4, events=[LineTrip(1, T_EV, True)]),
             "dpsim-dp": simulate_dpsim(_grid(status1=0), 0.6, engine="dpsim-dp", dt=1e-4,
                                        events=[LineTrip(1, T_EV, close=True)])}
-    both = _Oracle(_grid(), 2, 0.0)
+    both = _Oracle(_grid(status1=0), 2, 0.0)      # E' and Pm: the one-branch power flow's
     for e, r in runs.items():
         assert np.max(np.abs(r["G1.omega"][r.t < T_EV - 1e-9] - 1.0)) < 1e-6, e
-        late = r.t > 0.3
-        v3 = np.array([abs(both.solve(x)[0]) for x in r["G1.delta"][late]])
-        assert np.max(np.abs(r["bus3.v"][late] - v3)) < 2e-3, e
+        assert _v3_error(r, r.t > 0.3, both) < V_TOL, e
+
+
+def test_tripped_branch_does_not_ring():
+    """Without charging the tripped branch's interrupted inductor current has no path but the
+    open breakers: without the dump switches its end nodes alternate at 2.2 and 4.2 pu every
+    step for the rest of the run and bus 3 with them (sign of its voltage's increment changing
+    on 8-11 % of the steps, amplitude ~1e-6 pu); with them (factor 1/3 per step) on 1.9 %,
+    the network's own 60-Hz ripple."""
+    for e in ("dpsim-dp", "dpsim-emt"):
+        r = simulate_dpsim(_grid(b=0.0), 0.5, engine=e, dt=1e-4, events=[LineTrip(1, T_EV)])
+        d = np.diff(r["bus3.v"][r.t > T_EV + 1e-9])
+        assert np.mean(np.sign(d[1:]) != np.sign(d[:-1])) < 0.04, e
 
 
 def test_unsupported_trips_are_refused_at_planning():
@@ -159,7 +179,7 @@ def test_unsupported_trips_are_refused_at_planning():
         check_supported(s, [LineTrip(0, 0.05), LineTrip(1, 0.06)], "dpsim-emt")
     check_supported(s, [LineTrip(0, 0.05), LineTrip(0, 0.06, close=True), LineTrip(1, 0.07)],
                     "dpsim-emt")                                         # never islanded
-    with pytest.raises(DataError, match=r"LineTrip.*bus 3.*resistive|LineTrip.*bus 3.*load"):
+    with pytest.raises(DataError, match=r"LineTrip.*bus 3.*resistive path"):
         check_supported(_grid(load3=0.0), [LineTrip(1, 0.05)], "dpsim-dp")
     with pytest.raises(DataError, match="UPQC"):
         check_supported(classical_smib(upqc_vmax=0.1), [LineTrip(0, 0.05)], "dpsim-dp")
