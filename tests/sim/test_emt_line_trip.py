@@ -3,7 +3,8 @@ engine and an analytic oracle.
 
 Grid: a classical machine G1 (bus 1) behind a tie (j0.1 pu) to bus 3 (a 20 MW load), two
 parallel branches with charging (0.01 + j0.4 pu, b = 0.1 pu) from bus 3 to an infinite bus
-(bus 2): lines, or transformers (TAP 1.05: the π-equivalent path). One of them trips at 0.1 s.
+(bus 2): lines, or transformers (TAP 1.05, or a 110/220-kV step-up: the π-equivalent path).
+One of them trips at 0.1 s.
 Oracles: the three engines agree on the electromechanical response (G1's speed excursion and
 angle peak); after the trip, once the network's transients have decayed, bus 3's voltage is at
 every instant the algebraic solution of the grid *without* the branch (MATPOWER's π model of
@@ -36,12 +37,12 @@ X_TIE, XD1 = 0.1, 0.25
 V_TOL = 3e-3
 
 
-def _grid(tap=0.0, load3=20.0, status1=1, b=B):
+def _grid(tap=0.0, load3=20.0, status1=1, b=B, kv2=110):
     from weakgrid.sim.sources import InfiniteBus
     from weakgrid.sim.system import System
 
     bus = np.array([[1, 2, 0, 0, 0, 0, 1, 1.0, 0, 110, 1, 1.5, 0.5],
-                    [2, 3, 0, 0, 0, 0, 1, 1.0, 0, 110, 1, 1.5, 0.5],
+                    [2, 3, 0, 0, 0, 0, 1, 1.0, 0, kv2, 1, 1.5, 0.5],
                     [3, 1, load3, 0, 0, 0, 1, 1.0, 0, 110, 1, 1.5, 0.5]], float)
     gen = np.array([[1, 80, 0, 999, -999, 1.0, 100, 1, 999, -999] + [0] * 11,
                     [2, 0, 0, 999, -999, 1.0, 100, 1, 999, -999] + [0] * 11], float)
@@ -96,9 +97,10 @@ class _Oracle:
         return brentq(lambda d: self.solve(d)[1] - self.Pm, lo, hi)
 
 
-@pytest.mark.parametrize("tap", [0.0, 1.05], ids=["line", "transformer"])
-def test_trip_swings_alike_and_settles_on_the_grid_without_the_branch(tap):
-    runs = _three([LineTrip(1, T_EV)], tap=tap)
+@pytest.mark.parametrize("tap, kv2", [(0.0, 110), (1.05, 110), (0.0, 220)],
+                         ids=["line", "transformer", "step-up"])
+def test_trip_swings_alike_and_settles_on_the_grid_without_the_branch(tap, kv2):
+    runs = _three([LineTrip(1, T_EV)], tap=tap, kv2=kv2)
     exc = {e: np.max(np.abs(r["G1.omega"] - 1.0)) for e, r in runs.items()}
     peak = {e: np.max(r["G1.delta"]) for e, r in runs.items()}
     assert exc["phasor"] > 1e-3, exc
@@ -108,8 +110,8 @@ def test_trip_swings_alike_and_settles_on_the_grid_without_the_branch(tap):
         assert np.max(np.abs(r["G1.omega"][pre] - 1.0)) < 1e-6, e     # at the power flow
         assert exc[e] == pytest.approx(exc["phasor"], rel=0.02), exc
         assert peak[e] == pytest.approx(peak["phasor"], rel=0.01), peak
-    before, after = _Oracle(_grid(tap=tap), 2, tap), _Oracle(_grid(tap=tap), 1, tap)
-    charged = _Oracle(_grid(tap=tap), 1, tap)     # the wrong trip: the branch's charging left in
+    before, after = (_Oracle(_grid(tap=tap, kv2=kv2), n, tap) for n in (2, 1))
+    charged = _Oracle(_grid(tap=tap, kv2=kv2), 1, tap)     # the wrong trip: the branch's charging left in
     charged.Y[1, 1] += 0.5j * B / (tap or 1.0) ** 2
     d0 = runs["phasor"]["G1.delta"][0]
     assert abs(before.solve(d0)[1] - before.Pm) < 1e-9          # the oracle is the power flow's
