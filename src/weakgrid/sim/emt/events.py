@@ -46,8 +46,12 @@
   its π capacitors, a transformer's π-equivalent), stands between two end nodes of its own
   (:func:`line_switching`, ``build_network(switched=...)``), joined to its buses by a breaker
   at *each* end (closed ``1e-6`` pu, open ``OPEN_PU``: the load-step and generator-trip
-  switches' values and helper, :func:`_switch_seq`): opening both at ``t`` removes everything
-  the phasor engine removes, the charging included, and the grid sees two open switches.
+  switches' values and helper, :func:`_switch_seq`; closed, the two add ``2e-6`` pu to the
+  branch's resistance): opening both at ``t`` removes everything the phasor engine removes,
+  the charging included, and the grid sees two open switches. The switch is ideal: it chops
+  the current at ``t`` (a real breaker waits for a current zero), so the bus sees the step a
+  chopped inductive current gives (docs/engines.md: 1.7 pu for one step at a load bus without
+  charging on the test grid).
   Opening them interrupts the series inductor's current, which would ring undamped through
   the open switches (as a tripped machine's), so at ``t`` each end node is also switched to
   ground through a dump resistance (the closed resistance of a switch to ground):
