@@ -111,7 +111,7 @@ def test_trip_swings_alike_and_settles_on_the_grid_without_the_branch(tap, kv2):
         assert exc[e] == pytest.approx(exc["phasor"], rel=0.02), exc
         assert peak[e] == pytest.approx(peak["phasor"], rel=0.01), peak
     before, after = (_Oracle(_grid(tap=tap, kv2=kv2), n, tap) for n in (2, 1))
-    charged = _Oracle(_grid(tap=tap, kv2=kv2), 1, tap)     # the wrong trip: the branch's charging left in
+    charged = _Oracle(_grid(tap=tap, kv2=kv2), 1, tap)     # the wrong trip: charging left in
     charged.Y[1, 1] += 0.5j * B / (tap or 1.0) ** 2
     d0 = runs["phasor"]["G1.delta"][0]
     assert abs(before.solve(d0)[1] - before.Pm) < 1e-9          # the oracle is the power flow's
