@@ -31,7 +31,8 @@ from ..errors import DataError, SimulationError
 from ..results import Results
 from .controllers import _Loop, bind, sample_all
 from .dpsim_module import DOMAINS, Kit, domain_of
-from .events import build_events, removed_load, trip_terminals, tripped_machines
+from .events import (build_events, line_switching, removed_load, trip_terminals,
+                     tripped_machines)
 from .gti import GTIBridge
 from .machine_controls import MachineControls
 from .machines import build_machines, check_machines
@@ -119,7 +120,8 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
 def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers,
          gti_power="measured"):
     net = system.network
-    cir = build_network(system, kit, removed_load(system, events))
+    switched = {k: v[0] for k, v in line_switching(system, events).items()}
+    cir = build_network(system, kit, removed_load(system, events), switched)
     bridge = UPQCBridge(system, kit, cir)
     gti = GTIBridge(system, kit, cir, power=gti_power)
     gens = build_machines(system, kit, trip_terminals(system, kit, cir, events), cir.Vpf, cir)
