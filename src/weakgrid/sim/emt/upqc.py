@@ -25,7 +25,14 @@ import math
 import numpy as np
 
 from ..network import BR_R, BR_X
-from ..upqc import rating_clip, series_dc_power
+from ..upqc import UPQC, link_vmax, rating_clip, series_dc_power, shunt_dc_law
+
+#: recorded UPQC signals (the phasor engine's names ``<upqc>.<name>``), in :meth:`UPQCBridge.update`'s
+#: order: the series converter's, then the dc link's states and the shunt converter's
+SIGNALS = ("Vup", "Vuq", "Vu", "P_series", "Vdc", "xi_dc", "P_dc", "P_shunt", "S_shunt",
+           "I_shunt", "P_loss", "limited")
+#: the shunt converter's dc-link parameters (weakgrid.sim.upqc.shunt_dc_law's ``p``)
+_DC = ("Vdc0", "kp_dc", "ki_dc", "Imax", "Rsh", "Cdc")
 
 
 class UPQCBridge:
@@ -80,7 +87,9 @@ class UPQCBridge:
             self.items.append(dict(name=nm, i=i, branch=k, r=r, src=src, sh=sh, ind=ind, mid=mid, vb=vb,
                                    ib=system.Sb * 1e6 / vb, Vmax=float(comp.p["Vmax"][i]),
                                    gti=int(comp.gti_i[i]) if red else None,
-                                   chi=float(comp.p["chi"][i])))
+                                   chi=float(comp.p["chi"][i]),
+                                   dc={q: float(comp.p[q][i]) for q in _DC},
+                                   Vdc=float(comp.p["Vdc0"][i]), xi=0.0))
         self.comp = comp
         self._draw = {}
         cir.upqc_branches = {it["branch"] for it in self.items}
@@ -96,33 +105,55 @@ class UPQCBridge:
         self.kit.set_source(src, "I_ref", current / math.sqrt(3) if self.kit.three_phase
                             else current, init, f)
 
-    def update(self, t, phasor_of, current_of):
-        """Rewrite every UPQC's set points from its held inputs and the measured phasors.
+    def update(self, t, phasor_of, current_of, dt):
+        """At a measurement instant ``t_k`` [s]: rewrite every UPQC's set points from its held
+        inputs and the measured phasors, and advance the conventional UPQCs' dc links to
+        ``t_k + dt`` (forward Euler over ``dt`` [s]).
 
         ``phasor_of(b)``: bus ``b``'s voltage [pu phasor]; ``current_of(element)``: the current
         [A phasor, line-to-line RMS scale] from terminal 1 to terminal 2 inside a DPsim element
-        (here the branch's series inductor: from bus r towards bus 1).
+        (here the branch's series inductor: from bus r towards bus 1). Returns per UPQC the
+        values of :data:`SIGNALS` [pu]: the set points held over ``[t_k, t_k + dt]``, the
+        powers at ``t_k`` and the dc-link states at ``t_k + dt``.
         """
         out = []
         self._draw = {}
         for it in self.items:
-            i = it["i"]
-            u = rating_clip(np.array([self.comp.u_p[i], self.comp.u_q[i]]), it["Vmax"])
+            i, dc = it["i"], it["dc"]
+            conv = it["sh"] is not None
+            vmax = float(link_vmax(it["Vmax"], it["Vdc"], dc["Vdc0"])) if conv else it["Vmax"]
+            u = rating_clip(np.array([self.comp.u_p[i], self.comp.u_q[i]]), vmax)
             Vr = phasor_of(it["r"])
-            ur = Vr / abs(Vr) if abs(Vr) > 1e-9 else 1.0
+            vr_abs = abs(Vr)
+            ur = Vr / vr_abs if vr_abs > 1e-9 else 1.0
             Vu = complex(u[1], u[0]) * ur                       # pu
             self._set_v(it["src"], Vu * it["vb"])
             I = current_of(it["ind"]) / it["ib"]                # pu on Sb, bus r -> bus 1
-            P = (Vu * np.conj(I)).real
-            Vr_safe = Vr if abs(Vr) > 1e-6 else 1e-6
-            if it["sh"] is not None:
-                Ish = -(P / np.conj(Vr_safe))                   # injected into bus r [pu]
-                self._set_i(it["sh"], Ish * it["ib"])
+            P = float((Vu * np.conj(I)).real)
+            Pdc = float(series_dc_power(P, it["chi"]))
+            if conv:
+                Id, over, Psh, Ploss, dVdc, dxi = (float(a) for a in shunt_dc_law(
+                    Pdc, it["Vdc"], it["xi"], vr_abs, max(vr_abs, 1e-6), dc))
+                self._set_i(it["sh"], -Id * ur * it["ib"])      # drawn from bus r, in phase with Vr
+                it["Vdc"] += dt * dVdc
+                it["xi"] += dt * dxi
             else:   # reduced: drawn from the GTI's dc link
-                self._draw[it["gti"]] = self._draw.get(it["gti"], 0.0) + \
-                    float(series_dc_power(P, it["chi"]))
-            out.append((it["name"], u[0], u[1], abs(Vu), P))
+                Id = over = Psh = Ploss = 0.0
+                self._draw[it["gti"]] = self._draw.get(it["gti"], 0.0) + Pdc
+            out.append((u[0], u[1], abs(Vu), P, it["Vdc"], it["xi"], Pdc, Psh, abs(Psh), Id,
+                        Ploss, float(over)))
         return out
+
+    def initial(self):
+        """The :meth:`update` rows before the first step: nothing applied, the dc links at
+        ``Vdc0``."""
+        return [(0.0,) * 4 + (it["Vdc"], it["xi"]) + (0.0,) * 6 for it in self.items]
+
+    def names(self):
+        """``[(signal, kind)]`` recorded per UPQC, in :meth:`update`'s order (kinds as the
+        phasor engine's, :attr:`weakgrid.sim.upqc.UPQC.units`)."""
+        return [(f"{it['name']}.{s}", UPQC.units.get(s, "pu")) for it in self.items
+                for s in SIGNALS]
 
     def gti_draw(self, n_gti: int) -> np.ndarray:
         """Per GTI (its position in the GTI component), the dc power [pu on Sb] the reduced
