@@ -196,8 +196,10 @@ def test_paper_fault_with_29_depends_on_what_the_dc_link_sees():
     """The paper's fault with the law (29) in the loop (T = 0.81 ms, ZOH, bypassed during the
     fault). With the GTI's dc link paying its model's power (``gti_power = "model"``) DP
     reproduces the phasor engine's dc-link swing (measured over 1.5 s: 0.1576 against 0.1579
-    pu); paying the power its DPsim source delivered (the default) the loop swings it far
-    further (0.758 pu): docs/engines.md."""
+    pu); paying the power its DPsim source delivered (the default) the loop swings it further
+    (0.214 pu over 1 s; 0.758 while DPsim's UPQC shunt converter was ideal: now its current
+    limit binds on the series power's spike at clearing, its dc link drains and lowers the
+    series voltage): docs/engines.md."""
     from weakgrid.study.runner import Run, run_scenario
 
     dev = {}
@@ -208,4 +210,4 @@ def test_paper_fault_with_29_depends_on_what_the_dc_link_sees():
         assert rec.metrics["vu_peak_pu"] > 0.1, key                  # the controller acted
         dev[key] = rec.metrics["vdc_peak_dev_pu"]
     assert dev["model"] == pytest.approx(dev["phasor"], rel=0.05), dev
-    assert dev["measured"] > 2.0 * dev["phasor"], dev
+    assert dev["measured"] > 1.2 * dev["phasor"], dev
