@@ -1,21 +1,41 @@
-"""The UPQC (conventional structure) in DPsim: a series voltage source and its shunt converter.
+"""The UPQC (conventional structure) in DPsim: a series voltage source and its shunt converter
+with the dc link between them.
 
 weakgrid's UPQC (:mod:`weakgrid.sim.upqc`) inserts ``Vu = (Vuq + j Vup) e^{j theta_r}`` in its
-branch, at the shunt bus ``r``, and (conventional structure) draws the series real power
-``P_series = Re(Vu conj(I))`` from bus ``r`` through its shunt converter. In DPsim:
+branch, at the shunt bus ``r``; its series converter pays ``P_dc = P_series + chi |P_series|``
+(:func:`~weakgrid.sim.upqc.series_dc_power`) from a dc link. In DPsim:
 
 * the branch becomes ``bus r — VoltageSource(Vu) — node — R — L — bus 1``; the source's set
   point is rewritten between steps (zero-order hold over one step ``dt``) from the held inputs
-  ``Vup``, ``Vuq`` (after the rating clip ``Vmax``, :func:`weakgrid.sim.upqc.rating_clip`) and
-  the angle ``theta_r`` of bus ``r`` measured at the previous step;
-* the shunt converter is a current source at bus ``r`` drawing ``P_series`` at the measured bus
-  voltage, rewritten between steps likewise.
+  ``Vup``, ``Vuq`` after the rating clip (:func:`weakgrid.sim.upqc.rating_clip`) at the
+  conventional UPQC's modulation limit ``Vmax min(1, Vdc/Vdc0)`` with the current ``Vdc``
+  (:func:`weakgrid.sim.upqc.link_vmax`), and the angle ``theta_r`` of bus ``r`` measured at the
+  previous step;
+* the conventional structure's shunt converter is a ``CurrentSource`` at bus ``r`` drawing
+  ``I_shunt`` in phase with the measured ``Vr``, and its dc link (states ``Vdc``, ``xi_dc``) is
+  co-simulated with the phasor engine's own law (:func:`weakgrid.sim.upqc.shunt_dc_law`: the
+  feed-forward + dc-voltage PI ``P_ref``, the current limit ``Imax``, the loss ``Rsh I²``,
+  ``Cdc Vdc dVdc/dt = P_shunt − P_loss − P_dc``), stepped like the GTI's
+  (:mod:`weakgrid.sim.emt.gti`): at ``t_k`` the law is evaluated at the states ``x_k`` and the
+  measurements, the shunt current is set for ``[t_k, t_k + dt]`` and the states advance by
+  forward Euler, ``x_{k+1} = x_k + dt f_k``.
 
-The phasor engine applies both algebraically at every instant; here they lag by one step
-(1e-4 s by default). The reduced structure has no shunt converter: its series power (with the
-converter loss ``chi``, :func:`weakgrid.sim.upqc.series_dc_power`) is drawn from the dc link of
-its GTI (:mod:`weakgrid.sim.emt.gti`), which takes the power the series source delivered over
-the last step (:meth:`UPQCBridge.gti_draw`).
+The series power the dc link pays is the *measured* one (the convention of the GTI's default
+``gti_power = "measured"``, whatever a run's ``gti_power``): ``P_series = Re(Vu conj(I))`` with
+``I`` the branch current measured in DPsim's series inductor at ``t_k`` and ``Vu`` the set
+point the source holds from ``t_k`` — the power the DPsim source delivers at the start of the
+step the dc link is advanced over, network current transients included (the phasor engine's
+``I = (Vr + Vu − V1)/Zu`` leaves them out). Without a current limit and losses (``Imax = 0``,
+``chi = Rsh = 0``) ``P_shunt = P_series`` at every step and ``Vdc`` stays at ``Vdc0``: the
+ideal constant-power shunt this bridge had before. When the series power spikes beyond
+``Imax |Vr|`` (a fault's clearing), the link drains and the modulation limit lowers ``|Vu|``.
+
+The phasor engine applies all of this algebraically at every instant; here the set points lag
+by one step (1e-4 s by default). The reduced structure has no shunt converter: its series power
+``P_dc`` (the same measured ``P_series``) is drawn from the dc link of its GTI
+(:mod:`weakgrid.sim.emt.gti`, :meth:`UPQCBridge.gti_draw`); its own ``Vdc`` stays ``Vdc0``.
+Recorded per UPQC: :data:`SIGNALS` with the phasor engine's names (``<upqc>.Vdc``,
+``.xi_dc``, ``.P_dc``, ``.P_shunt``, ``.I_shunt``, ``.P_loss``, ``.limited``, ...).
 """
 
 from __future__ import annotations
