@@ -4,8 +4,9 @@ the phasor engine.
 The SMIB of test_emt_upqc (a conventional UPQC "U" in the line, shunt bus = the machine's bus):
 at 0.1 s a DigitalController (period 1 ms, zero-order hold) steps the series voltage's in-phase
 command ``Vuq`` from 0 to 0.15 pu, so the series converter draws ``P_series`` ~ 0.11 pu from the
-dc link. Oracles: the phasor engine's dc link (the same law, :func:`weakgrid.sim.upqc.shunt_dc_law`),
-the dc link's energy balance, and the ideal shunt the law reduces to without limit and losses.
+dc link. Oracles: the phasor engine's dc link (the same law,
+:func:`weakgrid.sim.upqc.shunt_dc_law`), the dc link's energy balance, and the ideal shunt the law
+reduces to without limit and losses.
 """
 
 import numpy as np

@@ -32,7 +32,9 @@ Where the series converter's dc power ``P_dc`` comes from:
   converter's modulation limit), so a link drained while the current limit binds lowers
   ``|Vu|`` and with it the series power, rather than running below zero. With
   ``chi = Rsh = 0`` and the limit not reached, ``P_shunt = P_series`` at every instant and the
-  dc link stays at ``Vdc0``: the lossless constant-power draw of the ideal model.
+  dc link stays at ``Vdc0``: the lossless constant-power draw of the ideal model. The law is
+  :func:`shunt_dc_law` (and the modulation limit :func:`link_vmax`), which the DPsim engines
+  step between their steps too (:mod:`weakgrid.sim.emt.upqc`).
 * ``structure="reduced"``: drawn from the dc link of GTI ``gti``, entering its
   balance ``C*Vc*dVc/dt = Pin - Pe - P_dc`` (the UPQC's own dc-link states stay constant).
 
@@ -89,7 +91,8 @@ def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p):
     vr_abs, vr_safe : array_like
         The shunt-bus voltage magnitude ``|Vr|`` [pu], and the same kept off zero (the divisor).
     p : mapping
-        ``Vdc0``, ``kp_dc``, ``ki_dc``, ``Imax`` (0: no limit), ``Rsh``, ``Cdc`` (:attr:`UPQC.params`).
+        ``Vdc0``, ``kp_dc``, ``ki_dc``, ``Imax`` (0: no limit), ``Rsh``, ``Cdc``
+        (:attr:`UPQC.params`).
 
     Returns
     -------

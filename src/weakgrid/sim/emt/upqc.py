@@ -47,8 +47,9 @@ import numpy as np
 from ..network import BR_R, BR_X
 from ..upqc import UPQC, link_vmax, rating_clip, series_dc_power, shunt_dc_law
 
-#: recorded UPQC signals (the phasor engine's names ``<upqc>.<name>``), in :meth:`UPQCBridge.update`'s
-#: order: the series converter's, then the dc link's states and the shunt converter's
+#: recorded UPQC signals (the phasor engine's names ``<upqc>.<name>``), in
+#: :meth:`UPQCBridge.update`'s order: the series converter's, then the dc link's states and the
+#: shunt converter's
 SIGNALS = ("Vup", "Vuq", "Vu", "P_series", "Vdc", "xi_dc", "P_dc", "P_shunt", "S_shunt",
            "I_shunt", "P_loss", "limited")
 #: the shunt converter's dc-link parameters (weakgrid.sim.upqc.shunt_dc_law's ``p``)
