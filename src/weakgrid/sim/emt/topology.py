@@ -33,6 +33,7 @@ import numpy as np
 
 from ..errors import DataError
 from ..network import BR_B, BR_R, BR_STATUS, BR_X, SHIFT, TAP, T_BUS, F_BUS, GS, BS
+from .damping import terminal_damping
 
 #: non-machine component types the DPsim engines map
 DEVICE_MAP = {"InfiniteBus": "NetworkInjection",
@@ -57,12 +58,16 @@ class Circuit:
     branch_ends : dict
         ``{branch row: (from-end node, to-end node)}`` of the branches built behind breakers
         (``build_network(switched=...)``).
+    damping : ndarray
+        Per bus position, the resistance [Ω] in series with each capacitor at the bus (0:
+        none; :mod:`weakgrid.sim.emt.damping`).
     """
 
     def __init__(self, nodes, f_hz):
         self.nodes, self.f_hz = nodes, f_hz
         self.components, self.extra_nodes = [], []
         self.branch_ends = {}
+        self.damping = np.zeros(len(nodes))
 
 
 def check_devices(system) -> None:
@@ -96,7 +101,9 @@ def check_network(system, removed=None, switched=()) -> None:
     cannot hold: a non-inductive branch (``BR_X <= 0``, a series capacitor), a phase shifter
     (``SHIFT != 0``: its two-port is not reciprocal, which no network of R, L, C is), a
     negative shunt conductance (generation as a load), a load step removing more load than its
-    bus holds (``removed``: :func:`weakgrid.sim.emt.events.removed_load`). Branches out of
+    bus holds (``removed``: :func:`weakgrid.sim.emt.events.removed_load`), a machine's node
+    with more capacitance than a damping resistor can be added to without changing the grid
+    (:func:`weakgrid.sim.emt.damping.terminal_damping`). Branches out of
     service are checked too when a ``LineTrip`` closes them (rows in ``switched``)."""
     net = system.network
     up = system.components.get("UPQC")
@@ -122,6 +129,7 @@ def check_network(system, removed=None, switched=()) -> None:
         raise DataError(f"bus{net.bus_ids[b]}", "PD/GS", float(y0[b].real),
                         "a negative shunt conductance (generation as a load) is not mapped to "
                         "DPsim")
+    terminal_damping(system, y, upqc_rows)      # refuses a capacitance too large to damp
 
 
 def build_network(system, kit, removed=None, switched=None) -> Circuit:
@@ -156,6 +164,7 @@ def build_network(system, kit, removed=None, switched=None) -> Circuit:
     ph = kit.ph
     up = system.components.get("UPQC")
     upqc_rows = set(np.asarray(up.branch).tolist()) if up is not None and up.n else set()
+    cir.damping = terminal_damping(system, _shunt_admittance(system, removed), upqc_rows) * Zb
     for k, row in enumerate(net.branch):
         if (row[BR_STATUS] <= 0 and k not in switched) or k in upqc_rows:
             continue                                   # a UPQC branch: weakgrid.sim.emt.upqc
@@ -175,14 +184,11 @@ def build_network(system, kit, removed=None, switched=None) -> Circuit:
         z = Zb[f]
         _series_rl(cir, kit, f"br{k}", nf, nt, Vf, Vt, complex(r, x) * z, w)
         if bc > 0:
-            for end, n in (("f", nf), ("t", nt)):
-                cap = ph.Capacitor(f"br{k}.C{end}", off)
-                cap.set_parameters(kit.param(0.5 * bc / (z * w)))
-                cap.connect([kit.gnd, n])
-                cir.components.append(cap)
+            for end, n, V, bp in (("f", nf, Vf, f), ("t", nt, Vt, t)):
+                _capacitor(cir, kit, f"br{k}.C{end}", n, V, 0.5 * bc / (z * w), bp, w)
     y = _shunt_admittance(system, removed)
     for b, yb in enumerate(y):
-        _shunt(cir, kit, f"bus{net.bus_ids[b]}", nodes[b], complex(yb) / Zb[b], w)
+        _shunt(cir, kit, f"bus{net.bus_ids[b]}", nodes[b], complex(yb) / Zb[b], w, b)
     for c in system.components.values():
         if c.type_name == "InfiniteBus":
             for i, nm in enumerate(c.names):
@@ -198,8 +204,10 @@ def build_network(system, kit, removed=None, switched=None) -> Circuit:
     return cir
 
 
-def _shunt(cir, kit, name, node, y, w):
-    """A constant admittance ``y`` [S] from ``node`` to ground: resistor ∥ inductor or capacitor."""
+def _shunt(cir, kit, name, node, y, w, b=None):
+    """A constant admittance ``y`` [S] from ``node`` (bus position ``b``) to ground:
+    resistor ∥ inductor or capacitor (the capacitor through :func:`_capacitor` when ``b`` is
+    given; ``b = None``: a switched admittance, never damped)."""
     off, ph = kit.d.LogLevel.off, kit.ph
     if y.real > 0:
         r = ph.Resistor(f"{name}.G", off)
@@ -212,10 +220,34 @@ def _shunt(cir, kit, name, node, y, w):
         L.connect([kit.gnd, node])
         cir.components.append(L)
     elif y.imag > 0:
-        C = ph.Capacitor(f"{name}.BC", off)
-        C.set_parameters(kit.param(y.imag / w))
-        C.connect([kit.gnd, node])
-        cir.components.append(C)
+        if b is None:
+            C = ph.Capacitor(f"{name}.BC", off)
+            C.set_parameters(kit.param(y.imag / w))
+            C.connect([kit.gnd, node])
+            cir.components.append(C)
+        else:
+            _capacitor(cir, kit, f"{name}.BC", node, cir.Vpf[b], y.imag / w, b, w)
+
+
+def _capacitor(cir, kit, name, node, V, C, b, w):
+    """A capacitor ``C`` [F] from ``node`` (of bus position ``b``, initial phasor ``V`` [V]) to
+    ground; at a machine's terminal bus in series with the damping resistor ``cir.damping[b]``
+    [Ω] (:mod:`weakgrid.sim.emt.damping`), through an internal node at its steady-state phasor."""
+    off, ph = kit.d.LogLevel.off, kit.ph
+    a = node
+    Rd = float(cir.damping[b])
+    if Rd > 0:
+        I = V / (Rd + 1.0 / (1j * w * C))
+        a = kit.node(f"{name}.mid", V - Rd * I)
+        cir.extra_nodes.append(a)
+        res = ph.Resistor(f"{name}.Rd", off)
+        res.set_parameters(kit.param(Rd))
+        res.connect([node, a])
+        cir.components.append(res)
+    cap = ph.Capacitor(name, off)
+    cap.set_parameters(kit.param(C))
+    cap.connect([kit.gnd, a])
+    cir.components.append(cap)
 
 
 def _series_rl(cir, kit, name, na, nb, Va, Vb, Z, w):
@@ -280,10 +312,6 @@ def _transformer(cir, kit, system, k, row, f, t, w, ends):
         _series_rl(cir, kit, f"br{k}.f", nf, kit.gnd, Vf, 0j, Z * N * N / (1 - N), w)
         _series_rl(cir, kit, f"br{k}.t", nt, kit.gnd, Vt, 0j, Z * N / (N - 1), w)
     if bc > 0:
-        off = kit.d.LogLevel.off
-        for end, node, C in (("f", nf, 0.5 * bc / (tap * tap) / (Zb[f] * w)),
-                             ("t", nt, 0.5 * bc / (Zb[t] * w))):
-            cap = kit.ph.Capacitor(f"br{k}.C{end}", off)
-            cap.set_parameters(kit.param(C))
-            cap.connect([kit.gnd, node])
-            cir.components.append(cap)
+        for end, node, V, bp, C in (("f", nf, Vf, f, 0.5 * bc / (tap * tap) / (Zb[f] * w)),
+                                    ("t", nt, Vt, t, 0.5 * bc / (Zb[t] * w))):
+            _capacitor(cir, kit, f"br{k}.C{end}", node, V, C, bp, w)
