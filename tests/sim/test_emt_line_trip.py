@@ -12,9 +12,9 @@ the remaining branch, its charging included, the tripped one's gone) at the mach
 (E' constant behind x'd): the post-trip operating point is the phasor engine's network without
 the branch, and the machine's new equilibrium angle (Pe = Pm) lies inside its swing.
 
-(The machine's terminal is kept free of capacitance: a DPsim GENCLS with a capacitor at its
-terminal node rings at 2–3 kHz after any current interruption — a cleared fault too — which
-is the machine model's, not the trip's; see docs/engines.md.)
+(The machine's terminal is kept free of capacitance: there DPsim's algebraic stator would
+ring at kHz after any current interruption, damped by a resistor in series with the
+capacitors (weakgrid.sim.emt.damping) which the oracle's π model does not have.)
 """
 
 import numpy as np

@@ -13,7 +13,8 @@ and machines in two domains used here:
 
 A set-up weakgrid :class:`~weakgrid.sim.system.System` is translated element by element
 (:mod:`weakgrid.sim.emt.topology`, :mod:`weakgrid.sim.emt.machines`,
-:mod:`weakgrid.sim.emt.events`, :mod:`weakgrid.sim.emt.upqc`) from its own data and power
+:mod:`weakgrid.sim.emt.events`, :mod:`weakgrid.sim.emt.upqc`; a machine's capacitive node
+damped: :mod:`weakgrid.sim.emt.damping`) from its own data and power
 flow — the phasor engine and the DPsim engines start from the same operating point — and run
 step by step (:mod:`weakgrid.sim.emt.run`; the machines' exciters, governors and stabilizers
 are weakgrid's, stepped beside DPsim: :mod:`weakgrid.sim.emt.machine_controls`) into

@@ -24,9 +24,9 @@ The remedy. A resistor ``R_d`` in series with every capacitor at the node (a cap
 series resistance) turns the mode into ``λ = −ω0 / (b (R_d + z_m))``, of damping ratio
 ``Re(R_d + z_m)/|R_d + z_m|``: ``R_d`` is sized so that the ratio is :data:`ZETA` (at least),
 independent of ``b``. At the fundamental, each capacitor ``j b_k`` becomes
-``j b_k / (1 + j b_k R_d)`` ≈ ``j b_k + b_k² R_d``: a conductance ``b_k² R_d`` (0.05 % of the
-machine's rating on the test grid) and a relative susceptance change ``(b_k R_d)²``. Only
-buses whose mode's own damping (from ``ra`` and the bus's load conductance ``g``) is below
+``j b_k / (1 + j b_k R_d)`` ≈ ``j b_k + b_k² R_d``: a conductance ``b_k² R_d`` (2.5e-4 pu in
+all on the test grid, 0.03 % of the machine's power; the speed excursion moves by 0.02 %) and
+a relative susceptance change ``(b_k R_d)²``. Only buses whose mode's own damping (from ``ra`` and the bus's load conductance ``g``) is below
 :data:`ZETA` get it. When ``b R_d`` would exceed :data:`MAX_SHIFT` (a large capacitance at the
 machine, the mode near the network's own frequencies) the bus is refused, naming the bus, the
 machines and the fixes.

@@ -63,6 +63,11 @@ Residual differences to weakgrid (stated, not hidden):
   unsaturated, and its power flow initialization is DPsim's own (unsaturated), so the field
   voltage ``Ef(0)`` differs from weakgrid's saturated ``vf0``.
 
+The stator of every DPsim machine used here is algebraic (no ``dψ/dt``): the network sees the
+machine as ``ra + j x`` at every frequency, not as an inductance, which with capacitance at the
+machine's node is an undamped kHz mode; such a node's capacitors get a series damping resistor
+(or the bus is refused): :mod:`weakgrid.sim.emt.damping`.
+
 The stator resistance ``ra`` (DPsim's reduced-order machines have none) is a DPsim resistor
 between the machine and its bus: ``V = E'' - (ra + j x'') I`` is weakgrid's stator exactly,
 and DPsim's torque ``Vd Id + Vq Iq``, taken inside the resistor, the air-gap torque.

@@ -20,6 +20,10 @@ Mapping
 * bus loads ``PD + jQD`` and shunts ``GS + jBS``: one constant admittance per bus, the
   impedance weakgrid's phasor engine uses (:meth:`weakgrid.sim.network.Network.load_admittance` at the solved
   voltage): a resistor and an inductor or capacitor to ground;
+* at a machine's bus, every capacitor (charging, capacitive shunt) in series with the damping
+  resistor of :mod:`weakgrid.sim.emt.damping` (DPsim's algebraic stator with the node's
+  capacitance is an undamped kHz mode), or the bus refused when that resistor would change the
+  capacitance's admittance by more than 1 %;
 * :class:`~weakgrid.sim.sources.InfiniteBus`: DPsim's ``NetworkInjection`` (an ideal source) at
   the power-flow phasor; the conventional UPQC: :mod:`weakgrid.sim.emt.upqc`; the GTI:
   :mod:`weakgrid.sim.emt.gti`; other devices (converters, PVSource, ZIP loads) are refused.
