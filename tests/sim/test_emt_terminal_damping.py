@@ -1,8 +1,9 @@
 """The DPsim machine with capacitance at its own node (weakgrid.sim.emt.damping).
 
 Grid: a classical machine G1 (xd1 = 0.25 pu, 0.8 pu, M = 6 s) at bus 1, two parallel lines
-0.01 + j0.3 pu with b = 0.1 pu each to an infinite bus: b = 0.1 pu at the machine's node. A
-bolted fault at bus 1 from 0.1 s to 0.15 s.
+0.01 + j0.3 pu with b = 0.1 pu each to an infinite bus: b = 0.1 pu at the machine's node (or
+the lines without charging and a 0.1 pu shunt capacitor at bus 1; or case 1's GENROU with
+xd2 = 0.25 pu). A bolted fault at bus 1 from 0.1 s to 0.15 s.
 Oracles: DPsim's VBR machine is the impedance ``j x`` at every frequency (an algebraic
 stator), so with the node's capacitance ``b`` it forms the first-order mode
 ``λ = −j ω0 / (x b)`` (undamped), which the trapezoidal rule keeps at ``(2/dt) atan(ω0 dt /
@@ -26,7 +27,12 @@ T_ON, T_OFF = 0.1, 0.15
 W0 = 2 * math.pi * 60.0
 
 
-def _grid(b=B, ra=0.0, load1=0.0, bs1=0.0):
+#: case 1's GENROU, its xd2 = 0.25 pu the classical machine's xd1, without ra (undamped mode)
+GENROU = dict(Sn=100, M=6.0, D=0.0, ra=0.0, xl=0.15, xd=1.8, xq=1.7, xd1=0.3, xq1=0.55,
+              xd2=XD1, xq2=XD1, Td10=6.0, Td20=0.03, Tq10=0.4, Tq20=0.05, S10=0.0)
+
+
+def _grid(b=B, ra=0.0, load1=0.0, bs1=0.0, model="GENCLS"):
     from weakgrid.sim.sources import InfiniteBus
     from weakgrid.sim.system import System
 
@@ -36,7 +42,10 @@ def _grid(b=B, ra=0.0, load1=0.0, bs1=0.0):
                     [2, 0, 0, 999, -999, 1.0, 100, 1, 999, -999] + [0] * 11], float)
     branch = np.array([[1, 2, 0.01, 0.3, b, 0, 0, 0, 0, 0, 1, -360, 360]] * 2, float)
     s = System({"baseMVA": 100.0, "bus": bus, "gen": gen, "branch": branch})
-    s.add_machine("GENCLS", "G1", 0, Sn=100, M=6.0, D=0.0, ra=ra, xd1=XD1)
+    if model == "GENCLS":
+        s.add_machine("GENCLS", "G1", 0, Sn=100, M=6.0, D=0.0, ra=ra, xd1=XD1)
+    else:
+        s.add_machine(model, "G1", 0, **dict(GENROU, ra=ra))
     src = InfiniteBus()
     src.add_source("S2", 1)
     s.add_component(src)
@@ -91,13 +100,16 @@ def _ringing(r, t0):
 
 @pytest.mark.emt
 @pytest.mark.parametrize("engine", ["dpsim-dp", "dpsim-emt"])
-def test_cleared_fault_leaves_no_ringing(engine):
+@pytest.mark.parametrize("kw", [dict(), dict(b=0.0, bs1=10.0), dict(model="GENROU")],
+                         ids=["line-charging", "shunt-capacitor", "GENROU"])
+def test_cleared_fault_leaves_no_ringing(engine, kw):
     pytest.importorskip("dpsimpy")
     from weakgrid.sim.emt import simulate_dpsim
-    r = simulate_dpsim(_grid(), T_END, engine=engine, dt=DT, events=[Fault(1, T_ON, T_OFF)])
+    r = simulate_dpsim(_grid(**kw), T_END, engine=engine, dt=DT, events=[Fault(1, T_ON, T_OFF)])
     # with ζ = 0.2 the mode (≈ 2 pu at clearing) decays as exp(−ζ |λ| t), e^-30 in 10 ms; what
-    # the measure leaves is the post-clearing 100–160 Hz transient (≈ 1 pu × 0.01 gain)
-    # Without the resistor (DPsim 1.4 as built on main): 2.06 (EMT), 2.11 pu (DP).
+    # the measure leaves is the post-clearing 100–160 Hz transient (≈ 1 pu × 0.01 gain).
+    # Without the resistor (DPsim 1.4 as built on main): 2.06 / 2.11 pu (EMT / DP) for the
+    # classical machine with line charging or a 0.1 pu shunt capacitor, 1.05 / 1.14 pu GENROU.
     assert _ringing(r, T_OFF + 0.01) < 0.03
     assert np.all(np.isfinite(r["G1.omega"]))
 
