@@ -39,7 +39,7 @@ import fnmatch
 import inspect
 import math
 
-from .stability import STABILITY_SIGNALS, run_instability  # noqa: F401  (re-exported)
+from .stability import run_instability
 from .ties import compare, run_uncertainty, unc_text
 
 __all__ = ["RULES", "STABILITY_NOTE", "judge_all", "judge_claim", "run_instability",
