@@ -42,8 +42,7 @@ import math
 from .stability import run_instability
 from .ties import compare, run_uncertainty, unc_text
 
-__all__ = ["RULES", "STABILITY_NOTE", "judge_all", "judge_claim", "run_instability",
-           "stability_gate"]
+__all__ = ["RULES", "STABILITY_NOTE", "judge_all", "judge_claim", "stability_gate"]
 
 
 def _value(v):

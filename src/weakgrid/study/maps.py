@@ -7,8 +7,8 @@ cell coloured by the quantity and labelled with its value, and with the claim's
 verdict in that cell as a mark: ``✓`` holds, ``✗`` does not (also: the controller failed where
 its baseline finished), ``=`` tie within the measured uncertainty (its ± printed), ``!`` a run
 failed with nothing to compare (both runs, or the only one), ``n/c`` on a grey hatched cell
-no comparison: both runs not stable (:mod:`weakgrid.study.sweep_maps`). A cell whose device power went
-beyond the UPQC's rating or the line's power carries a marker in its corner
+no comparison: both runs not stable (:mod:`weakgrid.study.sweep_maps`). A cell whose device
+power went beyond the UPQC's rating or the line's power carries a marker in its corner
 (:data:`DEVICE_MARK`). A cell without a value shows ``–`` and, instead
 of a verdict, why (a ``note``: a run failed, no settling, …). The setting the paper (or the
 shipped study) uses is outlined.
@@ -108,9 +108,9 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
         legend += f"outlined: {mark_label}"
     if verdict is not None:
         legend += ("; " if legend else "") + ("✓ holds (a baseline's failure or instability "
-                                              "named)  ✗ does not (a failure or instability "
-                                              "of ours where the baseline is stable counts: "
-                                              "named)  = tie: the difference "
+                                              "named)  ✗ does not (a failure of ours, or our "
+                                              "instability, where the baseline is stable "
+                                              "counts: named)  = tie: the difference "
                                               "is within the measured uncertainty ± (step "
                                               "halving + the metric's definition)  ! a run "
                                               "failed, nothing to compare  n/c (grey, "

@@ -137,7 +137,7 @@ def _stability_gate(a, ra, b, rb, fa, fb):
         return "failed", math.nan, "", ""
     wa = run_instability(ra)
     wb = run_instability(rb) if rb is not None else ""
-    full = {c: f"{c} {w}" + (f" ({r.get('failure', '')})" if run_failed(r) else "")
+    full = {c: f"{c} failed: {r.get('failure', '')}" if run_failed(r) else f"{c} {w}"
             for c, w, r in ((a, wa, ra), (b, wb, rb)) if w}
     if wa and wb:
         return (NO_COMPARISON, math.nan, "both unstable: no comparison",
