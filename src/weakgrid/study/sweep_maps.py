@@ -134,7 +134,7 @@ def _stability_gate(a, ra, b, rb, fa, fb):
     metric gives the cell no value.
     """
     if fa and (rb is None or fb):
-        return "failed", math.nan, "", ""
+        return "failed", math.nan, f"{a} & {b} failed" if rb is not None else f"{a} failed", ""
     wa = run_instability(ra)
     wb = run_instability(rb) if rb is not None else ""
     full = {c: f"{c} failed: {r.get('failure', '')}" if run_failed(r) else f"{c} {w}"
