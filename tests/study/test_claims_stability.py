@@ -199,3 +199,7 @@ def test_two_swings_still_decaying_are_judged_on_overshoot_alone():
     assert judge_claim(c, m)["verdict"] == "reproduced"
     m["c2-high-f200-lqr"]["speed_settling_s"] = 1.0         # the baseline settles: it wins that
     assert judge_claim(c, m)["verdict"] == "partly"
+
+
+def test_a_record_too_short_to_judge_is_not_evidence():
+    assert run_instability(stable(speed_verdict="too short", vdc_verdict="too short")) == ""

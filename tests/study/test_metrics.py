@@ -138,3 +138,15 @@ def test_runaway_regression_mean_of_its_own_tail():
     y = 1 + 0.9 * T3                   # the dc link ramping to 3.7 pu in 3 s
     assert stability_verdict(T3, y) == "unstable"
     assert stability_verdict(T3, y, t_start=1.0, y_set=1.0) == "unstable"
+
+
+def test_a_record_no_longer_than_the_window_is_too_short():
+    """A 1-s quick-sweep run with the fault cleared at 0.25 s leaves 0.75 s: no previous
+    window to compare with. main called every such run "undamped" (the one window holds the
+    peak), even a swing that has all but died out; now neither test claims anything."""
+    t = np.linspace(0.0, 1.0, 1001)
+    y = 1 + 0.05 * np.exp(-8 * t) * np.sin(2 * np.pi * 1.2 * t)   # gone by 0.5 s
+    assert stability_verdict(t, y, t_start=0.25, y_set=1.0) == "too short"
+    assert stability_verdict(t, y, t_start=0.0, tail=0.4, y_set=1.0) == "stable"
+    y[-1] = np.nan                      # a non-finite sample is unstable whatever the length
+    assert stability_verdict(t, y, t_start=0.25) == "unstable"

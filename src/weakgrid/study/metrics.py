@@ -127,8 +127,8 @@ def running_cost(x, u, Q, R) -> np.ndarray:
 
 def stability_verdict(t, y, t_start=0.0, tail=1.0, settled_fraction=0.05,
                       y_set=None) -> str:
-    """The stability of a response after ``t_start``: ``"stable"``, ``"unstable"`` or
-    ``"undamped"``.
+    """The stability of a response after ``t_start``: ``"stable"``, ``"unstable"``,
+    ``"undamped"`` or ``"too short"``.
 
     Two tests, in this order, with ``tail`` [s] the judging window (the last ``tail``
     seconds; the ``tail`` before it is the previous window) and ``D = max |y − y_set|`` after
@@ -152,7 +152,10 @@ def stability_verdict(t, y, t_start=0.0, tail=1.0, settled_fraction=0.05,
 
     Both tests see a mode whose period is at most ``2·tail`` (≥ 0.5 Hz with the default
     1 s); a slower swing can look like a runaway or a growth within one window. A record
-    with non-finite samples is ``"unstable"``.
+    with non-finite samples is ``"unstable"``; a record that ends within ``tail`` of
+    ``t_start`` (no previous window to compare with, e.g. a 1-s sweep run with its fault
+    cleared at 0.25 s) is ``"too short"``: neither test can tell (it was ``"undamped"``
+    whatever the signal did).
 
     Parameters
     ----------
@@ -178,10 +181,12 @@ def stability_verdict(t, y, t_start=0.0, tail=1.0, settled_fraction=0.05,
     ys = float(y[0]) if y_set is None else float(y_set)
     late_w = tt >= tt[-1] - tail
     prev_w = (tt >= tt[-1] - 2 * tail) & ~late_w
+    if not prev_w.any():
+        return "too short"
     # 1. runaway: ends at its largest deviation, one-sided, still moving away
     d = yy - ys
     big = np.abs(d).max()
-    if big > 0 and prev_w.any():
+    if big > 0:
         dl = d[late_w]
         one_sided = np.all(dl > 0) or np.all(dl < 0)
         growth = np.abs(dl).mean() - np.abs(d[prev_w]).mean()
@@ -195,9 +200,8 @@ def stability_verdict(t, y, t_start=0.0, tail=1.0, settled_fraction=0.05,
     if peak == 0:
         return "stable"
     late = e[late_w]
-    prev = e[prev_w]
     amp_late = late.max()
-    amp_prev = prev.max() if prev.size else peak
+    amp_prev = e[prev_w].max()
     if amp_late <= settled_fraction * peak:
         return "stable"
     if amp_late > 1.2 * amp_prev:

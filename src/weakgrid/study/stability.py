@@ -5,7 +5,8 @@ A run is *not stable* when it failed (voltage collapse, loss of synchronism, New
 when the stability verdict of its SG speed or dc-link voltage (``speed_verdict``,
 ``vdc_verdict``, from :func:`weakgrid.study.metrics.stability_verdict`) is ``unstable`` (it
 grows or runs away from its set-point) or ``undamped`` (a sustained oscillation). A signal a
-run does not record is not evidence either way.
+run does not record, or whose record is ``too short`` to judge (a 1-s quick-sweep run), is
+not evidence either way.
 """
 
 from __future__ import annotations
