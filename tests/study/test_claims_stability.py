@@ -3,9 +3,12 @@ compares costs, ITAE, overshoot or settling (weakgrid.study.claims.stability_gat
 
 import math
 
+import numpy as np
+import pandas as pd
 import pytest
 
 from weakgrid.study.claims import judge_claim, run_instability, stability_gate
+from weakgrid.study.metrics import stability_verdict
 from weakgrid.study.reproduce import paper_studies
 
 
@@ -24,11 +27,11 @@ def stable(**kw):
 
 
 def runaway(**kw):
-    """Finished, but the dc link ran away: never settles, ends at its peak deviation (the
-    EMT `measured` runs of docs/emt-findings.md; a ramp's tail looks "stable" to
-    stability_verdict, so only the settling says it)."""
-    return stable(**{"vdc_settling_s": math.nan, "vdc_peak_dev_pu": 0.84,
-                     "vdc_final_dev_pu": 0.84, **kw})
+    """Finished, but the dc link ran away from its set-point (the EMT `measured` runs of
+    docs/emt-findings.md): the runner's stability_verdict calls it unstable, its settling is
+    undefined and it ends at its peak deviation."""
+    return stable(**{"vdc_verdict": "unstable", "vdc_settling_s": math.nan,
+                     "vdc_peak_dev_pu": 0.84, "vdc_final_dev_pu": 0.84, **kw})
 
 
 LOST = {"failed": True, "failure": "t = 3.427 s: loss of synchronism: rotor angle spread 181 deg"}
@@ -41,27 +44,39 @@ def test_run_instability_names_the_cause():
     assert run_instability(LOST) == "failed: loss of synchronism"
     assert run_instability(stable(speed_verdict="unstable")) == "not stable: SG speed unstable"
     assert run_instability(stable(vdc_verdict="undamped")) == "not stable: dc link undamped"
-    why = run_instability(runaway())
-    assert why.startswith("not stable: dc link never settles within the run")
-    assert "100 % of its peak" in why
-    # undefined settling without the deviations recorded: never settles
-    assert "never settles" in run_instability({"vdc_settling_s": None})
+    assert run_instability(runaway()) == "not stable: dc link unstable"
+    assert run_instability(stable(speed_verdict="unstable", vdc_verdict="undamped")) == \
+        "not stable: SG speed unstable, dc link undamped"
 
 
-def test_a_swing_still_decaying_at_the_end_of_a_short_run_is_stable():
-    """Case 1's 0.5-Hz speed swing in a 3-s quick run: outside the 2 % band at the end, but
-    back within 4 % of its peak from the set-point — stable, not "never settles"."""
-    r = stable(speed_settling_s=math.nan, speed_peak_dev_pu=0.0063, speed_final_dev_pu=2.4e-4)
-    assert run_instability(r) == ""
-    r["speed_final_dev_pu"] = -0.004          # ends 63 % of its peak away: not back
-    assert "SG speed never settles" in run_instability(r)
+def test_one_definition_from_the_signal_to_the_gate():
+    """A dc link ramping away from its set-point (|Vc − 1| → 0.8 pu in 3 s): the verdict the
+    runner records makes the run not stable; a swing still decaying at the end of a short
+    record (case 1's 0.5-Hz mode, outside its 2 % band, 9 % of its peak away) does not."""
+    t = np.linspace(0.0, 3.0, 3001)
+    ramp = stability_verdict(t, 1 + 0.8 * t / 3, y_set=1.0)
+    swing = stability_verdict(t, 1 + 0.006 * np.exp(-0.8 * t) * np.cos(np.pi * t), y_set=1.0)
+    r = stable(vdc_verdict=ramp, speed_verdict=swing, speed_settling_s=math.nan)
+    assert run_instability(r) == "not stable: dc link unstable"
+
+
+def test_run_instability_reads_a_sweep_table_row():
+    """The maps judge a sweep table's rows (status, not failed) by the same function."""
+    rows = pd.DataFrame([{"status": "ok", "failure": "", "vdc_verdict": "unstable",
+                          "speed_verdict": "stable"},
+                         {"status": "failed", "failure": "t = 1 s: voltage collapse",
+                          "vdc_verdict": math.nan, "speed_verdict": math.nan},
+                         {"status": "ok", "failure": math.nan, "vdc_verdict": "stable",
+                          "speed_verdict": math.nan}])
+    assert [run_instability(r) for _, r in rows.iterrows()] == [
+        "not stable: dc link unstable", "failed: voltage collapse", ""]
 
 
 def test_gate_each_case():
     m = {"a": stable(), "b": stable(), "ua": runaway(), "ub": runaway(), "fa": LOST}
     assert stability_gate(m, "a", "b") is None                        # compare them
     v, why = stability_gate(m, "ua", "b")
-    assert v == "not" and why.startswith("ua not stable: dc link never settles")
+    assert v == "not" and why.startswith("ua not stable: dc link unstable")
     v, why = stability_gate(m, "a", "ub")
     assert v == "reproduced" and "ub not stable" in why and "a stable: a win" in why
     assert stability_gate(m, "a", "ub", baseline_unstable="not")[0] == "not"
@@ -86,7 +101,7 @@ def test_cost_less_both_stable_compares_costs():
 def test_cost_less_claims_run_unstable_is_not_even_with_a_lower_cost():
     r = judge_claim(claim("C1-cost"), _cost(runaway(running_cost_18=0.1), stable()))
     assert r["verdict"] == "not"
-    assert "c1-high-conv-hji not stable: dc link never settles" in r["why"]
+    assert "c1-high-conv-hji not stable: dc link unstable" in r["why"]
     assert "running cost" not in r["measured"]               # no cost comparison printed
 
 
@@ -159,14 +174,15 @@ def test_less_overshoot_settling_each_way(ours, theirs, verdict, words):
 
 
 def test_stability_contrast_uses_the_same_definition():
-    """An LQR run that finished with a "stable" speed verdict but never came back to its
-    set-point is not stable for C2-low-load either (one definition)."""
+    """An LQR run whose speed ran away from its set-point is not stable for C2-low-load
+    either (one definition: run_instability)."""
     c = claim("C2-low-load")
     m = {"c2-low-f100-hji": stable(),
-         "c2-low-f100-lqr": stable(speed_settling_s=math.nan, speed_final_dev_pu=0.006),
+         "c2-low-f100-lqr": stable(speed_verdict="unstable", speed_settling_s=math.nan,
+                                  speed_final_dev_pu=0.006),
          "c2-low-f100-pss-only": stable(speed_verdict="undamped")}
     r = judge_claim(c, m)
-    assert r["verdict"] == "reproduced" and "lqr: not stable: SG speed never settles" in \
+    assert r["verdict"] == "reproduced" and "lqr: not stable: SG speed unstable" in \
         r["measured"]
     m["c2-low-f100-lqr"] = stable()
     assert judge_claim(c, m)["verdict"] == "partly"
@@ -183,3 +199,7 @@ def test_two_swings_still_decaying_are_judged_on_overshoot_alone():
     assert judge_claim(c, m)["verdict"] == "reproduced"
     m["c2-high-f200-lqr"]["speed_settling_s"] = 1.0         # the baseline settles: it wins that
     assert judge_claim(c, m)["verdict"] == "partly"
+
+
+def test_a_record_too_short_to_judge_is_not_evidence():
+    assert run_instability(stable(speed_verdict="too short", vdc_verdict="too short")) == ""

@@ -95,3 +95,58 @@ def test_definition_spread_of_the_settling_band():
     assert 0 <= d["x_itae_def_unc"] < 1e-3          # the last 0.5 s add almost nothing
     assert definition_spread(float("nan"), [1.0]) != definition_spread(float("nan"), [1.0])
     assert definition_spread(2.0, [float("nan")]) == 0.0
+
+
+# ---------------------------------------------------------------- runaway vs set-point
+T3 = np.linspace(0.0, 3.0, 3001)        # a 3-s post-fault record [s]
+
+
+@pytest.mark.parametrize("name, y, want", [
+    ("decaying 1.2-Hz swing", 1 + 0.05 * np.exp(-1.5 * T3) * np.sin(2 * np.pi * 1.2 * T3),
+     "stable"),
+    ("sustained 1.2-Hz swing", 1 + 0.05 * np.sin(2 * np.pi * 1.2 * T3), "undamped"),
+    ("growing 1.2-Hz swing", 1 + 0.05 * np.exp(0.5 * T3) * np.sin(2 * np.pi * 1.2 * T3),
+     "unstable"),
+    # the EMT dc link: |Vc − 1| grows steadily to 0.8 pu (a ramp, with converter ripple)
+    ("runaway ramp", 1 - 0.8 * T3 / 3, "unstable"),
+    ("runaway ramp with ripple", 1 + 0.8 * T3 / 3 + 0.02 * np.sin(2 * np.pi * 1.2 * T3),
+     "unstable"),
+    ("runaway exponential", 1 + 0.05 * (np.exp(T3) - 1), "unstable"),
+    ("slow runaway exponential", 1 + 0.3 * (np.exp(0.3 * T3) - 1), "unstable"),
+    # settled at a new operating point off the set-point (e.g. droop): steady, stable
+    ("new operating point", 1 + 0.1 * (1 - np.exp(-5 * T3)), "stable"),
+])
+def test_verdict_against_the_set_point(name, y, want):
+    assert stability_verdict(T3, y, y_set=1.0) == want, name
+
+
+@pytest.mark.parametrize("phi", np.linspace(0, np.pi, 7))
+def test_a_slow_swing_still_decaying_at_the_end_is_stable(phi):
+    """Case 1's 0.5-Hz speed mode in a 3-s run: ends 4–12 % of its peak from the set-point
+    (outside the 2 % settling band), one window is half its period — stable, whatever the
+    phase at the record's end."""
+    d = 0.006 * np.exp(-0.8 * T3) * np.cos(np.pi * T3 + phi)
+    ratio = abs(d[-1]) / np.abs(d).max()
+    assert ratio < 0.12
+    assert stability_verdict(T3, 1 + d, y_set=1.0) == "stable"
+
+
+def test_runaway_regression_mean_of_its_own_tail():
+    """Regression: judged against the mean of its own last second, a steady ramp looked
+    "stable" (its tail swings less about that mean than the second before); against the
+    set-point it runs away. The default set-point is the record's first sample."""
+    y = 1 + 0.9 * T3                   # the dc link ramping to 3.7 pu in 3 s
+    assert stability_verdict(T3, y) == "unstable"
+    assert stability_verdict(T3, y, t_start=1.0, y_set=1.0) == "unstable"
+
+
+def test_a_record_no_longer_than_the_window_is_too_short():
+    """A 1-s quick-sweep run with the fault cleared at 0.25 s leaves 0.75 s: no previous
+    window to compare with. main called every such run "undamped" (the one window holds the
+    peak), even a swing that has all but died out; now neither test claims anything."""
+    t = np.linspace(0.0, 1.0, 1001)
+    y = 1 + 0.05 * np.exp(-8 * t) * np.sin(2 * np.pi * 1.2 * t)   # gone by 0.5 s
+    assert stability_verdict(t, y, t_start=0.25, y_set=1.0) == "too short"
+    assert stability_verdict(t, y, t_start=0.0, tail=0.4, y_set=1.0) == "stable"
+    y[-1] = np.nan                      # a non-finite sample is unstable whatever the length
+    assert stability_verdict(t, y, t_start=0.25) == "unstable"

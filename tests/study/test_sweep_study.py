@@ -381,3 +381,70 @@ def test_map_tie_within_the_metrics_definition_band():
     w = map_cells(t, dict(spec, kind="wins", metrics=["speed_settling_s"]),
                   ["upqc.rating", "t_off", "load"])
     assert w["verdict"].tolist() == ["tie"]
+
+
+def _diverged_table():
+    """Rating 0.3 of the synthetic table, both runs finished; a's cost 50 % below b's."""
+    t = _cells_table()
+    t = t[(t["dt_factor"] == 1.0) & (t["upqc.rating"] == 0.3)].copy()
+    t["failure"] = ""
+    t["speed_verdict"] = "stable"
+    t["vdc_verdict"] = "stable"
+    return t
+
+
+@pytest.mark.parametrize("kind", ["ratio", "wins"])
+def test_map_cell_with_both_runs_diverged_is_no_comparison(kind):
+    """Regression (stability first in the maps): both runs finished but their dc links ran
+    away — main compared their costs (a win, ratio 0.5); now no value, 'no comparison'."""
+    t = _diverged_table()
+    spec = {"claim": "X", "kind": kind, "metric": "cost", "metrics": ["cost"], "a": "a",
+            "b": "b", "holds_below": 0.8}
+    axes = ["upqc.rating", "t_off", "load"]
+    c = map_cells(t, spec, axes).iloc[0]
+    assert c["verdict"] == "holds" and c["value"] == pytest.approx(0.5)     # both stable
+    t["vdc_verdict"] = "unstable"
+    c = map_cells(t, spec, axes).iloc[0]
+    assert c["verdict"] == "no comparison" and math.isnan(c["value"])
+    assert c["note"] == "both unstable: no comparison"
+    assert "a not stable: dc link unstable" in c["detail"] and "b not stable" in c["detail"]
+    from weakgrid.study.sweep_maps import map_summaries
+    s = map_summaries([{"spec": spec, "cells": map_cells(t, spec, axes), "mark": None,
+                        "axes": tuple(axes)}])[0]
+    assert "no comparison (both runs unstable) at 0.3" in s["region"] and s["n_holds"] == 0
+
+
+@pytest.mark.parametrize("kind", ["ratio", "wins"])
+def test_map_cell_where_only_one_run_diverged(kind):
+    """The claim's run unstable (a lower cost, but undamped): a loss, named; only the
+    baseline unstable: holds without comparing, named."""
+    t = _diverged_table()
+    spec = {"claim": "X", "kind": kind, "metric": "cost", "metrics": ["cost"], "a": "a",
+            "b": "b", "holds_below": 0.8}
+    axes = ["upqc.rating", "t_off", "load"]
+    t.loc[t["controller"] == "a", "speed_verdict"] = "undamped"
+    c = map_cells(t, spec, axes).iloc[0]
+    assert c["verdict"] == "not" and math.isnan(c["value"])
+    assert c["note"] == "a not stable: SG speed undamped"
+    t["speed_verdict"] = "stable"
+    t.loc[t["controller"] == "b", "vdc_verdict"] = "unstable"
+    c = map_cells(t, spec, axes).iloc[0]
+    assert c["verdict"] == "holds" and c["note"] == "b not stable: dc link unstable"
+
+
+def test_no_comparison_cell_is_drawn_with_its_mark(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from weakgrid.study.maps import plot_map
+
+    t = _diverged_table()
+    t["vdc_verdict"] = "unstable"
+    spec = {"claim": "X", "kind": "ratio", "metric": "cost", "a": "a", "b": "b"}
+    cells = map_cells(t, spec, ["upqc.rating", "t_off", "load"])
+    fig = plot_map(cells, "upqc.rating", "t_off", "value", verdict="verdict", note="note",
+                   path=tmp_path / "m.png")
+    texts = [tx.get_text() for ax in fig.axes for tx in ax.texts]
+    assert any("n/c" in tx for tx in texts)
+    assert any(getattr(p, "get_hatch", lambda: None)() for ax in fig.axes for p in ax.patches)
+    assert "both runs unstable: no comparison" in fig.get_suptitle().replace("\n", " ")

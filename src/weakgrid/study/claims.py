@@ -11,16 +11,15 @@ Judges that compare two runs take ``step_unc`` (metric → relative step-halving
 from the sweeps' half-step check; :func:`weakgrid.study.sweep_maps.metric_uncertainty`) and
 apply the one tie rule of :mod:`weakgrid.study.ties`, as the maps do.
 
-**Stability first** (:func:`run_instability`, :func:`stability_gate`): before any judge
-compares two runs' costs, ITAE, overshoot or settling, it asks whether each run is stable. A
-run is *not stable* when it failed (voltage collapse, loss of synchronism, Newton failure, …:
-``failed`` and its ``failure``), when the stability verdict of its SG speed or dc-link voltage
+**Stability first** (:func:`run_instability`, :func:`stability_gate`; the one definition,
+:mod:`weakgrid.study.stability`, which the sweep maps use too): before any judge compares two
+runs' costs, ITAE, overshoot or settling, it asks whether each run is stable. A run is *not
+stable* when it failed (voltage collapse, loss of synchronism, Newton failure, …: ``failed``
+and its ``failure``), or when the stability verdict of its SG speed or dc-link voltage
 (``speed_verdict``, ``vdc_verdict``; :func:`weakgrid.study.metrics.stability_verdict`) is
-``unstable`` or ``undamped``, or when that signal never settles within the run (its
-``speed_settling_s`` / ``vdc_settling_s`` is recorded but undefined: still outside the 2 %
-band at the record's end) and ends more than half its peak deviation from its set-point
-(:data:`RETURN_FRACTION`; a swing still decaying at the end of a short record is stable). A
-metric a run does not record is not evidence either way. Then,
+``unstable`` (growing, or running away from its set-point: a dc link ramping away) or
+``undamped``. A swing still decaying at the end of a short record (outside its 2 % settling
+band) is stable. A metric a run does not record is not evidence either way. Then,
 for a pair (the claim's run a, its baseline b):
 
 * a not stable → ``not``, ``why`` naming it ("c1-high-conv-hji not stable: dc link never
@@ -40,11 +39,10 @@ import fnmatch
 import inspect
 import math
 
-from .failure import failure_kind
+from .stability import run_instability
 from .ties import compare, run_uncertainty, unc_text
 
-__all__ = ["RULES", "STABILITY_NOTE", "judge_all", "judge_claim", "run_instability",
-           "stability_gate"]
+__all__ = ["RULES", "STABILITY_NOTE", "judge_all", "judge_claim", "stability_gate"]
 
 
 def _value(v):
@@ -75,55 +73,14 @@ def _combine(vs):
 
 #: The rule in words, as every report states it (weakgrid.study.engine.DEFINITIONS).
 STABILITY_NOTE = (
-    "Stability first (claim table): before comparing two runs' costs, ITAE, overshoot or "
-    "settling, each run must be stable: finished (no voltage collapse, loss of synchronism, "
-    "Newton failure), SG speed and dc link neither unstable nor undamped (stability verdict), "
-    "and each back at its set-point — a signal still outside its 2 % settling band at the "
-    "end of the run AND more than half its peak deviation away from its set-point never "
-    "settles. A pair where the claim's run is not stable is 'not' (named); where only the "
-    "baseline is not stable, a win without comparing numbers (named); where both are not "
-    "stable, 'not' — both runs unstable: no comparison.")
-
-#: The signals whose stability a run is judged on: metric prefix → name in the verdict text
-#: (the runner's ``<prefix>_verdict``, ``_settling_s``, ``_final_dev_pu``, ``_peak_dev_pu``).
-STABILITY_SIGNALS = (("speed", "SG speed"), ("vdc", "dc link"))
-
-#: A signal that never enters its 2 % settling band counts as not settled only when it also
-#: ends farther than this fraction of its peak deviation from its set-point [–]: a decaying
-#: swing still outside the band at the end of a short record (case 1's 0.5-Hz speed mode in a
-#: 3-s run ends 4–12 % of its peak away) is stable; a dc link that ran away ends at ≈ 100 %.
-RETURN_FRACTION = 0.5
-
-
-def run_instability(r) -> str:
-    """Why run ``r`` (its metrics dict) is not stable, or ``""`` when nothing says so.
-
-    ``"failed: <cause>"`` (:func:`weakgrid.study.failure.failure_kind`) for a run that did not
-    finish; ``"not stable: <signal> unstable|undamped"`` for a stability verdict other than
-    stable; ``"not stable: <signal> never settles within the run"`` for a settling time that
-    is recorded but undefined (None or NaN: outside the 2 % band at the record's end) while
-    the signal ends more than :data:`RETURN_FRACTION` of its peak deviation from its
-    set-point (or those two are not recorded). A signal outside the band but back near its
-    set-point is a swing still decaying, stable. Keys a run does not record are skipped.
-    """
-    r = r or {}
-    if r.get("failed"):
-        return f"failed: {failure_kind(r.get('failure')) or 'failed'}"
-    why = []
-    for key, name in STABILITY_SIGNALS:
-        v = r.get(f"{key}_verdict")
-        if v in ("unstable", "undamped"):
-            why.append(f"{name} {v}")
-        elif f"{key}_settling_s" in r and _value(r[f"{key}_settling_s"]) is None:
-            fin, pk = _value(r.get(f"{key}_final_dev_pu")), _value(r.get(f"{key}_peak_dev_pu"))
-            if fin is None or not pk:
-                why.append(f"{name} never settles within the run")
-            elif abs(fin) > RETURN_FRACTION * pk:
-                why.append(f"{name} never settles within the run (ends {abs(fin):.3g} pu "
-                           f"from its set-point, {abs(fin) / pk * 100:.0f} % of its peak "
-                           "deviation)")
-    return "not stable: " + ", ".join(why) if why else ""
-
+    "Stability first (claim table and sweep maps): before comparing two runs' costs, ITAE, "
+    "overshoot or settling, each run must be stable: finished (no voltage collapse, loss of "
+    "synchronism, Newton failure), SG speed and dc link neither unstable (growing, or running "
+    "away from the set-point: ending at its largest deviation, on one side of the set-point "
+    "and still moving away) nor undamped (stability verdict). A pair where the claim's run "
+    "is not stable is 'not' (named); where only the baseline is not stable, a win without "
+    "comparing numbers (named); where both are not stable, 'not' — both runs unstable: no "
+    "comparison (a map shows such a cell as 'no comparison').")
 
 def stability_gate(m, ia, ib, baseline_unstable="reproduced"):
     """The verdict of a pair decided by stability alone, or None when both runs are stable.
@@ -301,7 +258,7 @@ def less_overshoot_settling(m, pairs, overshoot="speed_backswing_pu",
     Each comparison goes through the tie rule (:mod:`weakgrid.study.ties`): a difference
     within the measured uncertainty (step halving + the metric's sensitivity to its own
     definition, e.g. the settling band) is a tie. Only two stable runs are compared
-    (:func:`stability_gate`): a not stable (failed, unstable, undamped or never settling) is
+    (:func:`stability_gate`): a not stable (failed, unstable or undamped) is
     ``not``, only b not stable a win (``reproduced``), both ``not``.
     """
     out, vs, why = [], [], []

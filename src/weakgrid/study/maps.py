@@ -6,8 +6,9 @@ on the axes as evenly spaced categories (their values as tick labels), each
 cell coloured by the quantity and labelled with its value, and with the claim's
 verdict in that cell as a mark: ``✓`` holds, ``✗`` does not (also: the controller failed where
 its baseline finished), ``=`` tie within the measured uncertainty (its ± printed), ``!`` a run
-failed with nothing to compare (both runs, or the only one). A cell whose device power went
-beyond the UPQC's rating or the line's power carries a marker in its corner
+failed with nothing to compare (both runs, or the only one), ``n/c`` on a grey hatched cell
+no comparison: both runs not stable (:mod:`weakgrid.study.sweep_maps`). A cell whose device
+power went beyond the UPQC's rating or the line's power carries a marker in its corner
 (:data:`DEVICE_MARK`). A cell without a value shows ``–`` and, instead
 of a verdict, why (a ``note``: a run failed, no settling, …). The setting the paper (or the
 shipped study) uses is outlined.
@@ -21,7 +22,10 @@ import numpy as np
 
 __all__ = ["plot_map", "VERDICT_MARKS", "DEVICE_MARK"]
 
-VERDICT_MARKS = {"holds": "✓", "not": "✗", "tie": "=", "failed": "!", None: ""}
+VERDICT_MARKS = {"holds": "✓", "not": "✗", "tie": "=", "failed": "!", "no comparison": "n/c",
+                 None: ""}
+#: hatching of a cell whose two runs are both not stable (verdict "no comparison")
+NO_COMPARISON_HATCH = "///"
 #: corner marker of a cell whose UPQC power exceeded its rating ("rating") or the line's
 #: power ("line"), and its legend
 DEVICE_MARK = {"rating": "S>", "line": "S>L", "rating+line": "S>L"}
@@ -103,13 +107,15 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
     if mark is not None:
         legend += f"outlined: {mark_label}"
     if verdict is not None:
-        legend += ("; " if legend else "") + ("✓ holds (a baseline's failure named)  ✗ does "
-                                              "not (a failure of ours where the baseline "
-                                              "finished counts: named)  = tie: the difference "
+        legend += ("; " if legend else "") + ("✓ holds (a baseline's failure or instability "
+                                              "named)  ✗ does not (a failure of ours, or our "
+                                              "instability, where the baseline is stable "
+                                              "counts: named)  = tie: the difference "
                                               "is within the measured uncertainty ± (step "
                                               "halving + the metric's definition)  ! a run "
-                                              "failed, nothing to compare  – no value (why, "
-                                              "in the cell)")
+                                              "failed, nothing to compare  n/c (grey, "
+                                              "hatched) both runs unstable: no comparison  "
+                                              "– no value (why, in the cell)")
     if device is not None and device in table and any(
             DEVICE_MARK.get(str(v or ""), "") for v in table[device]):
         legend += ("; " if legend else "") + DEVICE_LEGEND
@@ -127,12 +133,15 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
         V = [["" for _ in xs] for _ in ys]
         N = [["" for _ in xs] for _ in ys]
         D = {}
+        NC = []
         for (xv, yv), grp in sub.groupby([x, y], sort=False):
             i, j = ys.index(yv), xs.index(xv)
             Z[i, j] = float(np.nanmean(grp[value].astype(float))) if \
                 np.isfinite(grp[value].astype(float)).any() else np.nan
             if verdict is not None:
                 v0 = grp[verdict].iloc[0]
+                if v0 == "no comparison":
+                    NC.append((i, j))
                 V[i][j] = VERDICT_MARKS.get(None if v0 is None or v0 != v0 else v0, "?")
                 u0 = grp[uncertainty].iloc[0] if uncertainty is not None and \
                     uncertainty in grp else None
@@ -161,6 +170,10 @@ def plot_map(table, x: str, y: str, value: str, *, verdict: str | None = None,
                 ax.text(j, i, txt, ha="center", va="center",
                         fontsize=8 if txt.count("\n") < 2 else 6,
                         color="white" if dark else "black")
+        for i, j in NC:
+            ax.add_patch(Rectangle((j - 0.5, i - 0.5), 1, 1, facecolor="0.85",
+                                   hatch=NO_COMPARISON_HATCH, edgecolor="0.55", lw=0,
+                                   zorder=1.5))
         for (i, j), dm in D.items():
             if dm:
                 ax.text(j + 0.45, i + 0.42, dm, ha="right", va="top", fontsize=6,

@@ -125,24 +125,83 @@ def running_cost(x, u, Q, R) -> np.ndarray:
     return np.cumsum(np.einsum("ki,ij,kj->k", x, Q, x) + np.einsum("ki,ij,kj->k", u, R, u))
 
 
-def stability_verdict(t, y, t_start=0.0, tail=1.0, settled_fraction=0.05) -> str:
-    """'stable' if the oscillation in the last ``tail`` seconds is below
-    ``settled_fraction`` of the peak after ``t_start`` and decaying; 'unstable' if
-    it grows; 'undamped' otherwise (sustained oscillation)."""
+def stability_verdict(t, y, t_start=0.0, tail=1.0, settled_fraction=0.05,
+                      y_set=None) -> str:
+    """The stability of a response after ``t_start``: ``"stable"``, ``"unstable"``,
+    ``"undamped"`` or ``"too short"``.
+
+    Two tests, in this order, with ``tail`` [s] the judging window (the last ``tail``
+    seconds; the ``tail`` before it is the previous window) and ``D = max |y − y_set|`` after
+    ``t_start`` the peak deviation from the set-point (the signal's unit, e.g. pu):
+
+    1. **runaway** (a monotonic divergence, e.g. a dc link ramping away) → ``"unstable"``
+       when the signal ends at its largest deviation from the set-point
+       (``|y_end − y_set| ≥ (1 − settled_fraction)·D``), stays on one side of the set-point
+       throughout the last window (it does not cross it: no swing about it), and its mean
+       distance from the set-point over the last window exceeds that over the previous one
+       by more than ``settled_fraction·D`` (it is still moving away). A decaying swing ends
+       far below its peak; a sustained oscillation about the set-point crosses it within
+       any window longer than half its period; a signal settled at a new operating point
+       off the set-point (e.g. a droop frequency) has a steady mean distance. A signal still
+       drifting away at the record's end towards an operating point it has not reached is
+       judged unstable too: the record does not show it stops (lengthen the run).
+    2. **oscillation**, measured about the signal's own final value (the mean of the last
+       window): ``"stable"`` if its amplitude in the last window is ≤ ``settled_fraction``
+       of its peak or decays (< 0.8 × the previous window's); ``"unstable"`` if it grows
+       (> 1.2 ×); ``"undamped"`` otherwise (a sustained oscillation).
+
+    Both tests see a mode whose period is at most ``2·tail`` (≥ 0.5 Hz with the default
+    1 s); a slower swing can look like a runaway or a growth within one window. A record
+    with non-finite samples is ``"unstable"``; a record that ends within ``tail`` of
+    ``t_start`` (no previous window to compare with, e.g. a 1-s sweep run with its fault
+    cleared at 0.25 s) is ``"too short"``: neither test can tell (it was ``"undamped"``
+    whatever the signal did).
+
+    Parameters
+    ----------
+    t, y : array_like
+        Time [s] and the signal (any unit; e.g. SG speed or dc-link voltage in pu).
+    t_start : float
+        Judge from this time [s] on (e.g. the last disturbance's end).
+    tail : float
+        Window length [s].
+    settled_fraction : float
+        Fraction of the peak deviation [–] below which a swing is settled, and the growth of
+        the mean distance from the set-point that counts as moving away.
+    y_set : float, optional
+        The set-point (the signal's unit; e.g. its pre-disturbance value). Default: ``y`` at
+        the first sample of the record (pass it when the record starts after the
+        disturbance).
+    """
     t, y = _check(t, y)
     sel = t >= t_start
     tt, yy = t[sel], y[sel]
     if not np.all(np.isfinite(yy)):
         return "unstable"
+    ys = float(y[0]) if y_set is None else float(y_set)
+    late_w = tt >= tt[-1] - tail
+    prev_w = (tt >= tt[-1] - 2 * tail) & ~late_w
+    if not prev_w.any():
+        return "too short"
+    # 1. runaway: ends at its largest deviation, one-sided, still moving away
+    d = yy - ys
+    big = np.abs(d).max()
+    if big > 0:
+        dl = d[late_w]
+        one_sided = np.all(dl > 0) or np.all(dl < 0)
+        growth = np.abs(dl).mean() - np.abs(d[prev_w]).mean()
+        if (abs(d[-1]) >= (1 - settled_fraction) * big and one_sided
+                and growth > settled_fraction * big):
+            return "unstable"
+    # 2. oscillation about its own final value
     yf = _final(tt, yy, tail)
     e = np.abs(yy - yf)
     peak = e.max()
     if peak == 0:
         return "stable"
-    late = e[tt >= tt[-1] - tail]
-    prev = e[(tt >= tt[-1] - 2 * tail) & (tt < tt[-1] - tail)]
+    late = e[late_w]
     amp_late = late.max()
-    amp_prev = prev.max() if prev.size else peak
+    amp_prev = e[prev_w].max()
     if amp_late <= settled_fraction * peak:
         return "stable"
     if amp_late > 1.2 * amp_prev:

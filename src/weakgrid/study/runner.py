@@ -553,7 +553,7 @@ def finish_run(prep: Prepared, res, wall: float) -> RunRecord:
             metrics[f"{label}_settling_s"] = settling_time(t[ok], y[ok], after, y_final=y[0])
             metrics[f"{label}_itae"] = itae(t[ok], y[ok], after, y_final=y[0])
             metrics[f"{label}_final_dev_pu"] = float(y[ok][-1] - y[0])  # back to set-point?
-            metrics[f"{label}_verdict"] = stability_verdict(t[ok], y[ok], after) \
+            metrics[f"{label}_verdict"] = stability_verdict(t[ok], y[ok], after, y_set=y[0]) \
                 if res.failure is None else "unstable"
             metrics.update(_definition_spreads(label, t[ok], y[ok], after, y[0], metrics))
         else:

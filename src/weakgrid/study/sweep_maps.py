@@ -7,12 +7,10 @@ table (a row per run; :mod:`weakgrid.study.sweep`)::
     id                         the map's own id when a claim has several maps [claim]
     kind = "ratio"             metric of controller a / of b; holds if ≤ holds_below, a tie
                                if a is within the runs' uncertainty of holds_below·b
-                               (or b failed while a finished: no value, holds, b's cause noted;
-                               a failed while b finished: a loss, not, a's cause noted)
+                               (stability first, below: only two stable runs are compared)
     kind = "value"             metric of controller a; holds if within holds_within = [lo, hi]
                                (no rule: the map only shows the quantity)
-    kind = "wins"              a smaller than b on every one of ``metrics`` (or b failed;
-                               a failed while b finished: not)
+    kind = "wins"              a smaller than b on every one of ``metrics`` (stability first)
     kind = "stable"            a's speed verdict "stable" while b's is not (or b failed)
     x, y, facet                table columns (default: the sweep's first three axes)
 
@@ -23,13 +21,20 @@ definition (``<metric>_def_unc``, recorded with every run: the settling band 1.5
 The step-halving part is measured by running the ``[sweep.dt_check]`` points again at half the
 integration step: ``|m(T) − m(T/2)|`` relative to ``|m(T)|``, per load level and fault severity
 (the row of the map), applied to every cell of that row (a row without a check takes the
-largest measured at its load level). Losses are counted: where controller a failed and the
-baseline b finished, the cell is ``not`` with the note "a failed: cause"; where b failed and a
-finished, ``holds`` with "b failed: cause"; where both failed (or a ``value`` map's run
-failed), the cell is marked failed, its detail naming the cause (voltage collapse, loss of
-synchronism, …; :mod:`weakgrid.study.failure`). A cell without a value gets no verdict but a
-``note`` saying why: a run failed, or the metric is undefined for a run that finished (e.g. the
-speed did not settle inside the run: no settling time).
+largest measured at its load level).
+
+Stability first (ratio, wins; as the claim table, with its one definition of a stable run,
+:func:`weakgrid.study.stability.run_instability`: finished, SG speed and dc link neither
+unstable — growing or running away from the set-point — nor undamped): only two stable runs
+are compared. Where controller a is not stable and the baseline b is, the cell is a loss,
+``not``, with the note "a failed: cause" or "a not stable: dc link unstable"; where only b is
+not stable, ``holds`` without a value ("b failed: cause", …); where both are not stable, the
+cell is ``no comparison`` (its own mark and hatching; the numbers of two diverged runs say
+nothing about the claim), except where both failed (or a ``value`` map's run failed): marked
+failed, its detail naming the cause (voltage collapse, loss of synchronism, …;
+:mod:`weakgrid.study.failure`). A not stable run's metric gives its cell no value. Any other
+cell without a value gets no verdict but a ``note`` saying why: the metric is undefined for a
+run that finished (e.g. the speed did not settle inside the run: no settling time).
 """
 
 from __future__ import annotations
@@ -41,6 +46,7 @@ import pandas as pd
 from ..game.errors import ParameterError
 from .failure import failure_kind
 from .maps import plot_map
+from .stability import run_failed, run_instability
 from .ties import compare, run_uncertainty
 
 __all__ = ["map_cells", "draw_maps", "map_summaries", "MAP_KINDS"]
@@ -110,11 +116,37 @@ def _why_missing(metric, who) -> str:
     return f"{who}: no {metric}"
 
 
-def _lost(a, ra):
-    """A cell where controller ``a`` failed while the baseline finished: counted as a loss,
-    ``not`` (``verdict, value, note, detail``)."""
-    kind = failure_kind(ra.get("failure")) or "failed"
-    return "not", math.nan, f"{a} failed: {kind}", f"{a} failed: {ra.get('failure', '')}"[:120]
+#: The verdict of a cell where both runs are not stable (:func:`_stability_gate`).
+NO_COMPARISON = "no comparison"
+
+
+def _stability_gate(a, ra, b, rb, fa, fb):
+    """Stability first, as the claim table (:func:`weakgrid.study.claims.stability_gate`; one
+    definition of stable, :func:`weakgrid.study.stability.run_instability`): ``(verdict,
+    value, note, detail)`` of a ratio/wins cell decided by its runs' stability, or None when
+    both ran stable (compare their numbers).
+
+    Both failed (or a failed without a baseline): ``failed``. Otherwise a (the claim's run)
+    not stable — failed where b finished, or finished but unstable/undamped — is a loss,
+    ``not`` ("a failed: voltage collapse", "a not stable: dc link unstable"); only b not
+    stable: ``holds`` without a value ("b failed: …"); both not stable: ``no comparison``
+    (the numbers of two diverged runs say nothing about the claim). A not stable run's
+    metric gives the cell no value.
+    """
+    if fa and (rb is None or fb):
+        return "failed", math.nan, f"{a} & {b} failed" if rb is not None else f"{a} failed", ""
+    wa = run_instability(ra)
+    wb = run_instability(rb) if rb is not None else ""
+    full = {c: f"{c} failed: {r.get('failure', '')}" if run_failed(r) else f"{c} {w}"
+            for c, w, r in ((a, wa, ra), (b, wb, rb)) if w}
+    if wa and wb:
+        return (NO_COMPARISON, math.nan, "both unstable: no comparison",
+                "; ".join(full.values())[:160])
+    if wa:
+        return "not", math.nan, f"{a} {wa}", full[a][:120]
+    if wb:
+        return "holds", math.nan, f"{b} {wb}", full[b][:120]
+    return None
 
 
 def _unc(by_row, rk):
@@ -156,7 +188,7 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
         rb = rb.iloc[0] if rb is not None and not rb.empty else None
         fa = ra["status"] != "ok"
         fb = rb is not None and rb["status"] != "ok"
-        val, verdict, u, detail, note = math.nan, None, math.nan, "", ""
+        val, verdict, u, detail, note, gate = math.nan, None, math.nan, "", "", None
         failed = [c for c, f in ((a, fa), (b, fb)) if f]
         if failed:
             note = " & ".join(failed) + " failed"
@@ -175,14 +207,9 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
             val = va / vb if vb else math.nan
             ua = run_uncertainty(ra, m, _unc(unc[(m, a)], rk))
             ub = run_uncertainty(rb, m, _unc(unc[(m, b)], rk)) if rb is not None else 0.0
-            if fa and rb is not None and not fb:    # ours lost the run, the baseline did not
-                verdict, val, note, detail = _lost(a, ra)
-            elif fa:
-                verdict = "failed"
-            elif fb:    # only the baseline lost the run (e.g. LQR out of step): a holds, no value
-                val = math.nan
-                verdict, detail = "holds", f"{b} failed: {rb.get('failure', '')}"[:120]
-                note = f"{b} failed: {failure_kind(rb.get('failure')) or 'failed'}"
+            gate = _stability_gate(a, ra, b, rb, fa, fb)
+            if gate:
+                verdict, val, note, detail = gate
             elif not math.isfinite(val):      # a metric undefined for a finished run
                 note = _why_missing(m, [c for c, v in ((a, va), (b, vb))
                                         if not math.isfinite(v)] or [f"{a}/{b}"])
@@ -199,13 +226,9 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
             va0 = _num(ra.get(m0))
             vb0 = _num(rb.get(m0)) if rb is not None else math.nan
             val = va0 / vb0 if vb0 and not fb else math.nan
-            if fa and rb is not None and not fb:
-                verdict, val, note, detail = _lost(a, ra)
-            elif fa:
-                verdict = "failed"
-            elif fb:
-                verdict, detail = "holds", f"{b} failed: {rb.get('failure', '')}"[:120]
-                note = f"{b} failed: {failure_kind(rb.get('failure')) or 'failed'}"
+            gate = _stability_gate(a, ra, b, rb, fa, fb)
+            if gate:
+                verdict, val, note, detail = gate
             else:
                 res, us = [], []
                 for m in metrics:
@@ -231,7 +254,7 @@ def map_cells(table: pd.DataFrame, spec: dict, axes) -> pd.DataFrame:
             verdict = "holds" if sa == "stable" and sb in ("unstable", "undamped") else "not"
             if not fa and not math.isfinite(val):   # the verdict is on stability, not on val
                 note = _why_missing(spec.get("metric", "speed_settling_s"), [a])
-        if kind == "wins" and not fa and not math.isfinite(val) and not fb:
+        if kind == "wins" and not gate and not math.isfinite(val):
             verdict = None      # no value: no verdict, the reason instead
             note = _why_missing(metrics[0], [c for c, v in ((a, va0), (b, vb0))
                                              if not math.isfinite(v)] or [f"{a}/{b}"])
@@ -366,10 +389,15 @@ def map_summaries(maps) -> list[dict]:
                         f"{v:g}" + (f" (±{u * 100:.2g} %)" if isinstance(u, float) and math.isfinite(u)
                                     else "") for v, u in zip(ties, tr["uncertainty"]))
                 lost = row[(row["verdict"] == "not") & row["note"].fillna("").str.contains(
-                    " failed:")] if "note" in row else row.iloc[:0]
+                    " failed:| not stable:")] if "note" in row else row.iloc[:0]
                 if not lost.empty:
                     txt += "; not at " + ", ".join(f"{v:g} ({n})" for v, n in
                                                    zip(lost[x], lost["note"]))
+                nc = row[row["verdict"] == NO_COMPARISON]
+                if not nc.empty:
+                    txt += "; no comparison (both runs unstable) at " + ", ".join(
+                        f"{v:g}" + (f" ({d})" if d else "") for v, d in
+                        zip(nc[x], nc["detail"] if "detail" in nc else [""] * len(nc)))
                 if fails:
                     fr = row[row["verdict"] == "failed"]
                     txt += "; a run failed at " + ", ".join(
