@@ -315,6 +315,7 @@ class BatchSimulator:
         nb = system.nb
         self.Y = xp.empty((self.B, 2 * nb, 2 * nb))
         self._ynet = [None] * self.B
+        self._alg_A = [None] * self.B     # (the member's algebraic factor, its J_yy) each
         self.timing = dict.fromkeys(TIMED, 0.0)
         self.steps = 0
         self.halved = 0
@@ -372,40 +373,57 @@ class BatchSimulator:
     # ------------------------------------------------------------------ solves
     def _alg_chord(self, t, Z, rows):
         """Chord iteration on the network variables of members ``rows`` (each member's own
-        algebraic LU), as :meth:`Simulator._alg_chord`; returns ``{k: (z, F, (ctx, row))}`` of
-        the members that converged (the others diverged or stalled)."""
+        algebraic matrix, :meth:`_alg_solve`), as :meth:`Simulator._alg_chord`; returns
+        ``{k: (z, F, (ctx, row))}`` of the members that converged (the others diverged or
+        stalled)."""
         nx = self.nx
         done = {}
-        live = list(range(len(rows)))
-        prev = [math.inf] * len(rows)
-        grow = [0] * len(rows)
-        evals = [0] * len(rows)
+        n = len(rows)
+        live = xp.arange(n)
+        prev = xp.full(n, math.inf)
+        grow = xp.zeros(n, dtype=int)
+        tol = xp.asarray([self.sims[k].tol for k in rows])
         Z = Z.copy()
-        for _ in range(30):
-            if not live:
+        for it in range(30):
+            if not len(live):
                 break
-            idx = [rows[j] for j in live]
+            idx = [rows[j] for j in live.tolist()]
             F, ctx = self.residual(t, Z[live], idx)
-            keep = []
-            for i, j in enumerate(live):
-                sim = self.sims[rows[j]]
-                evals[j] += 1
-                dy = sim._alg_lu_get().solve(F[i, nx:])
-                nrm = float(xp.max(xp.abs(dy)))
-                if not math.isfinite(nrm):
-                    continue
-                if nrm < sim.tol:
-                    done[rows[j]] = (Z[j].copy(), F[i].copy(), (ctx, i))
-                    sim.stats["evals"] += evals[j]   # a member that falls back counts its own
-                    continue
-                grow[j] = grow[j] + 1 if nrm > 0.9 * prev[j] else 0
-                if grow[j] >= 2:
-                    continue
-                prev[j] = nrm
-                Z[j, nx:] -= dy
-                keep.append(j)
+            dy = self._alg_solve(idx, F[:, nx:])
+            nrm = xp.abs(dy).max(axis=1)
+            fin = xp.isfinite(nrm)
+            conv = fin & (nrm < tol[live])
+            for i in xp.nonzero(conv)[0].tolist():
+                j = int(live[i])
+                done[rows[j]] = (Z[j].copy(), F[i].copy(), (ctx, i))
+                self.sims[rows[j]].stats["evals"] += it + 1   # a member that falls back counts its own
+            g = xp.where(nrm > 0.9 * prev[live], grow[live] + 1, 0)
+            go = fin & ~conv & (g < 2)
+            grow[live] = g
+            keep = live[go]
+            prev[keep] = nrm[go]
+            Z[keep, nx:] -= dy[go]
             live = keep
         return done
+
+    def _alg_solve(self, ks, R):
+        """``A_k x = R[i]`` for members ``k = ks[i]``, ``A_k`` the member's algebraic block
+        ``J_yy`` (factorized when its own :meth:`Simulator._alg_lu_get` refactorizes): one
+        stacked LAPACK ``gesv`` for all of them — ``getrf`` and ``getrs``, the arithmetic of
+        the member's factor and solve alone, bit for bit (tests/sim/test_batch.py); a singular
+        block (no ``gesv``) falls back to the members' own factors (NaN/inf, as alone)."""
+        A = self._alg_A
+        lus = []
+        for k in ks:
+            sim = self.sims[k]
+            lu = sim._alg_lu_get()
+            if A[k] is None or A[k][0] is not lu:
+                A[k] = (lu, sim.linsolver._full()[self.nx:, self.nx:])
+            lus.append(lu)
+        try:
+            return xp.linalg.solve(xp.stack([A[k][1] for k in ks]), R[..., None])[..., 0]
+        except np.linalg.LinAlgError:
+            return xp.stack([lu.solve(r) for lu, r in zip(lus, R)])
 
     def _solve(self, lus, idx, R):
         """Chord solves ``M_j x = R[i]`` for ``j = idx[i]`` with each member's LU factors (LAPACK
@@ -888,8 +906,12 @@ class BatchSimulator:
             mk, mc, M = self._measure(t, [ks[i] for i in on], [cs[i] for i in on], fail)
             if mk:
                 try:
-                    U = xp.asarray(mc[0].K(M), dtype=float)
-                    if U.ndim != 2 or U.shape[0] != len(mk):
+                    U = mc[0].call_rows(mc, M)
+                except Exception:    # a member's own error: each called alone, as in its run
+                    U, mk, mc, M = self._call_alone(t, mk, mc, M, changed, fail)
+                try:
+                    U = xp.asarray(U, dtype=float)
+                    if mk and (U.ndim != 2 or U.shape[0] != len(mk)):
                         raise ValueError(f"a batched policy returned {U.shape[0] if U.ndim else 0} rows "
                                          f"for {len(mk)} (an array of shape {U.shape})")
                 except Exception as exc:
@@ -913,6 +935,31 @@ class BatchSimulator:
         if hk:
             for k, ch in zip(hk, self._hold(t, hk, hc, hu)):
                 changed[k] |= ch
+
+    def _call_alone(self, t, ks, cs, M, changed, fail):
+        """The policies of controllers ``cs`` (members ``ks``) called one by one on their rows
+        of ``M`` (after the batched call raised): a member whose policy raises fails alone, with
+        the message of its run alone. Returns the outputs and the members, controllers and
+        measurements left."""
+        U, mk, mc, mm = [], [], [], []
+        for k, c, m in zip(ks, cs, M):
+            try:
+                try:
+                    u = c.K(m)
+                except Exception as exc:
+                    raise SimulationError(t, "controller", f"'{c.name}' raised {exc!r}") from exc
+                u = c.check(t, u, m)
+            except SimulationError as exc:
+                fail(k, exc)
+                del changed[k]
+                continue
+            U.append(u)
+            mk.append(k)
+            mc.append(c)
+            mm.append(m)
+        if not mk:
+            return xp.zeros((0, 0)), mk, mc, M[:0]
+        return xp.stack(U), mk, mc, xp.stack(mm)
 
     def _measure(self, t, ks, cs, fail):
         """The measurements of controllers ``cs`` of members ``ks`` at their accepted points:
