@@ -19,12 +19,17 @@ rounding (the bounded saddle point's vectorized iteration,
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import pickle
+import types
 
 import numpy as np
 
 __all__ = ["StudyLaw", "policy_key"]
+
+_FUNCTIONS = (types.FunctionType, types.BuiltinFunctionType, types.MethodType,
+              functools.partial)
 
 
 def _law_state(obj):
@@ -39,15 +44,18 @@ def policy_key(policy) -> str:
     """A content key of ``policy`` (``u = policy(x)``): equal keys compute the same outputs.
 
     ``"idle"`` for None; for a bound method (e.g. ``GameController.control``) or a policy
-    object, the SHA-256 of the pickled class, method and state (:func:`_law_state`); for
-    anything that cannot be pickled (a closure), its identity (shared only by the same object).
+    object, the SHA-256 of the pickled class, method and state (:func:`_law_state`); for a
+    function (its law is its code and closure) or anything that cannot be pickled, its
+    identity (shared only by the same object, alive while its runs are).
     """
     if policy is None:
         return "idle"
     owner, func = getattr(policy, "__self__", None), getattr(policy, "__func__", None)
-    if owner is not None and func is not None:
+    if owner is not None and func is not None and hasattr(owner, "__dict__"):
         content = (type(owner).__module__, type(owner).__qualname__, func.__name__,
                    _law_state(owner))
+    elif isinstance(policy, _FUNCTIONS) or not hasattr(policy, "__dict__"):
+        return f"object:{id(policy)}"     # a function's law is its code and closure
     else:
         content = (type(policy).__module__, type(policy).__qualname__, _law_state(policy))
     try:
