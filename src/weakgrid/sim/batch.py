@@ -862,9 +862,10 @@ class BatchSimulator:
 
     def _sample(self, t, rows, ctls, fail):
         """Take the due samples of members ``rows``; ``{k: changed}``. The ``j``-th controllers
-        of the members that share one ``K`` declared ``batched`` are sampled together
-        (:meth:`_sample_group`: one measurement, one call of ``K``, one hold for all of them);
-        the others one by one (:meth:`DigitalController.sample`)."""
+        of the members declared ``batched`` are sampled together (:meth:`_sample_groups`:
+        those that measure the same signals in one measurement and one hold, those that
+        share a law — :meth:`DigitalController.batch_key` — in one call of it); the others
+        one by one (:meth:`DigitalController.sample`)."""
         t0 = time.perf_counter()
         changed = {k: False for k in rows}
         for j in range(max((len(ctls[k]) for k in rows), default=0)):
@@ -886,55 +887,80 @@ class BatchSimulator:
                 except SimulationError as exc:
                     fail(k, exc)
                     del changed[k]
-            for ks in groups.values():
-                self._sample_group(t, ks, [ctls[k][j] for k in ks], changed, fail)
+            merged = {}    # the law groups that measure the same signals: measured together
+            for key, ks in groups.items():
+                cs = [ctls[k][j] for k in ks]
+                mkey = getattr(cs[0].measure, "key", None)
+                merged.setdefault(("signals", mkey) if mkey is not None else ("law", key),
+                                  []).append((ks, cs))
+            for parts in merged.values():
+                self._sample_groups(t, parts, changed, fail)
         self.timing["events"] += time.perf_counter() - t0
         return changed
 
-    def _sample_group(self, t, ks, cs, changed, fail):
-        """Sample the controllers ``cs`` of members ``ks`` (one each, sharing a batched ``K``):
-        the measurements of the enabled ones stacked (:meth:`_measure`), ``K`` called once on
-        them, each output checked, and every output (the bypass of the disabled) held at once
-        (:meth:`_hold`); each member's samples equal its run alone."""
-        on = [i for i, c in enumerate(cs) if c.active(t)]
+    def _sample_groups(self, t, parts, changed, fail):
+        """Sample the controllers ``cs`` of members ``ks`` for each ``(ks, cs)`` of ``parts``
+        (one law each, all measuring the same signals): the measurements of the enabled
+        ones stacked (:meth:`_measure`), each law called once on its rows (:meth:`_call_law`),
+        and every output (the bypass of the disabled) held at once (:meth:`_hold`); each
+        member's samples equal its run alone."""
         hk, hc, hu = [], [], []
-        for i in sorted(set(range(len(cs))) - set(on)):
-            hk.append(ks[i])
-            hc.append(cs[i])
-            hu.append(cs[i].bypass)
-        if on:
-            mk, mc, M = self._measure(t, [ks[i] for i in on], [cs[i] for i in on], fail)
-            if mk:
-                try:
-                    U = mc[0].call_rows(mc, M)
-                except Exception:    # a member's own error: each called alone, as in its run
-                    U, mk, mc, M = self._call_alone(t, mk, mc, M, changed, fail)
-                try:
-                    U = xp.asarray(U, dtype=float)
-                    if mk and (U.ndim != 2 or U.shape[0] != len(mk)):
-                        raise ValueError(f"a batched policy returned {U.shape[0] if U.ndim else 0} rows "
-                                         f"for {len(mk)} (an array of shape {U.shape})")
-                except Exception as exc:
-                    for k, c in zip(mk, mc):
-                        fail(k, SimulationError(t, "controller", f"'{c.name}' raised {exc!r}"))
-                        del changed[k]
-                    mk = []
-                ok = (xp.isfinite(U).all(axis=1) if mk and U.shape[1] == mc[0].target.size
-                      else xp.zeros(len(mk), dtype=bool))
-                for i, (k, c) in enumerate(zip(mk, mc)):
-                    if not ok[i]:    # its own message (as its run alone)
-                        try:
-                            c.check(t, U[i], M[i])
-                        except SimulationError as exc:
-                            fail(k, exc)
-                            del changed[k]
-                            continue
+        on_k, on_c, law = [], [], {}
+        for g, (ks, cs) in enumerate(parts):
+            for k, c in zip(ks, cs):
+                if c.active(t):
+                    on_k.append(k)
+                    on_c.append(c)
+                    law[k] = g
+                else:
                     hk.append(k)
                     hc.append(c)
-                    hu.append(U[i])
+                    hu.append(c.bypass)
+        if on_k:
+            mk, mc, M = self._measure(t, on_k, on_c, fail)
+            rows = {}
+            for i, k in enumerate(mk):
+                rows.setdefault(law[k], []).append(i)
+            for pos in rows.values():
+                self._call_law(t, [mk[i] for i in pos], [mc[i] for i in pos], M[pos], changed,
+                               fail, (hk, hc, hu))
         if hk:
             for k, ch in zip(hk, self._hold(t, hk, hc, hu)):
                 changed[k] |= ch
+
+    def _call_law(self, t, mk, mc, M, changed, fail, held):
+        """The outputs of the controllers ``mc`` (members ``mk``, one law) at their
+        measurements ``M``: one call (:meth:`DigitalController.call_rows`; if it raises, each
+        member alone, :meth:`_call_alone`), each output checked (a bad one fails its member
+        with its run alone's message); the good ones appended to ``held`` (members,
+        controllers, outputs)."""
+        try:
+            U = mc[0].call_rows(mc, M)
+        except Exception:    # a member's own error: each called alone, as in its run
+            U, mk, mc, M = self._call_alone(t, mk, mc, M, changed, fail)
+        try:
+            U = xp.asarray(U, dtype=float)
+            if mk and (U.ndim != 2 or U.shape[0] != len(mk)):
+                raise ValueError(f"a batched policy returned {U.shape[0] if U.ndim else 0} rows "
+                                 f"for {len(mk)} (an array of shape {U.shape})")
+        except Exception as exc:
+            for k, c in zip(mk, mc):
+                fail(k, SimulationError(t, "controller", f"'{c.name}' raised {exc!r}"))
+                del changed[k]
+            return
+        ok = (xp.isfinite(U).all(axis=1) if mk and U.shape[1] == mc[0].target.size
+              else xp.zeros(len(mk), dtype=bool))
+        for i, (k, c) in enumerate(zip(mk, mc)):
+            if not ok[i]:    # its own message (as its run alone)
+                try:
+                    c.check(t, U[i], M[i])
+                except SimulationError as exc:
+                    fail(k, exc)
+                    del changed[k]
+                    continue
+            held[0].append(k)
+            held[1].append(c)
+            held[2].append(U[i])
 
     def _call_alone(self, t, ks, cs, M, changed, fail):
         """The policies of controllers ``cs`` (members ``ks``) called one by one on their rows
