@@ -105,7 +105,8 @@ class StudyLaw:
     def rows(laws, Y):
         """``laws[i](Y[i])`` for every row of the measured signals ``Y`` ``(n, p)`` (the laws
         share :meth:`batch_key`): the state maps in one array operation, the policy of
-        ``laws[0]`` once on the ``(n, 2)`` design states; each law logs its row. Returns the
+        ``laws[0]`` once on the ``(n, 2)`` design states (one row, or a policy known only by
+        its identity: called on each row, as alone); each law logs its row. Returns the
         ``(n, 2)`` outputs."""
         Y = np.asarray(Y, float)
         maps = [law.state_map for law in laws]
@@ -116,7 +117,14 @@ class StudyLaw:
             X = np.stack([mp(y) for mp, y in zip(maps, Y)])
         pol = laws[0].policy
         n = len(laws)
-        U = np.zeros((n, 2)) if pol is None else np.asarray(pol(X), float).reshape(n, 2)
+        if pol is None:
+            U = np.zeros((n, 2))
+        elif n == 1 or laws[0].key.startswith("object:"):
+            # one row: the run's own call (the same arithmetic as alone); a policy known only
+            # by its identity (a function) is not assumed to take rows
+            U = np.stack([np.asarray(pol(x), float).reshape(2) for x in X])
+        else:
+            U = np.asarray(pol(X), float).reshape(n, 2)
         for law, y, x in zip(laws, Y, X):
             law.ys.append(y.copy())
             law.xs.append(x.copy())
