@@ -341,3 +341,83 @@ def test_a_batched_policy_with_bad_outputs_fails_each_member_as_its_run_alone(K)
     for a, b in zip(alone, got):
         assert a.failure is not None and a.failure.cause == "controller"
         _same(a, b)
+
+
+class _RaisingPolicy(_VectorPolicy):
+    """``_VectorPolicy`` that raises when a design angle passes ``limit`` [rad] (one member's
+    run reaches it, the others' do not)."""
+
+    limit = 0.0027
+
+    def __call__(self, m):
+        if np.any(np.asarray(m, dtype=float)[..., 0] > self.limit):
+            raise ValueError("design angle out of the policy's range")
+        return super().__call__(m)
+
+
+def test_a_batched_policy_raising_for_one_member_fails_that_member_alone():
+    """The batched call raises because of one member's measurement: the members are then
+    called one by one, so that only that member fails (its run alone's failure: cause, time,
+    message) and the others go on as alone."""
+    s = build_gti_upqc_sg("reduced")
+
+    def scen(K, batched):
+        return [{"events": [Fault(3, 0.2, 0.25, xf=x)],
+                 "controllers": [DigitalController(K, DT, gti_design_states("PV"), UPQCTarget("U"),
+                                                   enable=[(0.25, 0.6)], batched=batched)]}
+                for x in (0.05, 0.1)]
+    alone = [_alone(s, sc, 0.6, dt=DT, tol=1e-6) for sc in scen(_RaisingPolicy(), False)]
+    assert alone[0].failure is not None and alone[0].failure.cause == "controller"
+    assert "out of the policy's range" in str(alone[0].failure) and alone[1].ok
+    got = simulate_batch(s, scen(_RaisingPolicy(), True), 0.6, dt=DT, tol=1e-6)
+    for a, b in zip(alone, got):
+        _same(a, b)
+
+
+class _Law:
+    """A policy object per member computing one law (``batch_key``: its gain), evaluated for
+    the batch through ``rows`` with each member's own log — the protocol of
+    :class:`weakgrid.study.law.StudyLaw`."""
+
+    calls = []
+
+    def __init__(self, gain):
+        self.gain, self.log = gain, []
+
+    def __call__(self, m):
+        self.log.append(np.array(m, dtype=float))
+        return self.gain * np.asarray(_K(m), dtype=float)
+
+    def batch_key(self):
+        return "law", self.gain
+
+    @staticmethod
+    def rows(laws, M):
+        _Law.calls.append(len(laws))
+        for law, m in zip(laws, M):
+            law.log.append(np.array(m, dtype=float))
+        return laws[0].gain * _VectorPolicy()(M)
+
+
+def test_policy_objects_with_one_batch_key_are_sampled_in_one_call():
+    """Members with their own policy objects of one law (equal ``batch_key``) are sampled by
+    one ``rows`` call per instant; another law (gain) is its own group; every member's
+    samples and log equal its run alone."""
+    s = build_gti_upqc_sg("reduced")
+    gains = (1.0, 1.0, 0.5, 1.0)
+
+    def scen():
+        return [{"events": [Fault(3, 0.2, 0.25, xf=x)],
+                 "controllers": [DigitalController(_Law(g), DT, gti_design_states("PV"), UPQCTarget("U"),
+                                                   enable=[(0.25, 0.6)], batched=True)]}
+                for g, x in zip(gains, (0.05, 0.08, 0.1, 0.1))]
+    alone_sc, sc = scen(), scen()
+    alone = [_alone(s, c, 0.6, dt=DT, tol=1e-6) for c in alone_sc]
+    _Law.calls = []
+    got = simulate_batch(s, sc, 0.6, dt=DT, tol=1e-6)
+    assert sorted(set(_Law.calls)) == [1, 3]       # the three of gain 1 together, the other alone
+    assert _Law.calls.count(3) >= round((0.6 - 0.25) / DT) - 1
+    for a, b, ca, cb in zip(alone, got, alone_sc, sc):
+        _same(a, b)
+        la, lb = ca["controllers"][0].K.log, cb["controllers"][0].K.log
+        assert len(la) == len(lb) and np.array_equal(np.array(la), np.array(lb))

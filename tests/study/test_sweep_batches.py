@@ -176,3 +176,60 @@ def test_a_batch_whose_simulator_raises_runs_its_members_one_by_one(monkeypatch)
                 assert g[k] == pytest.approx(v, rel=1e-12, abs=0, nan_ok=True), k
             else:
                 assert g[k] == v, k
+
+
+def test_runs_of_one_controller_share_one_policy_call_per_sample(tmp_path, monkeypatch):
+    """In each batch (one load) the two ratings' runs of the HJI controller (one trained
+    controller: designed at high load for both) and of (29) (a policy object per run, the same
+    parameters) have equal law keys (the policy's content, not the controller's name), so the
+    batch samples each pair with one policy call; the table equals the scalar sweep's."""
+    from weakgrid.study.law import StudyLaw
+
+    d = copy.deepcopy(load_study("case1-weak-grid").data)
+    d["sweep"].update(controllers=["hji", "nonlinear-29"],
+                      quick={"axes": {"upqc.rating": [0.15, 0.6],
+                                      "scenarios.c1-high-conv.load": ["high", "low"]},
+                             "t_end": 0.4})
+    d["sweep"].pop("maps", None)
+    st = study_from_dict(d)
+    scalar = run_study_sweep(st, tmp_path / "scalar", quick=True, workers=0, progress=False,
+                             batched=False)
+    sizes = []
+    real = StudyLaw.rows
+
+    def counting(laws, Y):
+        sizes.append(len(laws))
+        assert len({law.key for law in laws}) == 1
+        return real(laws, Y)
+
+    monkeypatch.setattr(StudyLaw, "rows", staticmethod(counting))
+    batched = run_study_sweep(st, tmp_path / "batched", quick=True, workers=0, progress=False,
+                              batched=True)
+    assert len(scalar) == 8 and (scalar["status"] != "failed").all()
+    assert sizes and set(sizes) == {2}
+    pd.testing.assert_frame_equal(scalar.drop(columns=TIMES), batched.drop(columns=TIMES),
+                                  rtol=1e-8)
+
+
+def test_the_policy_key_is_the_content_of_the_policy():
+    """Equal laws (a copy of a trained controller without its history; (29) built twice) have
+    equal keys; another weight, gain or kind of policy, another key; an idle UPQC is "idle"."""
+    import numpy as np
+
+    from weakgrid.models import NonlinearInitialPolicy
+    from weakgrid.study.law import policy_key
+    from weakgrid.study.sweep import prepare_point
+
+    st = load_study("case1-weak-grid")
+    pt = next(p.inputs for p in sweep_points(st, quick=True) if p.params["controller"] == "hji")
+    ctl = prepare_point(pt).ctl
+    twin = copy.copy(ctl)
+    twin.history, twin.train_seconds = [], 0.0
+    other = copy.copy(ctl)
+    other.weights = ctl.weights * (1 + 1e-15 * np.arange(ctl.weights.size))
+    assert policy_key(ctl.control) == policy_key(twin.control) != policy_key(other.control)
+    assert policy_key(ctl.control) != policy_key(ctl.disturbance)
+    a, b, c = (NonlinearInitialPolicy(0.14, 0.069, g) for g in (125.0, 125.0, 120.0))
+    assert policy_key(a) == policy_key(b) != policy_key(c)
+    assert policy_key(None) == "idle"
+    assert policy_key(lambda x: x) != policy_key(lambda x: x)     # closures: by identity

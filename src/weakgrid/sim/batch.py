@@ -315,6 +315,7 @@ class BatchSimulator:
         nb = system.nb
         self.Y = xp.empty((self.B, 2 * nb, 2 * nb))
         self._ynet = [None] * self.B
+        self._alg_A = [None] * self.B     # (the member's algebraic factor, its J_yy) each
         self.timing = dict.fromkeys(TIMED, 0.0)
         self.steps = 0
         self.halved = 0
@@ -372,40 +373,57 @@ class BatchSimulator:
     # ------------------------------------------------------------------ solves
     def _alg_chord(self, t, Z, rows):
         """Chord iteration on the network variables of members ``rows`` (each member's own
-        algebraic LU), as :meth:`Simulator._alg_chord`; returns ``{k: (z, F, (ctx, row))}`` of
-        the members that converged (the others diverged or stalled)."""
+        algebraic matrix, :meth:`_alg_solve`), as :meth:`Simulator._alg_chord`; returns
+        ``{k: (z, F, (ctx, row))}`` of the members that converged (the others diverged or
+        stalled)."""
         nx = self.nx
         done = {}
-        live = list(range(len(rows)))
-        prev = [math.inf] * len(rows)
-        grow = [0] * len(rows)
-        evals = [0] * len(rows)
+        n = len(rows)
+        live = xp.arange(n)
+        prev = xp.full(n, math.inf)
+        grow = xp.zeros(n, dtype=int)
+        tol = xp.asarray([self.sims[k].tol for k in rows])
         Z = Z.copy()
-        for _ in range(30):
-            if not live:
+        for it in range(30):
+            if not len(live):
                 break
-            idx = [rows[j] for j in live]
+            idx = [rows[j] for j in live.tolist()]
             F, ctx = self.residual(t, Z[live], idx)
-            keep = []
-            for i, j in enumerate(live):
-                sim = self.sims[rows[j]]
-                evals[j] += 1
-                dy = sim._alg_lu_get().solve(F[i, nx:])
-                nrm = float(xp.max(xp.abs(dy)))
-                if not math.isfinite(nrm):
-                    continue
-                if nrm < sim.tol:
-                    done[rows[j]] = (Z[j].copy(), F[i].copy(), (ctx, i))
-                    sim.stats["evals"] += evals[j]   # a member that falls back counts its own
-                    continue
-                grow[j] = grow[j] + 1 if nrm > 0.9 * prev[j] else 0
-                if grow[j] >= 2:
-                    continue
-                prev[j] = nrm
-                Z[j, nx:] -= dy
-                keep.append(j)
+            dy = self._alg_solve(idx, F[:, nx:])
+            nrm = xp.abs(dy).max(axis=1)
+            fin = xp.isfinite(nrm)
+            conv = fin & (nrm < tol[live])
+            for i in xp.nonzero(conv)[0].tolist():
+                j = int(live[i])
+                done[rows[j]] = (Z[j].copy(), F[i].copy(), (ctx, i))
+                self.sims[rows[j]].stats["evals"] += it + 1   # a member that falls back counts its own
+            g = xp.where(nrm > 0.9 * prev[live], grow[live] + 1, 0)
+            go = fin & ~conv & (g < 2)
+            grow[live] = g
+            keep = live[go]
+            prev[keep] = nrm[go]
+            Z[keep, nx:] -= dy[go]
             live = keep
         return done
+
+    def _alg_solve(self, ks, R):
+        """``A_k x = R[i]`` for members ``k = ks[i]``, ``A_k`` the member's algebraic block
+        ``J_yy`` (factorized when its own :meth:`Simulator._alg_lu_get` refactorizes): one
+        stacked LAPACK ``gesv`` for all of them — ``getrf`` and ``getrs``, the arithmetic of
+        the member's factor and solve alone, bit for bit (tests/sim/test_batch.py); a singular
+        block (no ``gesv``) falls back to the members' own factors (NaN/inf, as alone)."""
+        A = self._alg_A
+        lus = []
+        for k in ks:
+            sim = self.sims[k]
+            lu = sim._alg_lu_get()
+            if A[k] is None or A[k][0] is not lu:
+                A[k] = (lu, sim.linsolver._full()[self.nx:, self.nx:])
+            lus.append(lu)
+        try:
+            return xp.linalg.solve(xp.stack([A[k][1] for k in ks]), R[..., None])[..., 0]
+        except np.linalg.LinAlgError:
+            return xp.stack([lu.solve(r) for lu, r in zip(lus, R)])
 
     def _solve(self, lus, idx, R):
         """Chord solves ``M_j x = R[i]`` for ``j = idx[i]`` with each member's LU factors (LAPACK
@@ -844,9 +862,10 @@ class BatchSimulator:
 
     def _sample(self, t, rows, ctls, fail):
         """Take the due samples of members ``rows``; ``{k: changed}``. The ``j``-th controllers
-        of the members that share one ``K`` declared ``batched`` are sampled together
-        (:meth:`_sample_group`: one measurement, one call of ``K``, one hold for all of them);
-        the others one by one (:meth:`DigitalController.sample`)."""
+        of the members declared ``batched`` are sampled together (:meth:`_sample_groups`:
+        those that measure the same signals in one measurement and one hold, those that
+        share a law — :meth:`DigitalController.batch_key` — in one call of it); the others
+        one by one (:meth:`DigitalController.sample`)."""
         t0 = time.perf_counter()
         changed = {k: False for k in rows}
         for j in range(max((len(ctls[k]) for k in rows), default=0)):
@@ -868,51 +887,105 @@ class BatchSimulator:
                 except SimulationError as exc:
                     fail(k, exc)
                     del changed[k]
-            for ks in groups.values():
-                self._sample_group(t, ks, [ctls[k][j] for k in ks], changed, fail)
+            merged = {}    # the law groups that measure the same signals: measured together
+            for key, ks in groups.items():
+                cs = [ctls[k][j] for k in ks]
+                mkey = getattr(cs[0].measure, "key", None)
+                merged.setdefault(("signals", mkey) if mkey is not None else ("law", key),
+                                  []).append((ks, cs))
+            for parts in merged.values():
+                self._sample_groups(t, parts, changed, fail)
         self.timing["events"] += time.perf_counter() - t0
         return changed
 
-    def _sample_group(self, t, ks, cs, changed, fail):
-        """Sample the controllers ``cs`` of members ``ks`` (one each, sharing a batched ``K``):
-        the measurements of the enabled ones stacked (:meth:`_measure`), ``K`` called once on
-        them, each output checked, and every output (the bypass of the disabled) held at once
-        (:meth:`_hold`); each member's samples equal its run alone."""
-        on = [i for i, c in enumerate(cs) if c.active(t)]
+    def _sample_groups(self, t, parts, changed, fail):
+        """Sample the controllers ``cs`` of members ``ks`` for each ``(ks, cs)`` of ``parts``
+        (one law each, all measuring the same signals): the measurements of the enabled
+        ones stacked (:meth:`_measure`), each law called once on its rows (:meth:`_call_law`),
+        and every output (the bypass of the disabled) held at once (:meth:`_hold`); each
+        member's samples equal its run alone."""
         hk, hc, hu = [], [], []
-        for i in sorted(set(range(len(cs))) - set(on)):
-            hk.append(ks[i])
-            hc.append(cs[i])
-            hu.append(cs[i].bypass)
-        if on:
-            mk, mc, M = self._measure(t, [ks[i] for i in on], [cs[i] for i in on], fail)
-            if mk:
-                try:
-                    U = xp.asarray(mc[0].K(M), dtype=float)
-                    if U.ndim != 2 or U.shape[0] != len(mk):
-                        raise ValueError(f"a batched policy returned {U.shape[0] if U.ndim else 0} rows "
-                                         f"for {len(mk)} (an array of shape {U.shape})")
-                except Exception as exc:
-                    for k, c in zip(mk, mc):
-                        fail(k, SimulationError(t, "controller", f"'{c.name}' raised {exc!r}"))
-                        del changed[k]
-                    mk = []
-                ok = (xp.isfinite(U).all(axis=1) if mk and U.shape[1] == mc[0].target.size
-                      else xp.zeros(len(mk), dtype=bool))
-                for i, (k, c) in enumerate(zip(mk, mc)):
-                    if not ok[i]:    # its own message (as its run alone)
-                        try:
-                            c.check(t, U[i], M[i])
-                        except SimulationError as exc:
-                            fail(k, exc)
-                            del changed[k]
-                            continue
+        on_k, on_c, law = [], [], {}
+        for g, (ks, cs) in enumerate(parts):
+            for k, c in zip(ks, cs):
+                if c.active(t):
+                    on_k.append(k)
+                    on_c.append(c)
+                    law[k] = g
+                else:
                     hk.append(k)
                     hc.append(c)
-                    hu.append(U[i])
+                    hu.append(c.bypass)
+        if on_k:
+            mk, mc, M = self._measure(t, on_k, on_c, fail)
+            rows = {}
+            for i, k in enumerate(mk):
+                rows.setdefault(law[k], []).append(i)
+            for pos in rows.values():
+                self._call_law(t, [mk[i] for i in pos], [mc[i] for i in pos], M[pos], changed,
+                               fail, (hk, hc, hu))
         if hk:
             for k, ch in zip(hk, self._hold(t, hk, hc, hu)):
                 changed[k] |= ch
+
+    def _call_law(self, t, mk, mc, M, changed, fail, held):
+        """The outputs of the controllers ``mc`` (members ``mk``, one law) at their
+        measurements ``M``: one call (:meth:`DigitalController.call_rows`; if it raises, each
+        member alone, :meth:`_call_alone`), each output checked (a bad one fails its member
+        with its run alone's message); the good ones appended to ``held`` (members,
+        controllers, outputs)."""
+        try:
+            U = mc[0].call_rows(mc, M)
+        except Exception:    # a member's own error: each called alone, as in its run
+            U, mk, mc, M = self._call_alone(t, mk, mc, M, changed, fail)
+        try:
+            U = xp.asarray(U, dtype=float)
+            if mk and (U.ndim != 2 or U.shape[0] != len(mk)):
+                raise ValueError(f"a batched policy returned {U.shape[0] if U.ndim else 0} rows "
+                                 f"for {len(mk)} (an array of shape {U.shape})")
+        except Exception as exc:
+            for k, c in zip(mk, mc):
+                fail(k, SimulationError(t, "controller", f"'{c.name}' raised {exc!r}"))
+                del changed[k]
+            return
+        ok = (xp.isfinite(U).all(axis=1) if mk and U.shape[1] == mc[0].target.size
+              else xp.zeros(len(mk), dtype=bool))
+        for i, (k, c) in enumerate(zip(mk, mc)):
+            if not ok[i]:    # its own message (as its run alone)
+                try:
+                    c.check(t, U[i], M[i])
+                except SimulationError as exc:
+                    fail(k, exc)
+                    del changed[k]
+                    continue
+            held[0].append(k)
+            held[1].append(c)
+            held[2].append(U[i])
+
+    def _call_alone(self, t, ks, cs, M, changed, fail):
+        """The policies of controllers ``cs`` (members ``ks``) called one by one on their rows
+        of ``M`` (after the batched call raised): a member whose policy raises fails alone, with
+        the message of its run alone. Returns the outputs and the members, controllers and
+        measurements left."""
+        U, mk, mc, mm = [], [], [], []
+        for k, c, m in zip(ks, cs, M):
+            try:
+                try:
+                    u = c.K(m)
+                except Exception as exc:
+                    raise SimulationError(t, "controller", f"'{c.name}' raised {exc!r}") from exc
+                u = c.check(t, u, m)
+            except SimulationError as exc:
+                fail(k, exc)
+                del changed[k]
+                continue
+            U.append(u)
+            mk.append(k)
+            mc.append(c)
+            mm.append(m)
+        if not mk:
+            return xp.zeros((0, 0)), mk, mc, M[:0]
+        return xp.stack(U), mk, mc, xp.stack(mm)
 
     def _measure(self, t, ks, cs, fail):
         """The measurements of controllers ``cs`` of members ``ks`` at their accepted points:

@@ -194,6 +194,12 @@ class DigitalController:
         when ``measure`` can read rows of a batched context (it has ``key`` and ``rows``, as the
         measurements of :func:`gti_signals`, :func:`sg_signals` and :func:`mapped` do) and holds
         their outputs at once when the target names its slots (:meth:`UPQCTarget.slots`).
+        ``K`` may be one of several objects that compute the same law: it then has
+        ``batch_key()`` (equal keys: the same outputs for the same measurement, e.g. the
+        content of a trained controller; default ``id(K)``) and may have
+        ``rows(Ks, M)`` (the outputs of the members' own ``Ks`` — equal keys, ``K`` among
+        them — at the rows of ``M``, row ``i`` for ``Ks[i]``, e.g. each logging its own
+        samples; default ``K(M)``).
     """
 
     def __init__(self, K, T, measure, target, enable=None, bypass=None, name="controller", t0=0.0,
@@ -259,7 +265,17 @@ class DigitalController:
         :func:`gti_signals`; None if it cannot)."""
         if not self.batched:
             return None
-        return id(self.K), getattr(self.measure, "key", None)
+        own = getattr(self.K, "batch_key", None)
+        return (own() if callable(own) else id(self.K)), getattr(self.measure, "key", None)
+
+    def call_rows(self, controllers, M):
+        """The outputs of the policies of ``controllers`` (equal :meth:`batch_key`, this one
+        among them) at the rows of ``M`` (row ``i`` for ``controllers[i]``): one call of
+        ``K.rows`` (or ``K``) for all of them."""
+        rows = getattr(self.K, "rows", None)
+        if rows is not None:
+            return rows([c.K for c in controllers], M)
+        return self.K(M)
 
     def check(self, t, u, m):
         """The policy's output ``u`` for measurement ``m`` as a flat float array, checked

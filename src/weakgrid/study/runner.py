@@ -18,6 +18,7 @@ from .build import build_setup
 from .controllers import controller_variant, make_controller
 from .device import power_metrics
 from .failure import failure_text
+from .law import StudyLaw
 from .metrics import (SETTLING_BANDS, backswing, control_cost, definition_spread, itae,
                       running_cost, settling_time, stability_verdict)
 
@@ -422,23 +423,16 @@ def prepare_run(study, run: Run, trained=None, dt=None, design_load=None, design
     ctl = (trained or {}).get((dload, run.upqc))
     choice = make_controller(study, run.controller, design, ctl)
     T = setup.design.T
-    xs, ys = [], []
-    policy = choice.policy
-    state_map = setup.state_map
-
-    def K(y):   # the digital controller: measured signals -> design state -> law
-        y = np.asarray(y, float)
-        m = state_map(y)
-        u = np.zeros(2) if policy is None else np.asarray(policy(m), float).reshape(2)
-        ys.append(y.copy())
-        xs.append(m.copy())
-        return u
-
+    # the digital controller: measured signals -> design state -> law (batched over the runs
+    # of a batch whose policies have the same content: weakgrid.study.law)
+    K = StudyLaw(choice.policy, setup.state_map)
+    xs, ys = K.xs, K.ys
     engine = sim_engine(study)
     target = UPQCTarget(setup.upqc_name) if setup.upqc_name else _MeasureOnly()
     measure = setup.measure_signals if engine == "phasor" else dpsim_measure(setup)
     dc = DigitalController(K, T=T, measure=measure, target=target,
-                           enable=enable_windows(run.bypass, run.t_end), name=run.controller)
+                           enable=enable_windows(run.bypass, run.t_end), name=run.controller,
+                           batched=True)
     if dt is None:
         dt, tol = sim_settings(study)
     if engine != "phasor":       # DPsim: the run's step in parts of at most dpsim_dt_max
