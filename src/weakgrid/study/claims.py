@@ -9,9 +9,29 @@ what decided it in a few words (a tie and its uncertainty, a failed run and its 
 
 Judges that compare two runs take ``step_unc`` (metric → relative step-halving uncertainty,
 from the sweeps' half-step check; :func:`weakgrid.study.sweep_maps.metric_uncertainty`) and
-apply the one tie rule of :mod:`weakgrid.study.ties`, as the maps do. A run of the claim's
-controller that failed while its baseline finished counts as ``not`` ("… failed: cause"); the
-baseline failing while the controller finished stays ``reproduced``, saying so.
+apply the one tie rule of :mod:`weakgrid.study.ties`, as the maps do.
+
+**Stability first** (:func:`run_instability`, :func:`stability_gate`): before any judge
+compares two runs' costs, ITAE, overshoot or settling, it asks whether each run is stable. A
+run is *not stable* when it failed (voltage collapse, loss of synchronism, Newton failure, …:
+``failed`` and its ``failure``), when the stability verdict of its SG speed or dc-link voltage
+(``speed_verdict``, ``vdc_verdict``; :func:`weakgrid.study.metrics.stability_verdict`) is
+``unstable`` or ``undamped``, or when that signal never settles within the run (its
+``speed_settling_s`` / ``vdc_settling_s`` is recorded but undefined: still outside the 2 %
+band at the record's end) and ends more than half its peak deviation from its set-point
+(:data:`RETURN_FRACTION`; a swing still decaying at the end of a short record is stable). A
+metric a run does not record is not evidence either way. Then,
+for a pair (the claim's run a, its baseline b):
+
+* a not stable → ``not``, ``why`` naming it ("c1-high-conv-hji not stable: dc link never
+  settles within the run"; a failure as "… failed: voltage collapse");
+* only b not stable → a win for a without comparing numbers (``reproduced``), saying so;
+* both not stable → ``not``, "both runs unstable: no comparison" — a cost or ITAE of two
+  diverged runs says nothing about the claim.
+
+Only a pair of two stable runs is compared. Judges whose claim is closeness, not a win
+(``itae_close``), count b not stable as ``not`` too; :func:`stability_contrast` (a claim *about*
+stability) uses :func:`run_instability` as its definition of stable.
 """
 
 from __future__ import annotations
@@ -23,15 +43,18 @@ import math
 from .failure import failure_kind
 from .ties import compare, run_uncertainty, unc_text
 
-__all__ = ["RULES", "judge_all", "judge_claim"]
+__all__ = ["RULES", "STABILITY_NOTE", "judge_all", "judge_claim", "run_instability",
+           "stability_gate"]
+
+
+def _value(v):
+    """``v``, or None when it is missing or NaN (a metric undefined for the run)."""
+    return None if v is None or (isinstance(v, float) and math.isnan(v)) else v
 
 
 def _get(m, rid, key):
     r = m.get(rid)
-    if r is None:
-        return None
-    v = r.get(key)
-    return None if v is None or (isinstance(v, float) and math.isnan(v)) else v
+    return None if r is None else _value(r.get(key))
 
 
 def _fmt(v, unit="", nd=3):
@@ -50,20 +73,76 @@ def _combine(vs):
     return "not"
 
 
-def _loss(m, ia, ib):
-    """``(verdict, why)`` when run ``ia`` (the claim's controller) or ``ib`` (its baseline)
-    failed: a lost a (loss of synchronism, Newton failure, …) while b finished counts as
-    ``not``; a lost b while a finished stays ``reproduced``, saying so; None when both
-    finished."""
-    ra, rb = m.get(ia) or {}, m.get(ib) or {}
-    fa, fb = bool(ra.get("failed")), bool(rb.get("failed"))
-    cause = (lambda r: failure_kind(r.get("failure")) or "failed")  # noqa: E731
-    if fa and fb:
-        return "not", f"both failed: {ia} {cause(ra)}, {ib} {cause(rb)}"
-    if fa:
-        return "not", f"{ia} failed: {cause(ra)}"
-    if fb:
-        return "reproduced", f"{ib} failed: {cause(rb)}"
+#: The rule in words, as every report states it (weakgrid.study.engine.DEFINITIONS).
+STABILITY_NOTE = (
+    "Stability first (claim table): before comparing two runs' costs, ITAE, overshoot or "
+    "settling, each run must be stable: finished (no voltage collapse, loss of synchronism, "
+    "Newton failure), SG speed and dc link neither unstable nor undamped (stability verdict), "
+    "and each back at its set-point — a signal still outside its 2 % settling band at the "
+    "end of the run AND more than half its peak deviation away from its set-point never "
+    "settles. A pair where the claim's run is not stable is 'not' (named); where only the "
+    "baseline is not stable, a win without comparing numbers (named); where both are not "
+    "stable, 'not' — both runs unstable: no comparison.")
+
+#: The signals whose stability a run is judged on: metric prefix → name in the verdict text
+#: (the runner's ``<prefix>_verdict``, ``_settling_s``, ``_final_dev_pu``, ``_peak_dev_pu``).
+STABILITY_SIGNALS = (("speed", "SG speed"), ("vdc", "dc link"))
+
+#: A signal that never enters its 2 % settling band counts as not settled only when it also
+#: ends farther than this fraction of its peak deviation from its set-point [–]: a decaying
+#: swing still outside the band at the end of a short record (case 1's 0.5-Hz speed mode in a
+#: 3-s run ends 4–12 % of its peak away) is stable; a dc link that ran away ends at ≈ 100 %.
+RETURN_FRACTION = 0.5
+
+
+def run_instability(r) -> str:
+    """Why run ``r`` (its metrics dict) is not stable, or ``""`` when nothing says so.
+
+    ``"failed: <cause>"`` (:func:`weakgrid.study.failure.failure_kind`) for a run that did not
+    finish; ``"not stable: <signal> unstable|undamped"`` for a stability verdict other than
+    stable; ``"not stable: <signal> never settles within the run"`` for a settling time that
+    is recorded but undefined (None or NaN: outside the 2 % band at the record's end) while
+    the signal ends more than :data:`RETURN_FRACTION` of its peak deviation from its
+    set-point (or those two are not recorded). A signal outside the band but back near its
+    set-point is a swing still decaying, stable. Keys a run does not record are skipped.
+    """
+    r = r or {}
+    if r.get("failed"):
+        return f"failed: {failure_kind(r.get('failure')) or 'failed'}"
+    why = []
+    for key, name in STABILITY_SIGNALS:
+        v = r.get(f"{key}_verdict")
+        if v in ("unstable", "undamped"):
+            why.append(f"{name} {v}")
+        elif f"{key}_settling_s" in r and _value(r[f"{key}_settling_s"]) is None:
+            fin, pk = _value(r.get(f"{key}_final_dev_pu")), _value(r.get(f"{key}_peak_dev_pu"))
+            if fin is None or not pk:
+                why.append(f"{name} never settles within the run")
+            elif abs(fin) > RETURN_FRACTION * pk:
+                why.append(f"{name} never settles within the run (ends {abs(fin):.3g} pu "
+                           f"from its set-point, {abs(fin) / pk * 100:.0f} % of its peak "
+                           "deviation)")
+    return "not stable: " + ", ".join(why) if why else ""
+
+
+def stability_gate(m, ia, ib, baseline_unstable="reproduced"):
+    """The verdict of a pair decided by stability alone, or None when both runs are stable.
+
+    ``ia`` is the claim's run, ``ib`` its baseline (ids in ``m``, ``{run id: metrics}``).
+    Returns ``(verdict, why)``: ``("not", "<ia> <reason>")`` when ia is not stable
+    (:func:`run_instability`); ``(baseline_unstable, "<ib> <reason>; <ia> stable: a win
+    without comparing")`` when only ib is not (pass ``"not"`` for a claim of closeness);
+    ``("not", "both runs unstable: no comparison (…)")`` when neither is. None: compare them.
+    """
+    wa, wb = run_instability(m.get(ia)), run_instability(m.get(ib))
+    if wa and wb:
+        return "not", f"both runs unstable: no comparison ({ia} {wa}; {ib} {wb})"
+    if wa:
+        return "not", f"{ia} {wa}"
+    if wb:
+        tail = ("a win without comparing" if baseline_unstable == "reproduced"
+                else "not the same performance")
+        return baseline_unstable, f"{ib} {wb}; {ia} stable: {tail}"
     return None
 
 
@@ -89,14 +168,16 @@ def cost_less(m, pairs, reduction=0.2, settling_tol=0.25, settling="vdc_settling
     """Run a needs ≥ ``reduction`` less ``metric`` (a cost) than run b, same settling ±tol.
 
     A difference within the measured uncertainty (:mod:`weakgrid.study.ties`) is a tie; a
-    smaller cost beyond it is ``partly``; a failed run a is ``not`` (b failed: reproduced).
+    smaller cost beyond it is ``partly``. Costs are compared only between two stable runs
+    (:func:`stability_gate`): a not stable is ``not``, only b not stable ``reproduced``, both
+    ``not`` ("both runs unstable: no comparison").
     """
     out, verdicts, why = [], [], []
     name = _COST_NAMES.get(metric, metric)
     for label, ia, ib in pairs:
         if ia not in m or ib not in m:
             continue
-        loss = _loss(m, ia, ib)
+        loss = stability_gate(m, ia, ib)
         if loss:
             out.append(f"{label}: {loss[1]}")
             verdicts.append(loss[0])
@@ -141,9 +222,21 @@ def power_share(m, runs, lo, hi, paper_pct):
 
 
 def itae_close(m, pairs, close=0.1, partly=0.3, metrics=("speed_itae", "vdc_itae")):
-    """ITAE of the named metrics of two runs within ``close`` (partly: ``partly``)."""
-    out, vs = [], []
+    """ITAE of the named metrics of two runs within ``close`` (partly: ``partly``).
+
+    Only two stable runs are compared (:func:`stability_gate`); either not stable is ``not``
+    (one stable and one not do not perform "the same"; two unstable runs: no comparison).
+    """
+    out, vs, why = [], [], []
     for label, ia, ib in pairs:
+        if ia not in m or ib not in m:
+            continue
+        gate = stability_gate(m, ia, ib, baseline_unstable="not")
+        if gate:
+            out.append(f"{label}: {gate[1]}")
+            vs.append(gate[0])
+            why.append(f"{label}: {gate[1]}")
+            continue
         vals = [(_get(m, ia, k), _get(m, ib, k)) for k in metrics]
         if any(None in v for v in vals):
             continue
@@ -152,7 +245,7 @@ def itae_close(m, pairs, close=0.1, partly=0.3, metrics=("speed_itae", "vdc_itae
                                             for k, r in zip(metrics, rel)))
         vs.append("reproduced" if max(rel) <= close else "partly" if max(rel) <= partly
                   else "not")
-    return _combine(vs), "; ".join(out)
+    return _combine(vs), "; ".join(out), "; ".join(why)
 
 
 def _pair_verdict(results):
@@ -171,14 +264,15 @@ def beats_baselines(m, groups, step_unc=None):
     """Lower ITAE of speed and dc-link voltage than each baseline (or the baseline failed).
 
     ``groups``: ``[[label, run, baseline label, baseline run], …]``. Differences within the
-    measured uncertainty are ties (:mod:`weakgrid.study.ties`); a failed run of ours while
-    the baseline finished is ``not``.
+    measured uncertainty are ties (:mod:`weakgrid.study.ties`). Only two stable runs are
+    compared (:func:`stability_gate`): ours not stable is ``not``, only the baseline not
+    stable a win, both ``not``.
     """
     out, vs, why = [], [], []
     for label, hid, base, bid in groups:
         if hid not in m or bid not in m:
             continue
-        loss = _loss(m, hid, bid)
+        loss = stability_gate(m, hid, bid)
         if loss:
             out.append(f"{label} vs {base}: {loss[1]}")
             vs.append(loss[0])
@@ -206,14 +300,15 @@ def less_overshoot_settling(m, pairs, overshoot="speed_backswing_pu",
 
     Each comparison goes through the tie rule (:mod:`weakgrid.study.ties`): a difference
     within the measured uncertainty (step halving + the metric's sensitivity to its own
-    definition, e.g. the settling band) is a tie. A failed run a is ``not`` (b failed while a
-    finished: reproduced); a settling time a has and b has not (b never settles) is a win.
+    definition, e.g. the settling band) is a tie. Only two stable runs are compared
+    (:func:`stability_gate`): a not stable (failed, unstable, undamped or never settling) is
+    ``not``, only b not stable a win (``reproduced``), both ``not``.
     """
     out, vs, why = [], [], []
     for label, h, l_ in pairs:
         if h not in m or l_ not in m:
             continue
-        loss = _loss(m, h, l_)
+        loss = stability_gate(m, h, l_)
         if loss:
             out.append(f"{label}: {loss[1]}")
             vs.append(loss[0])
@@ -225,8 +320,8 @@ def less_overshoot_settling(m, pairs, overshoot="speed_backswing_pu",
             continue
         co, to = _cmp(m, h, l_, overshoot, step_unc)
         cs, ts = _cmp(m, h, l_, settling, step_unc)
-        if cs == "n/a":       # a settles and b does not: a wins; a does not: b wins
-            cs = "a" if sh is not None else "b"
+        if cs == "n/a" and (sh is None) != (sl is None):  # one still decaying at the end
+            cs = "a" if sh is not None else "b"          # (stable, not settled): the other wins
         out.append(f"{label}: speed overshoot (backswing) {_fmt(oh)} vs {_fmt(ol)} pu ({to}), "
                    f"settling {_fmt(sh, ' s')} vs {_fmt(sl, ' s')}" + (f" ({ts})" if ts else ""))
         vs.append(_pair_verdict([co, cs]))
@@ -252,17 +347,18 @@ def stability_contrast(m, winner, others):
     """``winner = [label, run]`` stable while each of ``others`` is unstable or undamped.
 
     partly: the winner stable and one of the others not stable. A missing other run counts
-    as not stable (it was not run).
+    as not stable (it was not run). Stable is :func:`run_instability`'s (the comparing
+    judges' definition): finished, no signal unstable or undamped, every recorded signal
+    settling within the run.
     """
     runs = [tuple(o) for o in others] + [tuple(winner)]
     v = {lbl: (m.get(rid) or {}) for lbl, rid in runs}
     if not any(v.values()):
         return "not run", ""
-    verdict = {lbl: ("unstable" if r.get("failed") else r.get("speed_verdict", "n/a"))
-               for lbl, r in v.items() if r}
+    verdict = {lbl: (run_instability(r) or "stable") for lbl, r in v.items() if r}
     text = ", ".join(f"{c}: {s}" for c, s in verdict.items())
     ok_w = verdict.get(winner[0]) == "stable"
-    ok_o = [verdict.get(lbl) in ("unstable", "undamped", None) for lbl, _ in others]
+    ok_o = [verdict.get(lbl, "") != "stable" for lbl, _ in others]
     if ok_w and all(ok_o):
         return "reproduced", text
     return ("partly" if ok_w and any(ok_o) else "not"), text

@@ -34,7 +34,7 @@ from ..models import load_preset
 from .batches import STUDY_BATCHES, batch_size_for
 from .build import build_setup
 from .cache import inputs_key, load_run, remove_stale, save_run
-from .claims import judge_all
+from .claims import STABILITY_NOTE, judge_all
 from .controllers import controller_kind, controller_variant, train_hji
 from .figures import figure_specs, write_figures
 from .protocol import controller_name, protocol_of
@@ -61,6 +61,7 @@ DEFINITIONS = [
     "Numerics: every run integrates with the study's [simulation] step and Newton tolerance "
     "(default: the controller's sampling period T and the simulator's tolerance scaled with "
     "it).",
+    STABILITY_NOTE,
 ]
 SWEEP_DEFINITIONS = [
     "Maps: each claim's measured quantity and verdict over the axes of the study's [sweep]; "
