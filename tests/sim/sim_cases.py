@@ -17,10 +17,11 @@ def two_machine_case(x_line=0.3, p=0.8):
     return {"baseMVA": 100.0, "bus": bus, "gen": gen, "branch": branch}
 
 
-def classical_smib(p=0.8, model="GENCLS", upqc_vmax=None, **params):
+def classical_smib(p=0.8, model="GENCLS", upqc_vmax=None, upqc_params=None, **params):
     """A machine (``model``, classical by default: Sn 100 MVA, M 6 s, x'd 0.25 pu) on a line
     (0.01 + j0.3 pu) to an infinite bus, set up; with ``upqc_vmax`` a conventional UPQC "U" on
-    the line. The SMIB every engine (phasor, DPsim EMT and DP) is checked on."""
+    the line (further UPQC parameters: ``upqc_params``). The SMIB every engine (phasor, DPsim
+    EMT and DP) is checked on."""
     from weakgrid.sim.sources import InfiniteBus
     from weakgrid.sim.system import System
     from weakgrid.sim.upqc import UPQC
@@ -33,7 +34,8 @@ def classical_smib(p=0.8, model="GENCLS", upqc_vmax=None, **params):
     src.add_source("S2", 1)
     s.add_component(src)
     if upqc_vmax is not None:
-        s.add_component(UPQC()).add_upqc("U", branch=0, structure="conventional", Vmax=upqc_vmax)
+        s.add_component(UPQC()).add_upqc("U", branch=0, structure="conventional", Vmax=upqc_vmax,
+                                             **(upqc_params or {}))
     s.setup()
     return s
 

@@ -122,8 +122,15 @@ def test_stator_resistance_is_represented(engine):
 
 
 def test_unmapped_events_and_engines_are_refused():
+    from weakgrid.sim.events import Event
+
+    class Surge(Event):          # an event kind no engine maps
+        t = 0.005
+
     s = _smib()
-    with pytest.raises(DataError, match="LineTrip"):
+    with pytest.raises(DataError, match="Surge"):
+        simulate_dpsim(s, 0.01, engine="dpsim-dp", events=[Surge()])
+    with pytest.raises(DataError, match="LineTrip.*islands"):    # the SMIB's only line
         simulate_dpsim(s, 0.01, engine="dpsim-dp", events=[LineTrip(0, 0.005)])
     with pytest.raises(DataError, match="dpsim-emt"):
         simulate_dpsim(s, 0.01, engine="dpsim-sp")

@@ -71,10 +71,12 @@ def test_study_runs_in_dpsim_like_the_phasor_engine(recs):
     assert dp.info["sim"]["engine"] == "dpsim-dp" and ph.info["sim"]["engine"] == "phasor"
     assert dp.info["sim"]["dt"] <= 1e-4
     # the same figure keys from the same signal names
-    assert set(ph.aliases) <= set(dp.aliases) | {"sg_pe", "q_series", "p_line", "s_series",
-                                                 "s_shunt", "upqc_vdc", "shunt_limited"}
-    for key in ("sg_speed", "dc_voltage", "shunt_bus_v", "vup", "vuq"):
+    assert set(ph.aliases) <= set(dp.aliases) | {"sg_pe", "q_series", "p_line", "s_series"}
+    for key in ("sg_speed", "dc_voltage", "shunt_bus_v", "vup", "vuq", "upqc_vdc", "s_shunt",
+                "shunt_limited"):
         assert dp.aliases[key] == ph.aliases[key]
+    for m in ("s_shunt_peak_mva", "shunt_limit_reached"):     # the shunt converter's metrics
+        assert m in ph.metrics and m in dp.metrics, m
     # the electromechanical response: the classical SG's speed after the load step
     assert dp.metrics["speed_peak_dev_pu"] == pytest.approx(ph.metrics["speed_peak_dev_pu"],
                                                             rel=0.03)
@@ -214,8 +216,10 @@ def test_paper_fault_with_29_depends_on_what_the_dc_link_sees():
     """The paper's fault with the law (29) in the loop (T = 0.81 ms, ZOH, bypassed during the
     fault). With the GTI's dc link paying its model's power (``gti_power = "model"``) DP
     reproduces the phasor engine's dc-link swing (measured over 1.5 s: 0.1576 against 0.1579
-    pu); paying the power its DPsim source delivered (the default) the loop swings it far
-    further (0.758 pu): docs/engines.md."""
+    pu); paying the power its DPsim source delivered (the default) the loop swings it further
+    (0.214 pu over 1 s; 0.758 while DPsim's UPQC shunt converter was ideal: now its current
+    limit binds on the series power's spike at clearing, its dc link drains and lowers the
+    series voltage): docs/engines.md."""
     from weakgrid.study.runner import Run, run_scenario
 
     dev = {}
@@ -226,4 +230,4 @@ def test_paper_fault_with_29_depends_on_what_the_dc_link_sees():
         assert rec.metrics["vu_peak_pu"] > 0.1, key                  # the controller acted
         dev[key] = rec.metrics["vdc_peak_dev_pu"]
     assert dev["model"] == pytest.approx(dev["phasor"], rel=0.05), dev
-    assert dev["measured"] > 2.0 * dev["phasor"], dev
+    assert dev["measured"] > 1.2 * dev["phasor"], dev

@@ -32,7 +32,9 @@ Where the series converter's dc power ``P_dc`` comes from:
   converter's modulation limit), so a link drained while the current limit binds lowers
   ``|Vu|`` and with it the series power, rather than running below zero. With
   ``chi = Rsh = 0`` and the limit not reached, ``P_shunt = P_series`` at every instant and the
-  dc link stays at ``Vdc0``: the lossless constant-power draw of the ideal model.
+  dc link stays at ``Vdc0``: the lossless constant-power draw of the ideal model. The law is
+  :func:`shunt_dc_law` (and the modulation limit :func:`link_vmax`), which the DPsim engines
+  step between their steps too (:mod:`weakgrid.sim.emt.upqc`).
 * ``structure="reduced"``: drawn from the dc link of GTI ``gti``, entering its
   balance ``C*Vc*dVc/dt = Pin - Pe - P_dc`` (the UPQC's own dc-link states stay constant).
 
@@ -67,6 +69,50 @@ def series_dc_power(P, chi):
     ``P + chi*|P|`` — the paper's ``(1 + chi)*P`` while it delivers power (15), and a loss
     (never a gain) while it absorbs power."""
     return P + chi * np.abs(P)
+
+
+def link_vmax(Vmax, Vdc, Vdc0):
+    """The series voltage [pu] the dc link at ``Vdc`` [pu] can carry (the converter's
+    modulation limit): ``Vmax*min(1, max(Vdc, 0)/Vdc0)`` (conventional structure)."""
+    return np.where(Vdc < Vdc0, Vmax * np.maximum(Vdc, 0.0) / Vdc0, Vmax)
+
+
+def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p):
+    """The conventional UPQC's shunt converter and dc link (the module docstring's equations),
+    the one law every engine evaluates.
+
+    Parameters
+    ----------
+    Pdc : array_like
+        The series converter's dc power [pu on Sb] (:func:`series_dc_power`).
+    Vdc, xi_dc : array_like
+        The dc-link states: voltage [pu of ``Vdc0``'s base] and the dc-voltage loop's integral
+        [pu on Sb].
+    vr_abs, vr_safe : array_like
+        The shunt-bus voltage magnitude ``|Vr|`` [pu], and the same kept off zero (the divisor).
+    p : mapping
+        ``Vdc0``, ``kp_dc``, ``ki_dc``, ``Imax`` (0: no limit), ``Rsh``, ``Cdc``
+        (:attr:`UPQC.params`).
+
+    Returns
+    -------
+    tuple of arrays
+        ``(I_shunt, limited, P_shunt, P_loss, dVdc/dt, dxi_dc/dt)``: the active current [pu on
+        Sb] drawn from bus r in phase with ``Vr``, whether the current limit binds (bool), the
+        powers [pu on Sb] and the two derivatives [1/s].
+    """
+    err = p["Vdc0"] - Vdc
+    Id = (Pdc + p["kp_dc"] * err + xi_dc) / vr_safe
+    imax = np.where(p["Imax"] > 0, p["Imax"], np.inf)   # 0: no limit
+    over = np.abs(Id) > imax
+    if np.any(over):
+        Id = np.clip(Id, -imax, imax)
+    Psh = Id * vr_abs
+    Ploss = p["Rsh"] * Id ** 2
+    Vdcs = Vdc if np.all(Vdc > 1e-6) else np.maximum(Vdc, 1e-6)
+    dVdc = (Psh - Ploss - Pdc) / (p["Cdc"] * Vdcs)
+    dxi = np.where(over, 0.0, p["ki_dc"] * err)
+    return Id, over, Psh, Ploss, dVdc, dxi
 
 
 class UPQC(Component):
@@ -200,9 +246,8 @@ class UPQC(Component):
         conv = self._conv
         if self._any_conv:   # the series voltage the dc link can carry: Vmax at Vdc >= Vdc0
             Vdc = ctx.x[..., self.sl(0)]
-            low = Vdc < p["Vdc0"]
-            if low.any():
-                Vmax = np.where(conv & low, Vmax * np.maximum(Vdc, 0.0) / p["Vdc0"], Vmax)
+            if (Vdc < p["Vdc0"]).any():
+                Vmax = np.where(conv, link_vmax(Vmax, Vdc, p["Vdc0"]), Vmax)
         if (mag > Vmax).any():
             Vu = Vu * np.where(mag > Vmax, Vmax / np.where(mag > 0, mag, 1.0), 1.0)
             mag = np.abs(Vu)
@@ -218,24 +263,13 @@ class UPQC(Component):
         Pdc = series_dc_power(P, p["chi"]) if self._any_chi else P
         o = ctx.out
         if self._any_conv:
-            err = p["Vdc0"] - Vdc
-            Id = (Pdc + p["kp_dc"] * err + ctx.x[..., self.sl(1)]) / vr_safe
-            imax = np.where(p["Imax"] > 0, p["Imax"], np.inf)   # 0: no limit
-            over = np.abs(Id) > imax
-            if over.any():
-                Id = np.clip(Id, -imax, imax)
+            Id, over, Psh, Ploss, dVdc, dxi = shunt_dc_law(Pdc, Vdc, ctx.x[..., self.sl(1)],
+                                                          vr_abs, vr_safe, p)
             if not self._all_conv:
-                Id = np.where(conv, Id, 0.0)
+                Id, Psh, Ploss, dVdc, dxi = (np.where(conv, a, 0.0)
+                                             for a in (Id, Psh, Ploss, dVdc, dxi))
                 over = over & conv
             scatter_add(ctx.I, self.r[conv], -(Id * ur)[..., conv], self._uniq)
-            Psh = Id * vr_abs
-            Ploss = p["Rsh"] * Id ** 2
-            Vdcs = Vdc if (Vdc > 1e-6).all() else np.maximum(Vdc, 1e-6)
-            dVdc = (Psh - Ploss - Pdc) / (p["Cdc"] * Vdcs)
-            dxi = np.where(over, 0.0, p["ki_dc"] * err)
-            if not self._all_conv:
-                dVdc = np.where(conv, dVdc, 0.0)
-                dxi = np.where(conv, dxi, 0.0)
             self._f = (dVdc, dxi)
             o["UPQC.P_shunt"], o["UPQC.S_shunt"] = Psh, np.abs(Psh)
             o["UPQC.I_shunt"], o["UPQC.P_loss"], o["UPQC.limited"] = Id, Ploss, over * 1.0

@@ -39,8 +39,37 @@
   (:mod:`weakgrid.sim.disconnect`). Refused: a row whose bus holds another machine or device
   (one terminal node per tripped machine), a bus left without a resistive path (as a cleared
   fault), a tripped row that is not a mapped machine (a GTI).
+* :class:`~weakgrid.sim.events.LineTrip` (a branch opened, or closed with ``close=True``): the
+  phasor engine takes the whole branch out of the network admittance matrix (its series
+  impedance and both charging halves, a transformer's whole two-port) or puts it back. In
+  DPsim the branch, exactly as :mod:`weakgrid.sim.emt.topology` builds it (a line's R–L and
+  its π capacitors, a transformer's π-equivalent), stands between two end nodes of its own
+  (:func:`line_switching`, ``build_network(switched=...)``), joined to its buses by a breaker
+  at *each* end (closed ``1e-6`` pu, open ``OPEN_PU``: the load-step and generator-trip
+  switches' values and helper, :func:`_switch_seq`; closed, the two add ``2e-6`` pu to the
+  branch's resistance): opening both at ``t`` removes everything the phasor engine removes,
+  the charging included, and the grid sees two open switches. The switch is ideal: it chops
+  the current at ``t`` (a real breaker waits for a current zero), so the bus sees the step a
+  chopped inductive current gives (docs/engines.md: 1.7 pu for one step at a load bus without
+  charging on the test grid).
+  Opening them interrupts the series inductor's current, which would ring undamped through
+  the open switches (as a tripped machine's), so at ``t`` each end node is also switched to
+  ground through a dump resistance (the closed resistance of a switch to ground):
+  ``TAP² x / (2 w dt)`` [pu of the from bus] and ``x / (2 w dt)`` [pu of the to bus],
+  ``x = BR_X``, ``w = 2π f``: the islanded branch's loop, referred to its to side, then holds
+  at least ``L/dt`` (``L`` its series inductance), the trapezoidal factor of the interrupted
+  current is at most 1/3 (the tripped machine's), and the charging capacitors discharge too
+  (a real line's trapped charge is not modelled: the branch is gone from the grid's point of
+  view either way). A re-close (``close=True``) opens the dump switches and closes the
+  breakers at ``t`` (the branch re-energized from its buses, its charging inrush included).
+  A branch out of service in the case (``BR_STATUS = 0``) that an event closes is built dead
+  (nodes at zero) behind open breakers. Refused at planning (a study stops before any run):
+  a trip of a UPQC's branch (:mod:`weakgrid.sim.emt.upqc` builds it), a trip that leaves a
+  bus without an in-service path to a slack bus (an island: the phasor engine's
+  :meth:`~weakgrid.sim.network.Network.check_connected`), and a trip at a bus without a
+  resistive path (as a cleared fault: the other branches' interrupted currents would ring).
 * a bolted fault at a GTI's reference bus is refused (see :mod:`weakgrid.sim.emt.gti`); every
-  other event (line trips) is refused naming it.
+  other event is refused naming it.
 """
 
 from __future__ import annotations
@@ -48,7 +77,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import DataError
-from ..events import Fault, GeneratorTrip, LoadStep
+from ..events import Fault, GeneratorTrip, LineTrip, LoadStep
 
 #: largest fault impedance [pu on the system base] mapped to DPsim's resistive switch
 BOLTED_MAX = 1e-3
@@ -57,6 +86,9 @@ BOLTED_MAX = 1e-3
 FAULT_DAMP = 1e3
 #: open-switch resistance [pu on the bus base impedance]
 OPEN_PU = 1e7
+#: the refusal of an event kind the DPsim engines do not map
+UNMAPPED = ("the DPsim engines map bus faults (Fault), load steps (LoadStep), generator trips "
+            "(GeneratorTrip) and branch trips and re-closures (LineTrip)")
 
 
 def _step_admittance(system, ev):
@@ -109,6 +141,65 @@ def _unit(system, ev):
     return inst
 
 
+def line_switching(system, events) -> dict:
+    """The branches the run's :class:`LineTrip` events open or close, checked.
+
+    Returns
+    -------
+    dict
+        ``{branch row: (in service at t = 0, [(t [s], closed, event), ...])}``, the changes of
+        state in time order (an event that leaves the branch as it is is dropped: it changes
+        nothing in the phasor engine either).
+
+    Raises
+    ------
+    DataError
+        Naming the event: a UPQC's branch; a trip that islands a bus (no in-service path to a
+        slack bus); a trip at an end bus without a resistive path (no load or shunt
+        conductance, machine or source).
+    """
+    from ..network import BR_STATUS, F_BUS, T_BUS
+
+    net = system.network
+    trips = sorted((ev for ev in events or () if isinstance(ev, LineTrip)), key=lambda e: e.t)
+    if not trips:
+        return {}
+    up = system.components.get("UPQC")
+    upqc_rows = set(np.asarray(up.branch).tolist()) if up is not None and up.n else set()
+    status = net.branch[:, BR_STATUS] > 0
+    out = {}
+    damped = None
+    for ev in trips:
+        ev.validate(system)
+        k = int(ev.branch)
+        where = f"{ev!r} (branch {net.branch_label(k)})"
+        if k in upqc_rows:
+            raise DataError(where, "branch", k, "a UPQC's own branch is not switched in the DPsim "
+                            "engines (weakgrid.sim.emt.upqc builds it); trip another branch")
+        closed = bool(ev.close)
+        if status[k] == closed:
+            continue
+        status = status.copy()
+        status[k] = closed
+        try:
+            net.check_connected(status)
+        except DataError as err:
+            raise DataError(where, "branch", k, f"the trip islands {err.element} (no in-service "
+                            "branch to a slack bus): the DPsim engines do not run islands "
+                            "opened by a trip; trip a branch with a parallel path") from None
+        if not closed:
+            damped = _damped_buses(system) if damped is None else damped
+            ends = [int(net.branch[k, F_BUS]), int(net.branch[k, T_BUS])]
+            bad = [b for b in ends if net.index_of(b) not in damped]
+            if bad:
+                raise DataError(where, "branch", k, f"opening it at bus {bad[0]}, a bus without a "
+                                "resistive path (no load or shunt conductance, machine or "
+                                "source), rings undamped in DPsim's trapezoidal rule; put a load "
+                                "or a shunt conductance (GS) there")
+        out.setdefault(k, (bool(net.branch[k, BR_STATUS] > 0), []))[1].append((ev.t, closed, ev))
+    return out
+
+
 def trip_terminals(system, kit, cir, events) -> list:
     """The node each bus's machines connect to: the bus node, or for a tripped machine its own
     terminal node (initialized at the bus's power-flow voltage)."""
@@ -144,8 +235,10 @@ def build_events(system, kit, cir, events, dt):
 
     _, Zb = bus_base(system)
     w = 2 * np.pi * system.network.f_hz
-    out = []
+    out = _branch_breakers(system, kit, cir, events, dt)
     for j, ev in enumerate(events or ()):
+        if isinstance(ev, LineTrip):
+            continue
         if isinstance(ev, LoadStep):
             ev.validate(system)
             b, y = _step_admittance(system, ev)
@@ -183,9 +276,7 @@ def build_events(system, kit, cir, events, dt):
                 cir.components.append(res)
             continue
         if not isinstance(ev, Fault):
-            raise DataError(f"event {j}", "kind", type(ev).__name__,
-                            "the DPsim engines map bus faults (Fault), load steps (LoadStep) and "
-                            "generator trips (GeneratorTrip) so far")
+            raise DataError(f"event {j}", "kind", type(ev).__name__, UNMAPPED)
         ev.validate(system)
         z = abs(complex(ev.rf, ev.xf))
         bolted = z <= BOLTED_MAX
@@ -231,18 +322,50 @@ def build_events(system, kit, cir, events, dt):
     return out
 
 
+def _branch_breakers(system, kit, cir, events, dt):
+    """The breakers and dump switches of every switched branch (``cir.branch_ends``, built
+    with :func:`line_switching`'s rows) and their switch events."""
+    from ..network import BR_X, F_BUS, T_BUS, TAP
+    from .topology import bus_base
+
+    net = system.network
+    _, Zb = bus_base(system)
+    w = 2 * np.pi * net.f_hz
+    out = []
+    for k, (closed0, changes) in line_switching(system, events).items():
+        row = net.branch[k]
+        tap = float(row[TAP]) if row[TAP] != 0 else 1.0
+        dump = float(row[BR_X]) / (2 * w * dt)                 # pu of the to bus
+        toggles = [(t, closed) for t, closed, _ in changes]
+        for end, bus, node, dump_pu in (("f", row[F_BUS], cir.branch_ends[k][0], tap * tap * dump),
+                                        ("t", row[T_BUS], cir.branch_ends[k][1], dump)):
+            b = net.index_of(int(bus))
+            out += _switch_seq(kit, cir, f"br{k}.brk{end}", cir.nodes[b], node, Zb[b], closed0,
+                               toggles, closed_pu=1e-6)
+            out += _switch_seq(kit, cir, f"br{k}.dump{end}", kit.gnd, node, Zb[b], not closed0,
+                               [(t, not closed) for t, closed in toggles], closed_pu=dump_pu)
+    return out
+
+
 def _switch(kit, cir, name, a, b, zb, t, close, closed_pu):
     """A switch from node ``a`` to ``b`` (open: ``OPEN_PU``, closed: ``closed_pu`` [pu of
     ``zb`` Ω]), open before ``t`` if ``close`` else closed; return its event at ``t``."""
+    return _switch_seq(kit, cir, name, a, b, zb, not close, [(t, close)], closed_pu)[0]
+
+
+def _switch_seq(kit, cir, name, a, b, zb, closed0, toggles, closed_pu):
+    """A switch from node ``a`` to ``b`` (open: ``OPEN_PU``, closed: ``closed_pu`` [pu of
+    ``zb`` Ω]), closed at ``t = 0`` if ``closed0``; return its switch events, one per
+    ``(t [s], closed)`` of ``toggles``."""
     sw = kit.ph.Switch(name, kit.d.LogLevel.off)
     sw.set_parameters(kit.param(OPEN_PU * zb), kit.param(closed_pu * zb))
-    if close:
-        sw.open()
-    else:
+    if closed0:
         sw.close()
+    else:
+        sw.open()
     sw.connect([a, b])
     cir.components.append(sw)
-    return kit.event(float(t), sw, bool(close))
+    return [kit.event(float(t), sw, bool(closed)) for t, closed in toggles]
 
 
 def _damped_buses(system, exclude=()) -> set:

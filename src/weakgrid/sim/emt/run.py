@@ -11,6 +11,9 @@ Recorded signals (names as the phasor engine's where they exist):
 * ``<machine>.vf`` [pu], ``<machine>.tm`` [pu on Sb]: the field voltage and mechanical torque
   weakgrid's exciter and governor hold over each step (machines with an exciter / a governor;
   :mod:`weakgrid.sim.emt.machine_controls`);
+* ``<upqc>.<signal>`` for the signals of :data:`weakgrid.sim.emt.upqc.SIGNALS` (the series
+  voltage and power, the dc link ``Vdc``, ``xi_dc`` and the shunt converter's ``P_shunt``,
+  ``I_shunt``, ``P_loss``, ``limited``, ...), kinds and units as the phasor engine's;
 * EMT only, in addition: ``bus<id>.va``, ``.vb``, ``.vc`` [pu of the peak phase-to-ground base
   ``sqrt(2/3) kV``; SI: kV instantaneous], the three-phase instantaneous voltages.
 
@@ -31,7 +34,8 @@ from ..errors import DataError, SimulationError
 from ..results import Results
 from .controllers import _Loop, bind, sample_all
 from .dpsim_module import DOMAINS, Kit, domain_of
-from .events import build_events, removed_load, trip_terminals, tripped_machines
+from .events import (build_events, line_switching, removed_load, trip_terminals,
+                     tripped_machines)
 from .gti import GTIBridge
 from .machine_controls import MachineControls
 from .machines import build_machines, check_machines
@@ -119,7 +123,8 @@ def simulate_dpsim(system, t_end: float, *, engine: str = "dpsim-emt", dt: float
 def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, controllers,
          gti_power="measured"):
     net = system.network
-    cir = build_network(system, kit, removed_load(system, events))
+    switched = {k: v[0] for k, v in line_switching(system, events).items()}
+    cir = build_network(system, kit, removed_load(system, events), switched)
     bridge = UPQCBridge(system, kit, cir)
     gti = GTIBridge(system, kit, cir, power=gti_power)
     gens = build_machines(system, kit, trip_terminals(system, kit, cir, events), cir.Vpf, cir)
@@ -155,7 +160,7 @@ def _run(system, kit, engine, domain, t_end, dt, events, decimate, name, control
             t = (k - 1) * dt
             if bound and any((k - 1) % every == 0 for every, _ in bound):
                 sample_all(bound, loop, k - 1, t, rec.latest())
-            rec.upqc = bridge.update(t, rec.phasor, rec.current)
+            rec.upqc = bridge.update(t, rec.phasor, rec.current, dt)
             if mc.active:
                 mc.step(t, rec)
             out.call(sim.next)
@@ -193,11 +198,12 @@ class _Recorder:
             names += [f"bus{bid}.v", f"bus{bid}.a"]
             kinds += ["voltage", "angle"]
             fac += [net.base_kv[b], 180 / math.pi]
-        for it in bridge.items:
-            nm = it["name"]
-            names += [f"{nm}.Vup", f"{nm}.Vuq", f"{nm}.Vu", f"{nm}.P_series"]
-            kinds += ["pu", "pu", "pu", "power"]
-            fac += [1.0, 1.0, 1.0, system.Sb]
+        for n, kind in bridge.names():
+            names.append(n)
+            kinds.append(kind)
+            fac.append(system.Sb if kind in ("power", "apparent") else
+                       system.Sb / (math.sqrt(3) * system.element_kv(n)) if kind == "current"
+                       else 1.0)
         self.gti_names = [n for n, _ in gti.names()]
         for n, kind in gti.names():
             names.append(n)
@@ -220,7 +226,7 @@ class _Recorder:
         self.names, self.kinds, self.fac = names, kinds, fac
         self.t, self.rows = [], []
         self._a = np.exp(2j * np.pi / 3)
-        self.upqc = [(it["name"], 0.0, 0.0, 0.0, 0.0) for it in bridge.items]
+        self.upqc = bridge.initial()
         self._ph, self._abc, self._t = None, None, 0.0
         self.tripped, self._frozen = dict(tripped or {}), {}
 
@@ -261,8 +267,8 @@ class _Recorder:
             row += vals
         for ph in self._ph:
             row += [abs(ph), float(np.angle(ph))]
-        for _, up, uq, vu, P in self.upqc:
-            row += [up, uq, vu, P]
+        for vals in self.upqc:
+            row += list(vals)
         row += [self.gti[n] for n in self.gti_names]
         row += list(self.mc.vf.values()) + list(self.mc.tm.values())
         for abc in self._abc:

@@ -4,7 +4,7 @@
 field or event) everything :func:`weakgrid.sim.emt.simulate_dpsim` would refuse on the way —
 machines and controls (:mod:`weakgrid.sim.emt.machines`), devices
 (:mod:`weakgrid.sim.emt.topology`), the network's branches and the events
-(:mod:`weakgrid.sim.emt.events`) — without importing ``dpsimpy``, so that a study asking for a
+(:mod:`weakgrid.sim.emt.events`: a line trip that islands a bus, for instance) — without importing ``dpsimpy``, so that a study asking for a
 DPsim engine stops at planning, before any training or run. :func:`dpsim_step` is the step a
 study's run takes in DPsim.
 """
@@ -16,9 +16,9 @@ import math
 import numpy as np
 
 from ..errors import DataError
-from ..events import Fault, GeneratorTrip, LoadStep
+from ..events import Fault, GeneratorTrip, LineTrip, LoadStep
 from .dpsim_module import domain_of
-from .events import BOLTED_MAX, removed_load, _unit
+from .events import BOLTED_MAX, UNMAPPED, line_switching, removed_load, _unit
 from .gti import check_gti
 from .machines import check_machines
 from .topology import check_devices, check_network
@@ -44,7 +44,8 @@ def check_supported(system, events=(), engine: str = "dpsim-emt",
     check_gti(system, gti_power)
     check_devices(system)
     net = system.network
-    check_network(system, removed_load(system, events))
+    switched = line_switching(system, events)
+    check_network(system, removed_load(system, events), {k: v[0] for k, v in switched.items()})
     gti = system.components.get("GTI")
     refs = set(np.asarray(gti.ref).tolist()) if gti is not None and gti.n else set()
     for j, ev in enumerate(events or ()):
@@ -55,7 +56,5 @@ def check_supported(system, events=(), engine: str = "dpsim-emt",
                                 "GTI's reference bus is not mapped (weakgrid.sim.emt.events)")
         elif isinstance(ev, GeneratorTrip):
             _unit(system, ev)
-        elif not isinstance(ev, LoadStep):
-            raise DataError(f"event {j}", "kind", type(ev).__name__,
-                            "the DPsim engines map bus faults (Fault), load steps (LoadStep) "
-                            "and generator trips (GeneratorTrip) so far")
+        elif not isinstance(ev, (LoadStep, LineTrip)):
+            raise DataError(f"event {j}", "kind", type(ev).__name__, UNMAPPED)

@@ -9,7 +9,9 @@ Mapping
 -------
 * branch (MATPOWER row, in service): series resistor (when ``BR_R > 0``) and inductor through an
   internal node, half the charging ``BR_B`` as a capacitor at each end; refused: ``BR_X <= 0``
-  (a series capacitor);
+  (a series capacitor). A branch a ``LineTrip`` opens or closes is built the same way between
+  two end nodes of its own, joined to its buses by breakers (``switched``;
+  :mod:`weakgrid.sim.emt.events`);
 * transformer (a branch with an off-nominal ``TAP``, or ends at different base voltages):
   the exact π-equivalent of its ideal ratio ``N = TAP · kV_from / kV_to`` and series R–L,
   three scaled R–L branches (:func:`_transformer`; DPsim's own ``Transformer`` is not used, the
@@ -52,11 +54,15 @@ class Circuit:
         Internal nodes (between a branch's resistor and inductor).
     f_hz : float
         Network frequency [Hz].
+    branch_ends : dict
+        ``{branch row: (from-end node, to-end node)}`` of the branches built behind breakers
+        (``build_network(switched=...)``).
     """
 
     def __init__(self, nodes, f_hz):
         self.nodes, self.f_hz = nodes, f_hz
         self.components, self.extra_nodes = [], []
+        self.branch_ends = {}
 
 
 def check_devices(system) -> None:
@@ -85,17 +91,18 @@ def _shunt_admittance(system, removed=None):
     return y if removed is None else y - removed
 
 
-def check_network(system, removed=None) -> None:
+def check_network(system, removed=None, switched=()) -> None:
     """Refuse (:class:`DataError`, naming the branch or bus and the field) what the circuit
     cannot hold: a non-inductive branch (``BR_X <= 0``, a series capacitor), a phase shifter
     (``SHIFT != 0``: its two-port is not reciprocal, which no network of R, L, C is), a
     negative shunt conductance (generation as a load), a load step removing more load than its
-    bus holds (``removed``: :func:`weakgrid.sim.emt.events.removed_load`)."""
+    bus holds (``removed``: :func:`weakgrid.sim.emt.events.removed_load`). Branches out of
+    service are checked too when a ``LineTrip`` closes them (rows in ``switched``)."""
     net = system.network
     up = system.components.get("UPQC")
     upqc_rows = set(np.asarray(up.branch).tolist()) if up is not None and up.n else set()
     for k, row in enumerate(net.branch):
-        if row[BR_STATUS] <= 0 or k in upqc_rows:
+        if (row[BR_STATUS] <= 0 and k not in switched) or k in upqc_rows:
             continue
         where = f"branch {net.branch_label(k)}"
         if row[SHIFT] != 0:
@@ -117,7 +124,7 @@ def check_network(system, removed=None) -> None:
                         "DPsim")
 
 
-def build_network(system, kit, removed=None) -> Circuit:
+def build_network(system, kit, removed=None, switched=None) -> Circuit:
     """Nodes, branches, shunt admittances and ideal sources of a set-up system in DPsim.
 
     Parameters
@@ -129,8 +136,15 @@ def build_network(system, kit, removed=None) -> Circuit:
     removed : ndarray of complex, optional
         Per bus position, admittance [pu] left out of the bus's permanent shunt (the part a
         load step removes: :func:`weakgrid.sim.emt.events.removed_load`).
+    switched : dict, optional
+        ``{branch row: in service at t = 0}`` of the branches ``LineTrip`` events open or
+        close (:func:`weakgrid.sim.emt.events.line_switching`): each is built between two end
+        nodes of its own (``Circuit.branch_ends``; initialized at its buses' power-flow
+        voltages when in service, at zero when not: a dead branch), for
+        :func:`weakgrid.sim.emt.events.build_events` to join to its buses by breakers.
     """
-    check_network(system, removed)
+    switched = dict(switched or {})
+    check_network(system, removed, switched)
     net = system.network
     w = 2 * math.pi * net.f_hz
     Vb, Zb = bus_base(system)
@@ -143,17 +157,23 @@ def build_network(system, kit, removed=None) -> Circuit:
     up = system.components.get("UPQC")
     upqc_rows = set(np.asarray(up.branch).tolist()) if up is not None and up.n else set()
     for k, row in enumerate(net.branch):
-        if row[BR_STATUS] <= 0 or k in upqc_rows:     # a UPQC branch: weakgrid.sim.emt.upqc
-            continue
+        if (row[BR_STATUS] <= 0 and k not in switched) or k in upqc_rows:
+            continue                                   # a UPQC branch: weakgrid.sim.emt.upqc
         f, t = net.index_of(int(row[F_BUS])), net.index_of(int(row[T_BUS]))
+        nf, nt, Vf, Vt = nodes[f], nodes[t], Vpf[f], Vpf[t]
+        if k in switched:          # behind breakers: its own end nodes (dead if out of service)
+            if not switched[k]:
+                Vf = Vt = 0j
+            nf, nt = kit.node(f"br{k}.f", Vf), kit.node(f"br{k}.t", Vt)
+            cir.extra_nodes += [nf, nt]
+            cir.branch_ends[k] = (nf, nt)
         tap = row[TAP] if row[TAP] != 0 else 1.0
         if tap != 1.0 or row[SHIFT] != 0 or Zb[f] != Zb[t]:
-            _transformer(cir, kit, system, k, row, f, t, w)
+            _transformer(cir, kit, system, k, row, f, t, w, (nf, nt, Vf, Vt))
             continue
         r, x, bc = float(row[BR_R]), float(row[BR_X]), float(row[BR_B])
         z = Zb[f]
-        nf, nt = nodes[f], nodes[t]
-        _series_rl(cir, kit, f"br{k}", nf, nt, Vpf[f], Vpf[t], complex(r, x) * z, w)
+        _series_rl(cir, kit, f"br{k}", nf, nt, Vf, Vt, complex(r, x) * z, w)
         if bc > 0:
             for end, n in (("f", nf), ("t", nt)):
                 cap = ph.Capacitor(f"br{k}.C{end}", off)
@@ -219,8 +239,10 @@ def _series_rl(cir, kit, name, na, nb, Va, Vb, Z, w):
     cir.components.append(ind)
 
 
-def _transformer(cir, kit, system, k, row, f, t, w):
-    """Branch ``k`` (positions ``f`` → ``t``) with an off-nominal ratio as its exact π-equivalent.
+def _transformer(cir, kit, system, k, row, f, t, w, ends):
+    """Branch ``k`` (positions ``f`` → ``t``) with an off-nominal ratio as its exact π-equivalent
+    between the nodes ``ends = (from node, to node, from voltage, to voltage)`` (the buses'
+    nodes and power-flow voltages [V], or a switched branch's end nodes).
 
     weakgrid's (MATPOWER's) two-port: from bus — ideal transformer ``TAP:1`` — series
     impedance ``z = BR_R + j BR_X`` [pu] — to bus, ``BR_B / 2`` at both ends of ``z``. In SI the
@@ -252,7 +274,7 @@ def _transformer(cir, kit, system, k, row, f, t, w):
     tap = float(row[TAP]) if row[TAP] != 0 else 1.0
     N = tap * Vbase[f] / Vbase[t]
     Z = complex(r, x) * Zb[t]
-    nf, nt, Vf, Vt = cir.nodes[f], cir.nodes[t], cir.Vpf[f], cir.Vpf[t]
+    nf, nt, Vf, Vt = ends
     _series_rl(cir, kit, f"br{k}", nf, nt, Vf, Vt, Z * N, w)
     if N != 1.0:
         _series_rl(cir, kit, f"br{k}.f", nf, kit.gnd, Vf, 0j, Z * N * N / (1 - N), w)

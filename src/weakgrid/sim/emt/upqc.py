@@ -1,21 +1,41 @@
-"""The UPQC (conventional structure) in DPsim: a series voltage source and its shunt converter.
+"""The UPQC (conventional structure) in DPsim: a series voltage source and its shunt converter
+with the dc link between them.
 
 weakgrid's UPQC (:mod:`weakgrid.sim.upqc`) inserts ``Vu = (Vuq + j Vup) e^{j theta_r}`` in its
-branch, at the shunt bus ``r``, and (conventional structure) draws the series real power
-``P_series = Re(Vu conj(I))`` from bus ``r`` through its shunt converter. In DPsim:
+branch, at the shunt bus ``r``; its series converter pays ``P_dc = P_series + chi |P_series|``
+(:func:`~weakgrid.sim.upqc.series_dc_power`) from a dc link. In DPsim:
 
 * the branch becomes ``bus r — VoltageSource(Vu) — node — R — L — bus 1``; the source's set
   point is rewritten between steps (zero-order hold over one step ``dt``) from the held inputs
-  ``Vup``, ``Vuq`` (after the rating clip ``Vmax``, :func:`weakgrid.sim.upqc.rating_clip`) and
-  the angle ``theta_r`` of bus ``r`` measured at the previous step;
-* the shunt converter is a current source at bus ``r`` drawing ``P_series`` at the measured bus
-  voltage, rewritten between steps likewise.
+  ``Vup``, ``Vuq`` after the rating clip (:func:`weakgrid.sim.upqc.rating_clip`) at the
+  conventional UPQC's modulation limit ``Vmax min(1, Vdc/Vdc0)`` with the current ``Vdc``
+  (:func:`weakgrid.sim.upqc.link_vmax`), and the angle ``theta_r`` of bus ``r`` measured at the
+  previous step;
+* the conventional structure's shunt converter is a ``CurrentSource`` at bus ``r`` drawing
+  ``I_shunt`` in phase with the measured ``Vr``, and its dc link (states ``Vdc``, ``xi_dc``) is
+  co-simulated with the phasor engine's own law (:func:`weakgrid.sim.upqc.shunt_dc_law`: the
+  feed-forward + dc-voltage PI ``P_ref``, the current limit ``Imax``, the loss ``Rsh I²``,
+  ``Cdc Vdc dVdc/dt = P_shunt − P_loss − P_dc``), stepped like the GTI's
+  (:mod:`weakgrid.sim.emt.gti`): at ``t_k`` the law is evaluated at the states ``x_k`` and the
+  measurements, the shunt current is set for ``[t_k, t_k + dt]`` and the states advance by
+  forward Euler, ``x_{k+1} = x_k + dt f_k``.
 
-The phasor engine applies both algebraically at every instant; here they lag by one step
-(1e-4 s by default). The reduced structure has no shunt converter: its series power (with the
-converter loss ``chi``, :func:`weakgrid.sim.upqc.series_dc_power`) is drawn from the dc link of
-its GTI (:mod:`weakgrid.sim.emt.gti`), which takes the power the series source delivered over
-the last step (:meth:`UPQCBridge.gti_draw`).
+The series power the dc link pays is the *measured* one (the convention of the GTI's default
+``gti_power = "measured"``, whatever a run's ``gti_power``): ``P_series = Re(Vu conj(I))`` with
+``I`` the branch current measured in DPsim's series inductor at ``t_k`` and ``Vu`` the set
+point the source holds from ``t_k`` — the power the DPsim source delivers at the start of the
+step the dc link is advanced over, network current transients included (the phasor engine's
+``I = (Vr + Vu − V1)/Zu`` leaves them out). Without a current limit and losses (``Imax = 0``,
+``chi = Rsh = 0``) ``P_shunt = P_series`` at every step and ``Vdc`` stays at ``Vdc0``: the
+ideal constant-power shunt this bridge had before. When the series power spikes beyond
+``Imax |Vr|`` (a fault's clearing), the link drains and the modulation limit lowers ``|Vu|``.
+
+The phasor engine applies all of this algebraically at every instant; here the set points lag
+by one step (1e-4 s by default). The reduced structure has no shunt converter: its series power
+``P_dc`` (the same measured ``P_series``) is drawn from the dc link of its GTI
+(:mod:`weakgrid.sim.emt.gti`, :meth:`UPQCBridge.gti_draw`); its own ``Vdc`` stays ``Vdc0``.
+Recorded per UPQC: :data:`SIGNALS` with the phasor engine's names (``<upqc>.Vdc``,
+``.xi_dc``, ``.P_dc``, ``.P_shunt``, ``.I_shunt``, ``.P_loss``, ``.limited``, ...).
 """
 
 from __future__ import annotations
@@ -25,7 +45,15 @@ import math
 import numpy as np
 
 from ..network import BR_R, BR_X
-from ..upqc import rating_clip, series_dc_power
+from ..upqc import UPQC, link_vmax, rating_clip, series_dc_power, shunt_dc_law
+
+#: recorded UPQC signals (the phasor engine's names ``<upqc>.<name>``), in
+#: :meth:`UPQCBridge.update`'s order: the series converter's, then the dc link's states and the
+#: shunt converter's
+SIGNALS = ("Vup", "Vuq", "Vu", "P_series", "Vdc", "xi_dc", "P_dc", "P_shunt", "S_shunt",
+           "I_shunt", "P_loss", "limited")
+#: the shunt converter's dc-link parameters (weakgrid.sim.upqc.shunt_dc_law's ``p``)
+_DC = ("Vdc0", "kp_dc", "ki_dc", "Imax", "Rsh", "Cdc")
 
 
 class UPQCBridge:
@@ -80,7 +108,9 @@ class UPQCBridge:
             self.items.append(dict(name=nm, i=i, branch=k, r=r, src=src, sh=sh, ind=ind, mid=mid, vb=vb,
                                    ib=system.Sb * 1e6 / vb, Vmax=float(comp.p["Vmax"][i]),
                                    gti=int(comp.gti_i[i]) if red else None,
-                                   chi=float(comp.p["chi"][i])))
+                                   chi=float(comp.p["chi"][i]),
+                                   dc={q: float(comp.p[q][i]) for q in _DC},
+                                   Vdc=float(comp.p["Vdc0"][i]), xi=0.0))
         self.comp = comp
         self._draw = {}
         cir.upqc_branches = {it["branch"] for it in self.items}
@@ -96,33 +126,55 @@ class UPQCBridge:
         self.kit.set_source(src, "I_ref", current / math.sqrt(3) if self.kit.three_phase
                             else current, init, f)
 
-    def update(self, t, phasor_of, current_of):
-        """Rewrite every UPQC's set points from its held inputs and the measured phasors.
+    def update(self, t, phasor_of, current_of, dt):
+        """At a measurement instant ``t_k`` [s]: rewrite every UPQC's set points from its held
+        inputs and the measured phasors, and advance the conventional UPQCs' dc links to
+        ``t_k + dt`` (forward Euler over ``dt`` [s]).
 
         ``phasor_of(b)``: bus ``b``'s voltage [pu phasor]; ``current_of(element)``: the current
         [A phasor, line-to-line RMS scale] from terminal 1 to terminal 2 inside a DPsim element
-        (here the branch's series inductor: from bus r towards bus 1).
+        (here the branch's series inductor: from bus r towards bus 1). Returns per UPQC the
+        values of :data:`SIGNALS` [pu]: the set points held over ``[t_k, t_k + dt]``, the
+        powers at ``t_k`` and the dc-link states at ``t_k + dt``.
         """
         out = []
         self._draw = {}
         for it in self.items:
-            i = it["i"]
-            u = rating_clip(np.array([self.comp.u_p[i], self.comp.u_q[i]]), it["Vmax"])
+            i, dc = it["i"], it["dc"]
+            conv = it["sh"] is not None
+            vmax = float(link_vmax(it["Vmax"], it["Vdc"], dc["Vdc0"])) if conv else it["Vmax"]
+            u = rating_clip(np.array([self.comp.u_p[i], self.comp.u_q[i]]), vmax)
             Vr = phasor_of(it["r"])
-            ur = Vr / abs(Vr) if abs(Vr) > 1e-9 else 1.0
+            vr_abs = abs(Vr)
+            ur = Vr / vr_abs if vr_abs > 1e-9 else 1.0
             Vu = complex(u[1], u[0]) * ur                       # pu
             self._set_v(it["src"], Vu * it["vb"])
             I = current_of(it["ind"]) / it["ib"]                # pu on Sb, bus r -> bus 1
-            P = (Vu * np.conj(I)).real
-            Vr_safe = Vr if abs(Vr) > 1e-6 else 1e-6
-            if it["sh"] is not None:
-                Ish = -(P / np.conj(Vr_safe))                   # injected into bus r [pu]
-                self._set_i(it["sh"], Ish * it["ib"])
+            P = float((Vu * np.conj(I)).real)
+            Pdc = float(series_dc_power(P, it["chi"]))
+            if conv:
+                Id, over, Psh, Ploss, dVdc, dxi = (float(a) for a in shunt_dc_law(
+                    Pdc, it["Vdc"], it["xi"], vr_abs, max(vr_abs, 1e-6), dc))
+                self._set_i(it["sh"], -Id * ur * it["ib"])      # drawn from bus r, in phase with Vr
+                it["Vdc"] += dt * dVdc
+                it["xi"] += dt * dxi
             else:   # reduced: drawn from the GTI's dc link
-                self._draw[it["gti"]] = self._draw.get(it["gti"], 0.0) + \
-                    float(series_dc_power(P, it["chi"]))
-            out.append((it["name"], u[0], u[1], abs(Vu), P))
+                Id = over = Psh = Ploss = 0.0
+                self._draw[it["gti"]] = self._draw.get(it["gti"], 0.0) + Pdc
+            out.append((u[0], u[1], abs(Vu), P, it["Vdc"], it["xi"], Pdc, Psh, abs(Psh), Id,
+                        Ploss, float(over)))
         return out
+
+    def initial(self):
+        """The :meth:`update` rows before the first step: nothing applied, the dc links at
+        ``Vdc0``."""
+        return [(0.0,) * 4 + (it["Vdc"], it["xi"]) + (0.0,) * 6 for it in self.items]
+
+    def names(self):
+        """``[(signal, kind)]`` recorded per UPQC, in :meth:`update`'s order (kinds as the
+        phasor engine's, :attr:`weakgrid.sim.upqc.UPQC.units`)."""
+        return [(f"{it['name']}.{s}", UPQC.units.get(s, "pu")) for it in self.items
+                for s in SIGNALS]
 
     def gti_draw(self, n_gti: int) -> np.ndarray:
         """Per GTI (its position in the GTI component), the dc power [pu on Sb] the reduced
