@@ -113,8 +113,8 @@ def _fmt(v: float) -> str:
 
 
 def _pct(v: float, ref: float) -> str:
-    if not (math.isfinite(v) and math.isfinite(ref)) or ref == 0:
-        return ""
+    if not (math.isfinite(v) and math.isfinite(ref)) or abs(ref) < 1e-12:
+        return ""                          # no reference, or one at round-off (a 1e-16 swing)
     if abs(v / ref) >= 10:                 # orders of magnitude: a factor reads better
         return f" (×{v / ref:.3g})"
     return f" ({100 * (v / ref - 1):+.0f} %)"

@@ -48,8 +48,11 @@ def _study(engine, fault=False, gti_power=None, drop_saturation=None, dpsim_dt_m
         d.setdefault("simulation", {})["gti_power"] = gti_power
     if drop_saturation is not None:
         d.setdefault("simulation", {})["drop_saturation"] = drop_saturation
+    # the engines' checks below were measured at DPsim's default step (T in 9 steps of 90 µs),
+    # 4.5 times cheaper than the shipped study's 2e-5 (its own test: the shipped step below)
+    d.setdefault("simulation", {}).pop("dpsim_dt_max", None)
     if dpsim_dt_max is not None:
-        d.setdefault("simulation", {})["dpsim_dt_max"] = dpsim_dt_max
+        d["simulation"]["dpsim_dt_max"] = dpsim_dt_max
     return study_from_dict(d, source=src.source)
 
 
