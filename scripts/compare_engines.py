@@ -2,7 +2,7 @@
 
     PYTHONPATH=src python scripts/compare_engines.py OUT_DIR NAME \\
         --run phasor=RUN_A --run DP=RUN_B --run EMT=RUN_C [--speed SG.omega] [--vu U.Vu] \\
-        [--dc WF.Vc] [--scenario ID ...] [--from 2.8] [--to 5]
+        [--dc WF.Vc] [--peak UPQC.Vdc] [--scenario ID ...] [--from 2.8] [--to 5]
 
 Each ``RUN_*`` is a run folder written by ``weakgrid run`` (its ``metrics.csv``, ``claims.json``
 and ``runs/<id>.parquet``); the first is the reference. Writes, atomically:
@@ -11,11 +11,14 @@ and ``runs/<id>.parquet``); the first is the reference. Writes, atomically:
   (``speed_peak_dev_pu``), the dc-link peak deviation (``vdc_peak_dev_pu``), the speed and
   dc-link settling times, the largest ``|Vu|`` (``vu_peak_pu``), the demanded peak, the peak
   series power, the running cost of (18) (``running_cost_18``), the run's wall time, each
-  with its difference from the reference in per cent (``--metrics`` picks columns);
+  with its difference from the reference in per cent (``--metrics`` picks columns), and per
+  ``--peak SIGNAL`` the signal's largest deviation from its initial value over the run
+  (``SIGNAL peak dev``, read from ``runs/<id>.parquet``: e.g. a conventional UPQC's dc link
+  ``UPQC.Vdc``, which ``metrics.csv`` does not carry);
 - ``OUT_DIR/NAME-claims.md``: the verdict of every claim in each engine (the ``claims.json``
   each run writes);
 - ``OUT_DIR/NAME-<scenario>.png``: per scenario, one row per controller, the speed, dc-link
-  voltage (if ``--dc``) and ``|Vu|`` of every engine overlaid.
+  voltage (if ``--dc``), each ``--peak`` signal and ``|Vu|`` of every engine overlaid.
 """
 
 from __future__ import annotations
@@ -71,6 +74,32 @@ def load(runs: list[tuple[str, Path]]) -> dict:
     return out
 
 
+def peak_column(signal: str) -> str:
+    """The table column of ``--peak signal``."""
+    return f"{signal} peak dev"
+
+
+def add_peaks(m: dict, folders, signals) -> None:
+    """Per engine and run id, ``max |y − y(0)|`` of each of ``signals`` over the run (its
+    ``runs/<id>.parquet``; NaN where the run or the signal is missing), as column
+    :func:`peak_column` of ``m[label]``."""
+    for lab, folder in folders:
+        df = m[lab]
+        for sig in signals:
+            vals = []
+            for rid in df.index:
+                p = folder / "runs" / f"{rid}.parquet"
+                v = math.nan
+                if p.is_file():
+                    r = read_run(p)
+                    if sig in r.columns:
+                        y = r[sig].to_numpy(dtype=float)
+                        ok = y[pd.notna(y)]
+                        v = float(abs(ok - ok[0]).max()) if ok.size else math.nan
+                vals.append(v)
+            df[peak_column(sig)] = vals
+
+
 def _num(x) -> float:
     try:
         v = float(x)
@@ -84,20 +113,22 @@ def _fmt(v: float) -> str:
 
 
 def _pct(v: float, ref: float) -> str:
-    if not (math.isfinite(v) and math.isfinite(ref)) or ref == 0:
-        return ""
+    if not (math.isfinite(v) and math.isfinite(ref)) or abs(ref) < 1e-12:
+        return ""                          # no reference, or one at round-off (a 1e-16 swing)
     if abs(v / ref) >= 10:                 # orders of magnitude: a factor reads better
         return f" (×{v / ref:.3g})"
     return f" ({100 * (v / ref - 1):+.0f} %)"
 
 
-def metrics_table(m: dict, only=None) -> tuple[str, pd.DataFrame]:
+def metrics_table(m: dict, only=None, peaks=()) -> tuple[str, pd.DataFrame]:
     """Markdown table (rows run id × engine; each non-reference value with its difference from the
-    reference engine in per cent) and the long table behind it; ``only``: these metrics."""
+    reference engine in per cent) and the long table behind it; ``only``: these metrics;
+    ``peaks``: the ``--peak`` signals (columns :func:`peak_column`, after the metrics)."""
     labels = list(m)
     ref = labels[0]
     cols = [(c, h) for c, h in METRICS if any(c in df.columns for df in m.values())
             and (not only or c in only)]
+    cols += [(peak_column(s), f"{s} peak dev [pu]") for s in peaks]
     ids = [i for i in m[ref].index if any(i in df.index for lab, df in m.items() if lab != ref)]
     rows, lines = [], []
     lines.append("| run | engine | " + " | ".join(h for _, h in cols) + " |")
@@ -206,6 +237,9 @@ def main(argv=None) -> int:
     ap.add_argument("--speed", default="SG.omega", help="speed signal [pu]")
     ap.add_argument("--vu", default="U.Vu", help="series-voltage magnitude signal [pu]")
     ap.add_argument("--dc", default=None, help="dc-link voltage signal [pu] (a GTI's `<gti>.Vc`)")
+    ap.add_argument("--peak", action="append", default=[], metavar="SIGNAL",
+                    help="a table column: the signal's largest deviation from its initial value "
+                         "over the run [pu] (e.g. UPQC.Vdc); repeatable")
     ap.add_argument("--scenario", action="append", default=[], help="only these scenarios' figures")
     ap.add_argument("--metrics", default="", help="comma-separated metrics.csv columns of the "
                     "table (default: all of " + ", ".join(c for c, _ in METRICS) + ")")
@@ -224,12 +258,13 @@ def main(argv=None) -> int:
     unknown = sorted(set(only) - {c for c, _ in METRICS})
     if unknown:
         raise SystemExit(f"--metrics: unknown {unknown}; known: {[c for c, _ in METRICS]}")
-    md, long = metrics_table(m, only)
+    add_peaks(m, folders, a.peak)
+    md, long = metrics_table(m, only, a.peak)
     write_text_atomic(a.out / f"{a.name}-metrics.md", md)
     write_text_atomic(a.out / f"{a.name}-metrics.csv", long.to_csv(index=False))
     write_text_atomic(a.out / f"{a.name}-claims.md", claims_table(folders))
     panels = [(a.speed, f"{a.speed} [pu]")] + ([(a.dc, f"{a.dc} [pu]")] if a.dc else []) + \
-        [(a.vu, f"{a.vu} [pu]")]
+        [(s, f"{s} [pu]") for s in a.peak] + [(a.vu, f"{a.vu} [pu]")]
     figs = figures(a.out, a.name, folders, m, panels, a.scenario, a.t_from, a.t_to)
     print(md)
     print(claims_table(folders))

@@ -71,3 +71,19 @@ def test_bad_arguments_are_refused_by_name(ce, tmp_path):
         ce.main([str(tmp_path / "o"), "x", "--run", f"p={a}", "--run", f"q={tmp_path}"])
     with pytest.raises(SystemExit, match="--metrics: unknown"):
         ce.main([str(tmp_path / "o"), "x", "--run", f"p={a}", "--metrics", "nope"])
+
+
+def test_peak_of_a_signal_from_the_run_files(ce, tmp_path):
+    """--peak SIGNAL: max |y − y(0)| over each engine's run file, with its difference from the
+    reference; a signal a run does not have is '–' (and a figure panel says so)."""
+    a = _folder(tmp_path, "ph", 0.02, "not")
+    b = _folder(tmp_path, "emt", 0.01, "tie")
+    out = tmp_path / "out"
+    assert ce.main([str(out), "x", "--run", f"phasor={a}", "--run", f"EMT={b}",
+                    "--metrics", "speed_peak_dev_pu", "--peak", "SG.omega",
+                    "--peak", "U.Vdc"]) == 0
+    md = (out / "x-metrics.md").read_text()
+    assert "SG.omega peak dev [pu] | U.Vdc peak dev [pu] |" in md
+    # 1 + p sin(t) on [0, 1]: the largest deviation p sin(1)
+    assert f"| s1-hji | phasor | 0.02 | {0.02 * np.sin(1.0):.4g} | – |" in md
+    assert f"| s1-hji | EMT | 0.01 (-50 %) | {0.01 * np.sin(1.0):.4g} (-50 %) | – |" in md

@@ -31,6 +31,12 @@ def add_parser(sub):
                         "and the [sweep.quick] of a study with a [sweep]; what runs is said "
                         "first, the sweep's runs are a table in the report")
     p.add_argument("--list", action="store_true", help="list the shipped studies")
+    p.add_argument("--no-maps", dest="maps", action="store_false",
+                   help="leave out the study's [sweep] (its runs, maps and the claims' "
+                        "step-halving uncertainty, which then counts 0): the scenarios' runs "
+                        "only. On a DPsim engine the sweep's half-step check halves the "
+                        "controller's step, which DPsim divides into parts of at most "
+                        "dpsim_dt_max again, so it does not halve DPsim's step")
     add_engine_argument(p)
     add_cluster_arguments(p)
     add_batch_argument(p)
@@ -61,7 +67,7 @@ def run(args) -> int:
     summary = run_studies([st], out, quick=args.quick, title=st.data["study"]["title"] or st.name,
                           scheduler=args.scheduler, workers=args.workers,
                           progress=show_progress(args), force=args.force,
-                          batched=args.batched)
+                          batched=args.batched, maps=args.maps)
     for d in summary["designs"]:
         print(f"  design {d['load']} {d['upqc']}: a = {d['a']}, V̄r = {d['Vr_bar']}, "
               f"ϕs0 = {d['phi_s0']}; modes {d['modes']}")
