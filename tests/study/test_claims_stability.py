@@ -203,3 +203,42 @@ def test_two_swings_still_decaying_are_judged_on_overshoot_alone():
 
 def test_a_record_too_short_to_judge_is_not_evidence():
     assert run_instability(stable(speed_verdict="too short", vdc_verdict="too short")) == ""
+
+
+# ---------------------------------------------------------------- "not back"
+def test_a_swing_that_shrinks_while_its_mean_drifts_away_is_not_back():
+    """The EMT run of case 1 at low load with HJI (docs/emt-findings.md): the SG speed swings
+    2.3 % and ends 1.3 % below its set-point, never inside its band. The verdict's two windows
+    see a shrinking swing ("stable"); the run is still not back, so it cannot win a pair."""
+    t = np.linspace(0.0, 3.0, 3001)
+    y = 1.0 - 0.0115 * (1 - np.cos(2 * np.pi * 0.55 * t)) * np.exp(-0.15 * t) \
+        - 0.0045 * t + 0.004 * np.sin(2 * np.pi * 4 * t) * np.exp(-0.4 * t)
+    after = 0.25
+    ok = t >= after
+    verdict = stability_verdict(t[ok], y[ok], after, y_set=1.0)
+    assert verdict == "stable"              # what the two windows see
+    r = stable(speed_verdict=verdict, speed_settling_s=math.nan,
+               speed_peak_dev_pu=float(np.max(np.abs(y[ok] - 1.0))),
+               speed_final_dev_pu=float(y[-1] - 1.0))
+    assert abs(r["speed_final_dev_pu"]) > 0.5 * r["speed_peak_dev_pu"]
+    why = run_instability(r)
+    assert why.startswith("not stable: SG speed"), why
+    # and so HJI cannot beat an unstable PSS-only run on it: both not stable, no comparison
+    c = claim("C1-baselines")
+    m = {k: stable() for k in ("c1-high-conv-hji", "c1-high-conv-pss-only", "c1-low-conv-hji",
+                                "c1-low-conv-pss-only", "c1-high-conv-pq", "c1-low-conv-pq",
+                                "c1-high-red-hji", "c1-low-red-hji")}
+    m["c1-low-conv-hji"] = r
+    m["c1-low-conv-pss-only"] = stable(speed_verdict="undamped")
+    out = judge_claim(c, m)
+    assert "both runs unstable" in out["measured"], out["measured"]
+
+
+def test_not_back_needs_all_three_keys_and_a_judgeable_record():
+    far = dict(speed_settling_s=math.nan, speed_peak_dev_pu=0.02, speed_final_dev_pu=-0.013)
+    assert "not back" in run_instability(stable(**far))
+    assert run_instability(stable(**dict(far, speed_final_dev_pu=-0.009))) == ""   # < half
+    assert run_instability(stable(**dict(far, speed_settling_s=1.2))) == ""        # settles
+    assert run_instability(stable(**dict(far, speed_verdict="too short"))) == ""   # 1-s run
+    row = pd.Series(stable(**far))                                                 # a table row
+    assert "not back" in run_instability(row)
