@@ -41,3 +41,17 @@ def build_case(name, load="high", upqc="conventional", variant="upqc"):
         s.info["Pe_sg_pu"] = der.details["Pe_pu"]
     s.info["preset_case2_paper"] = s.info["preset"]
     return s
+
+
+def classical_case1():
+    """``(data, source)`` of case 1's study with its generator made classical (GENCLS, no
+    exciter, governor or PSS: the models every DPsim engine has), for the DPsim study tests."""
+    import copy
+
+    src = load_study("case1-weak-grid")
+    d = copy.deepcopy(src.data)
+    g = d["dynamics"]["generator"][0]
+    for k in ("exciter", "governor", "pss"):
+        g.pop(k)
+    g["machine"] = {"model": "GENCLS", "Sn": 80.0, "M": 6.0, "D": 0.0, "ra": 0.0, "xd1": 0.3}
+    return d, src.source

@@ -7,12 +7,12 @@ bus (3) to the grid bus (4), tripped at 0.2 s: the study plans and runs in DPsim
 and its SG's speed excursion is the phasor engine's within a few per cent.
 """
 
-import copy
-
 import numpy as np
 import pytest
 
-from weakgrid.study.studyfile import load_study, study_from_dict
+from paper_setups import classical_case1
+
+from weakgrid.study.studyfile import study_from_dict
 
 pytest.importorskip("dpsimpy")
 
@@ -22,12 +22,7 @@ T_TRIP, T_END = 0.2, 0.6
 
 
 def _study(engine):
-    src = load_study("case1-weak-grid")
-    d = copy.deepcopy(src.data)
-    g = d["dynamics"]["generator"][0]
-    for k in ("exciter", "governor", "pss"):
-        g.pop(k)
-    g["machine"] = {"model": "GENCLS", "Sn": 80.0, "M": 6.0, "D": 0.0, "ra": 0.0, "xd1": 0.3}
+    d, source = classical_case1()
     line = next(b for b in d["grid"]["branch"] if b["name"] == "line")
     d["grid"]["branch"].append({**line, "name": "line b", "r": 2 * line["r"], "x": 2 * line["x"]})
     sc = next(s for s in d["scenarios"] if s["id"] == "c1-high-conv")
@@ -38,7 +33,7 @@ def _study(engine):
     d["controllers"]["compare"] = sc["controllers"]
     d.pop("sweep", None)
     d.setdefault("simulation", {})["engine"] = engine
-    return study_from_dict(d, source=src.source)
+    return study_from_dict(d, source=source)
 
 
 def _run(engine):

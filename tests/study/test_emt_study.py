@@ -16,6 +16,8 @@ import pytest
 
 from weakgrid.game.errors import ParameterError
 from weakgrid.sim.errors import DataError
+from paper_setups import classical_case1
+
 from weakgrid.study.studyfile import load_study, study_from_dict
 
 pytest.importorskip("dpsimpy")
@@ -26,12 +28,7 @@ T_END = 0.8
 
 
 def _study(engine, fault=False, gti_power=None, drop_saturation=None, dpsim_dt_max=None):
-    src = load_study("case1-weak-grid")
-    d = copy.deepcopy(src.data)
-    g = d["dynamics"]["generator"][0]
-    for k in ("exciter", "governor", "pss"):
-        g.pop(k)
-    g["machine"] = {"model": "GENCLS", "Sn": 80.0, "M": 6.0, "D": 0.0, "ra": 0.0, "xd1": 0.3}
+    d, source = classical_case1()
     sc = next(s for s in d["scenarios"] if s["id"] == "c1-high-conv")
     if fault:    # the paper's fault, the study's own (xf = 0.1 pu at the UPQC bus)
         sc.update(controllers=["none", "nonlinear-29"], t_end=1.0)
@@ -53,7 +50,7 @@ def _study(engine, fault=False, gti_power=None, drop_saturation=None, dpsim_dt_m
     d.setdefault("simulation", {}).pop("dpsim_dt_max", None)
     if dpsim_dt_max is not None:
         d["simulation"]["dpsim_dt_max"] = dpsim_dt_max
-    return study_from_dict(d, source=src.source)
+    return study_from_dict(d, source=source)
 
 
 def _run(engine):

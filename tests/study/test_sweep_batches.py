@@ -14,6 +14,17 @@ from weakgrid.sweep import group
 TIMES = ["wall_s", "sim_wall_s"]
 
 
+def _two_ratings_two_loads(controllers):
+    """Case 1's quick sweep cut to two ratings × two loads of 0.4 s, no maps."""
+    d = copy.deepcopy(load_study("case1-weak-grid").data)
+    d["sweep"].update(controllers=controllers,
+                      quick={"axes": {"upqc.rating": [0.15, 0.6],
+                                      "scenarios.c1-high-conv.load": ["high", "low"]},
+                             "t_end": 0.4})
+    d["sweep"].pop("maps", None)
+    return study_from_dict(d)
+
+
 def test_the_case1_quick_sweep_is_one_batch_per_load():
     """The ratings and the controllers of one load share a batch (the rating is a per-member
     parameter of the batched simulator); the two loads are two grids."""
@@ -34,13 +45,7 @@ def test_the_case1_quick_sweep_is_one_batch_per_load():
 
 
 def test_a_batched_study_sweep_gives_the_scalar_table(tmp_path):
-    d = copy.deepcopy(load_study("case1-weak-grid").data)
-    d["sweep"].update(controllers=["nonlinear-29"],
-                      quick={"axes": {"upqc.rating": [0.15, 0.6],
-                                      "scenarios.c1-high-conv.load": ["high", "low"]},
-                             "t_end": 0.4})
-    d["sweep"].pop("maps", None)
-    st = study_from_dict(d)
+    st = _two_ratings_two_loads(["nonlinear-29"])
     scalar = run_study_sweep(st, tmp_path / "scalar", quick=True, workers=0, progress=False,
                              batched=False)
     batched = run_study_sweep(st, tmp_path / "batched", quick=True, workers=0, progress=False,
@@ -185,13 +190,7 @@ def test_runs_of_one_controller_share_one_policy_call_per_sample(tmp_path, monke
     batch samples each pair with one policy call; the table equals the scalar sweep's."""
     from weakgrid.study.law import StudyLaw
 
-    d = copy.deepcopy(load_study("case1-weak-grid").data)
-    d["sweep"].update(controllers=["hji", "nonlinear-29"],
-                      quick={"axes": {"upqc.rating": [0.15, 0.6],
-                                      "scenarios.c1-high-conv.load": ["high", "low"]},
-                             "t_end": 0.4})
-    d["sweep"].pop("maps", None)
-    st = study_from_dict(d)
+    st = _two_ratings_two_loads(["hji", "nonlinear-29"])
     scalar = run_study_sweep(st, tmp_path / "scalar", quick=True, workers=0, progress=False,
                              batched=False)
     sizes = []
