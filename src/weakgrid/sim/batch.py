@@ -40,14 +40,16 @@ it for large batches; the linear solves stay per member (LAPACK through
 :mod:`weakgrid.sim.linsolve`, exactly the one-by-one factorization and solve).
 
 Per-member parameters: a member may bring its own grid (``scenario["system"]``, e.g. built by a
-sweep at its point) that differs from the others only in the parameters its components declare
+sweep at its point) that differs from the others only in its operating point (its loads, power
+flow, initial point and the machines' initial signals: each member's network matrix is its own)
+and in the parameters its components declare
 batchable (:attr:`Component.batch_params`, e.g. the UPQC's rating ``Vmax``): these are held as
 ``(B, n)`` arrays, a row per member, bound into the evaluating copy like the controllers'
 inputs. Members whose grids differ in anything else (:func:`system_fingerprint`) go to different
 batches.
 
 Scope: dense networks (``nb <= system.DENSE_NETWORK_MAX``), members whose grids differ only in
-batchable parameters, events that change the network (:class:`Fault`,
+their loads and batchable parameters, events that change the network (:class:`Fault`,
 :class:`LineTrip`, :class:`LoadStep`). A member outside it (a :class:`GeneratorTrip`, a model
 whose limits move with the solution or with discrete memory) is run one-by-one by
 :func:`simulate_batch`; the results are the same, only slower.
@@ -351,8 +353,8 @@ class BatchSimulator:
                 raise DataError("simulate_batch", "events", why, "run this scenario one by one (Simulator.run)")
             if msys is not system and system_fingerprint(msys) != fp:
                 raise DataError("simulate_batch", f"scenarios[{k}].system", "a different grid",
-                                "a member's grid may differ from the batch's only in batchable "
-                                "parameters (Component.batch_params); batch it with its own grid "
+                                "a member's grid may differ from the batch's only in its loads and "
+                                "batchable parameters (Component.batch_params); batch it with its own grid "
                                 "(simulate_batch groups them)")
             self.sims.append(Simulator(copy.deepcopy(msys), **sim_kw))
         # batchable parameters that differ: one (B, n) array each, bound like the inputs
@@ -1191,8 +1193,8 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
     scenarios : list of dict
         ``{"events": [...], "controllers": [...], "system": System}`` per scenario (fresh
         objects per scenario; ``system``: the scenario's own grid, default the argument).
-        Scenarios whose grids differ only in batchable parameters share batches, each with
-        its own values (:func:`system_fingerprint`).
+        Scenarios whose grids differ only in their loads (operating point) and batchable
+        parameters share batches, each with its own values (:func:`system_fingerprint`).
     t_end : float
         Final time [s].
     batch_size : int
