@@ -25,23 +25,55 @@ def _two_ratings_two_loads(controllers):
     return study_from_dict(d)
 
 
-def test_the_case1_quick_sweep_is_one_batch_per_load():
-    """The ratings and the controllers of one load share a batch (the rating is a per-member
-    parameter of the batched simulator); the two loads are two grids."""
+def test_the_case1_quick_sweep_is_one_batch():
+    """The ratings, the loads and the controllers share a batch: the rating is a per-member
+    parameter of the batched simulator, the load a member's own admittances and the set-points
+    its initialization computed from them."""
     st = load_study("case1-weak-grid")
     pts = sweep_points(st, quick=True)
     batches = group(pts, key=lambda p: batch_key(p.inputs))
     load = "scenarios.c1-high-conv.load"
-    assert len(pts) == 12 and len(batches) == 2
-    for b in batches:
-        members = [pts[i].params for i in b.rows]
-        assert len({m[load] for m in members}) == 1
-        assert sorted({m["upqc.rating"] for m in members}) == [0.15, 0.6]
-        assert sorted({m["controller"] for m in members}) == \
-            sorted(["hji", "nonlinear-29", "hji-bounded"])
-        name, run_load, upqc, *_ = b.key
-        assert (name, run_load, upqc) == ("case1-weak-grid", members[0][load], "conventional")
-    assert [pts[b.rows[0]].params[load] for b in batches] == ["high", "low"]   # sweep order
+    assert len(pts) == 12 and len(batches) == 1
+    members = [pts[i].params for i in batches[0].rows]
+    assert len(members) == 12
+    assert sorted({m[load] for m in members}) == ["high", "low"]
+    assert sorted({m["upqc.rating"] for m in members}) == [0.15, 0.6]
+    assert sorted({m["controller"] for m in members}) == \
+        sorted(["hji", "nonlinear-29", "hji-bounded"])
+    name, upqc, *_ = batches[0].key
+    assert (name, upqc) == ("case1-weak-grid", "conventional")
+
+
+def _grids_of(pts):
+    from weakgrid.study.sweep import prepare_point
+
+    return [prepare_point(p.inputs).setup.system for p in pts]
+
+
+def test_the_two_loads_grids_are_one_grid_to_the_batch_simulator_and_others_are_not():
+    """The grids of the two loads (and two ratings) have one fingerprint, so the batched
+    simulator keeps them in one batch; a grid that differs in a line, a bus shunt or a device
+    parameter that is not batchable does not (it would be wrongly merged)."""
+    from weakgrid.sim.batch import system_fingerprint
+    from weakgrid.sim.network import BR_X, BS, GS
+
+    st = _two_ratings_two_loads(["nonlinear-29"])
+    pts = sweep_points(st, quick=True)
+    grids = _grids_of(pts)
+    assert len({system_fingerprint(g) for g in grids}) == 1
+    ref = system_fingerprint(grids[0])
+
+    for edit in (lambda n: n.branch.__setitem__((0, BR_X), n.branch[0, BR_X] * 1.1),
+                 lambda n: n.bus.__setitem__((2, BS), n.bus[2, BS] + 5.0),
+                 lambda n: n.bus.__setitem__((2, GS), n.bus[2, GS] + 5.0)):
+        g = copy.deepcopy(grids[0])
+        edit(g.network)
+        assert system_fingerprint(g) != ref
+    g = copy.deepcopy(grids[0])
+    exc = g.components["EXDC2"]
+    exc.p["KA"] = exc.p["KA"] * 2
+    assert system_fingerprint(g) != ref
+    assert system_fingerprint(grids[0]) == ref      # the comparison left the grid as it was
 
 
 def test_a_batched_study_sweep_gives_the_scalar_table(tmp_path):
@@ -132,6 +164,84 @@ def test_a_studys_runs_simulated_together_equal_their_runs_alone():
     assert together[0].metrics["speed_peak_dev_pu"] != together[3].metrics["speed_peak_dev_pu"]
 
 
+def test_runs_at_both_loads_simulated_in_one_batch_equal_their_runs_alone(monkeypatch):
+    """A batch mixing the high- and the low-load grid (each member its own load admittances,
+    initial point and set-points) gives each run's trajectories to 1e-10 and its metrics."""
+    import numpy as np
+
+    import weakgrid.sim.batch as batch
+    from weakgrid.study.runner import Run, run_scenarios
+
+    st = load_study("case1-weak-grid")
+    sc = dict(next(s for s in st.scenarios() if s["id"] == "c1-high-conv"), t_end=0.4)
+    runs = [Run.of(st, dict(sc, load=load), c)
+            for load in ("high", "low") for c in ("nonlinear-29", "hji")]
+    assert [r.load for r in runs] == ["high", "high", "low", "low"]
+    alone = run_scenarios(st, runs, batched=False)
+    sizes = []
+    real = batch.BatchSimulator.__init__
+
+    def counting(self, system, scenarios, **kw):
+        sizes.append(len(scenarios))
+        real(self, system, scenarios, **kw)
+
+    monkeypatch.setattr(batch.BatchSimulator, "__init__", counting)
+    together = run_scenarios(st, runs, batched=True)
+    assert sizes == [4]                      # one batch holds both loads
+    for a, b in zip(alone, together):
+        ma, mb = (dict(r.metrics) for r in (a, b))
+        ma.pop("wall_s"), mb.pop("wall_s")
+        assert ma.keys() == mb.keys()
+        for k in ma:
+            if isinstance(ma[k], float):
+                assert mb[k] == pytest.approx(ma[k], rel=1e-8, abs=1e-12, nan_ok=True), k
+            else:
+                assert mb[k] == ma[k], k
+        assert a.series.keys() == b.series.keys()
+        for k in a.series:
+            np.testing.assert_allclose(b.series[k], a.series[k], rtol=0, atol=1e-10, err_msg=k)
+    # the loads act: another operating point
+    assert abs(together[0].series["sg_pe"][0] - together[2].series["sg_pe"][0]) > 1e-3
+
+
+def test_machines_without_controls_keep_their_own_initial_signals_in_a_mixed_load_batch(
+        monkeypatch):
+    """Case 1 with a classical SG and no exciter or governor: its field voltage and torque
+    are the initial signals of its own operating point (``System._sig_stack``), held per
+    member; both loads in one batch equal their runs alone (the runs differ by far more if a
+    member took another's: checked by not binding them)."""
+    import numpy as np
+    from paper_setups import classical_case1
+
+    import weakgrid.sim.batch as batch
+    from weakgrid.study.runner import Run, run_scenarios
+
+    d, src = classical_case1()
+    st = study_from_dict(d, source=src)
+    sc = dict(next(s for s in st.scenarios() if s["id"] == "c1-high-conv"), t_end=0.4)
+    runs = [Run.of(st, dict(sc, load=load), "nonlinear-29") for load in ("high", "low")]
+    alone = run_scenarios(st, runs, batched=False)
+    sizes = []
+    real = batch.BatchSimulator.__init__
+
+    def counting(self, system, scenarios, **kw):
+        sizes.append(len(scenarios))
+        real(self, system, scenarios, **kw)
+
+    monkeypatch.setattr(batch.BatchSimulator, "__init__", counting)
+    together = run_scenarios(st, runs, batched=True)
+    assert sizes == [2]
+    for a, b in zip(alone, together):
+        assert a.series.keys() == b.series.keys()
+        for k in a.series:
+            np.testing.assert_allclose(b.series[k], a.series[k], rtol=0, atol=1e-10, err_msg=k)
+    monkeypatch.setattr(batch, "member_signals", lambda systems: None)
+    wrong = run_scenarios(st, runs, batched=True)
+    assert any(len(w.series["sg_speed"]) != len(a.series["sg_speed"])
+               or np.abs(w.series["sg_speed"] - a.series["sg_speed"]).max() > 1e-6
+               for w, a in zip(wrong, alone))
+
+
 def test_a_member_rerun_alone_keeps_the_samples_of_its_own_run():
     """A batch member whose step had to be halved is re-run alone: its controller's log starts
     again, while the policy's own log of design states still holds the batched attempt's
@@ -184,10 +294,11 @@ def test_a_batch_whose_simulator_raises_runs_its_members_one_by_one(monkeypatch)
 
 
 def test_runs_of_one_controller_share_one_policy_call_per_sample(tmp_path, monkeypatch):
-    """In each batch (one load) the two ratings' runs of the HJI controller (one trained
-    controller: designed at high load for both) and of (29) (a policy object per run, the same
-    parameters) have equal law keys (the policy's content, not the controller's name), so the
-    batch samples each pair with one policy call; the table equals the scalar sweep's."""
+    """In the batch (both loads, both ratings) the four runs of the HJI controller (one
+    trained controller: designed at high load for both loads) and of (29) (a policy object per
+    run, the same parameters) have equal law keys (the policy's content, not the controller's
+    name), so the batch samples each four with one policy call; the table equals the scalar
+    sweep's."""
     from weakgrid.study.law import StudyLaw
 
     st = _two_ratings_two_loads(["hji", "nonlinear-29"])
@@ -205,7 +316,7 @@ def test_runs_of_one_controller_share_one_policy_call_per_sample(tmp_path, monke
     batched = run_study_sweep(st, tmp_path / "batched", quick=True, workers=0, progress=False,
                               batched=True)
     assert len(scalar) == 8 and (scalar["status"] != "failed").all()
-    assert sizes and set(sizes) == {2}
+    assert sizes and set(sizes) == {4}
     pd.testing.assert_frame_equal(scalar.drop(columns=TIMES), batched.drop(columns=TIMES),
                                   rtol=1e-8)
 

@@ -40,14 +40,16 @@ it for large batches; the linear solves stay per member (LAPACK through
 :mod:`weakgrid.sim.linsolve`, exactly the one-by-one factorization and solve).
 
 Per-member parameters: a member may bring its own grid (``scenario["system"]``, e.g. built by a
-sweep at its point) that differs from the others only in the parameters its components declare
+sweep at its point) that differs from the others only in its operating point (its loads, power
+flow, initial point and the machines' initial signals: each member's network matrix is its own)
+and in the parameters its components declare
 batchable (:attr:`Component.batch_params`, e.g. the UPQC's rating ``Vmax``): these are held as
 ``(B, n)`` arrays, a row per member, bound into the evaluating copy like the controllers'
 inputs. Members whose grids differ in anything else (:func:`system_fingerprint`) go to different
 batches.
 
 Scope: dense networks (``nb <= system.DENSE_NETWORK_MAX``), members whose grids differ only in
-batchable parameters, events that change the network (:class:`Fault`,
+their loads and batchable parameters, events that change the network (:class:`Fault`,
 :class:`LineTrip`, :class:`LoadStep`). A member outside it (a :class:`GeneratorTrip`, a model
 whose limits move with the solution or with discrete memory) is run one-by-one by
 :func:`simulate_batch`; the results are the same, only slower.
@@ -191,40 +193,105 @@ def batch_unsupported(system, events=()) -> str | None:
     return None
 
 
-def system_fingerprint(system) -> str:
-    """A digest of everything of a set-up ``system`` but its batchable parameters
-    (:attr:`Component.batch_params`): grids with equal fingerprints can be members of one batch,
-    each with its own values of those parameters."""
+#: attributes of a set-up :class:`System` that are its operating point, not its structure:
+#: the initial point, the power flow's result, the load admittances and the network matrices
+#: they enter, the machines' initial signals (held per member by :class:`BatchSimulator`)
+OPERATING_POINT = ("z0", "y_load", "Yr", "Yr_dense", "_Yr_mv", "Yr_coo", "sig_defaults",
+                   "_sig_stack")
+
+
+def _bp_get(c, name):
+    """Value of the batchable parameter ``name`` of component ``c``: a parameter (``c.p``)
+    or a set-point its initialization computed (an attribute)."""
+    return c.p[name] if name in c.p else getattr(c, name, None)
+
+
+def _bp_set(c, name, value):
+    if name in c.p:
+        c.p[name] = value
+    else:
+        setattr(c, name, value)
+
+
+def _masked(system):
+    """``[(setter, saved value)]`` after setting everything of ``system`` that members of a
+    batch may hold of their own to None: the batchable parameters
+    (:attr:`Component.batch_params`), the last evaluation's values (:attr:`Component.scratch`),
+    :data:`OPERATING_POINT` and the network's loads (``PD``, ``QD``) and power flow."""
+    from .network import PD, QD
+
     saved = []
+
+    def put(setter, old, new):
+        saved.append((setter, old))
+        setter(new)
+
     for c in system.comps:
         for name in getattr(c, "batch_params", ()):
             if name in c.p:
-                saved.append((c, name, c.p[name], [v.get(name) for v in c._values]))
-                c.p[name] = None
+                put(lambda v, c=c, n=name: c.p.__setitem__(n, v), c.p[name], None)
                 for v in c._values:
-                    v[name] = None
+                    put(lambda x, v=v, n=name: v.__setitem__(n, x), v.get(name), None)
+            elif hasattr(c, name):
+                put(lambda v, c=c, n=name: setattr(c, n, v), getattr(c, name), None)
+        for name in getattr(c, "scratch", ()):
+            if hasattr(c, name):
+                put(lambda v, c=c, n=name: setattr(c, n, v), getattr(c, name), None)
+    for name in OPERATING_POINT:
+        if hasattr(system, name):
+            put(lambda v, n=name: setattr(system, n, v), getattr(system, name), None)
+    net = system.network
+    put(lambda v: setattr(net, "pf", v), getattr(net, "pf", None), None)
+    tables = [net.bus] + ([net.case["bus"]] if isinstance(getattr(net, "case", None), dict)
+                          and "bus" in net.case else [])
+    for tab in tables:
+        cols = tab[:, [PD, QD]].copy()
+
+        def setter(v, tab=tab):
+            tab[:, [PD, QD]] = v
+        put(setter, cols, 0.0)
+    return saved
+
+
+def system_fingerprint(system) -> str:
+    """A digest of everything of a set-up ``system`` but what the members of a batch hold of
+    their own: its batchable parameters (:attr:`Component.batch_params`, including the
+    set-points its initialization computed), its loads and its operating point (the initial
+    point, the power flow, the load admittances: :data:`OPERATING_POINT`). Grids with equal
+    fingerprints can be members of one batch; grids that differ in their topology, lines,
+    shunts, devices, models or other parameters cannot."""
+    saved = _masked(system)
     try:
         blob = pickle.dumps(system, protocol=pickle.HIGHEST_PROTOCOL)
     finally:
-        for c, name, val, vals in saved:
-            c.p[name] = val
-            for v, x in zip(c._values, vals):
-                v[name] = x
+        for setter, val in reversed(saved):
+            setter(val)
     return hashlib.sha256(blob).hexdigest()
 
 
 def member_params(systems) -> list:
-    """``[(component index, name, (B, n) array)]``: the batchable parameters whose values differ
-    between the member grids ``systems`` (equal :func:`system_fingerprint`), a row per member."""
+    """``[(component index, name, (B, n) array)]``: the batchable parameters (and
+    initialization set-points) whose values differ between the member grids ``systems``
+    (equal :func:`system_fingerprint`), a row per member."""
     out = []
     for j, c in enumerate(systems[0].comps):
         for name in getattr(c, "batch_params", ()):
-            if name not in c.p:
+            if _bp_get(c, name) is None:
                 continue
-            rows = [xp.asarray(s.comps[j].p[name], dtype=float) for s in systems]
+            rows = [xp.asarray(_bp_get(s.comps[j], name), dtype=float) for s in systems]
             if any(not xp.array_equal(r, rows[0]) for r in rows[1:]):
                 out.append((j, name, xp.stack(rows)))
     return out
+
+
+def member_signals(systems):
+    """The machines' initial signals (``System._sig_stack``, ``(n_sig, n_machines)``) of the
+    member grids ``systems`` stacked on a batch axis, ``(n_sig, B, n_machines)``; None when
+    they are equal."""
+    rows = [s._sig_stack for s in systems]
+    if all(xp.array_equal(r, rows[0]) for r in rows[1:]):
+        return None
+    return xp.stack(rows, axis=1)
 
 
 def _member_system(system, scenario):
@@ -286,13 +353,14 @@ class BatchSimulator:
                 raise DataError("simulate_batch", "events", why, "run this scenario one by one (Simulator.run)")
             if msys is not system and system_fingerprint(msys) != fp:
                 raise DataError("simulate_batch", f"scenarios[{k}].system", "a different grid",
-                                "a member's grid may differ from the batch's only in batchable "
-                                "parameters (Component.batch_params); batch it with its own grid "
+                                "a member's grid may differ from the batch's only in its loads and "
+                                "batchable parameters (Component.batch_params); batch it with its own grid "
                                 "(simulate_batch groups them)")
             self.sims.append(Simulator(copy.deepcopy(msys), **sim_kw))
         # batchable parameters that differ: one (B, n) array each, bound like the inputs
         self._params = [(self.tmpl.comps[j], name, stack)
                         for j, name, stack in member_params([s.sys for s in self.sims])]
+        self._signals = member_signals([s.sys for s in self.sims])   # initial signals
         self.nx, self.N = system.nx, system.N
         # controller outputs and other inputs a member changes: one (B, n) array per attribute,
         # each member's component holding a row view of it (Component.batch_inputs)
@@ -327,7 +395,10 @@ class BatchSimulator:
             setattr(c, attr, a if rep == 1 else xp.repeat(a, rep, axis=0))
         for c, name, stack in self._params:
             a = stack[rows]
-            c.p[name] = a if rep == 1 else xp.repeat(a, rep, axis=0)
+            _bp_set(c, name, a if rep == 1 else xp.repeat(a, rep, axis=0))
+        if self._signals is not None:   # Context reads them with the batch axis
+            a = self._signals[:, rows]
+            self.tmpl._sig_stack = a if rep == 1 else xp.repeat(a, rep, axis=1)
 
     def _sync_network(self, rows):
         for k in rows:
@@ -1122,8 +1193,8 @@ def simulate_batch(system, scenarios, t_end, batch_size=64, exact=True, on_failu
     scenarios : list of dict
         ``{"events": [...], "controllers": [...], "system": System}`` per scenario (fresh
         objects per scenario; ``system``: the scenario's own grid, default the argument).
-        Scenarios whose grids differ only in batchable parameters share batches, each with
-        its own values (:func:`system_fingerprint`).
+        Scenarios whose grids differ only in their loads (operating point) and batchable
+        parameters share batches, each with its own values (:func:`system_fingerprint`).
     t_end : float
         Final time [s].
     batch_size : int

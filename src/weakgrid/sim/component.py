@@ -60,7 +60,8 @@ class Context:
         self.I = np.zeros(V.shape, dtype=complex)
         # one copy of the stacked defaults; the dict holds row views of it
         S = system._sig_stack
-        if x.ndim > 1:   # a batch of points (leading axis): one row block per point
+        if x.ndim > 1 and S.ndim == 2:   # a batch of points (leading axis): one row block per
+            # point (a batch simulator may bind its members' own, (n_sig, B, n): weakgrid.sim.batch)
             S = np.broadcast_to(S[:, None, :], (S.shape[0],) + x.shape[:-1] + (S.shape[1],))
         self.sig = dict(zip(system._sig_keys, S.copy()))
         self.out = {}
@@ -124,8 +125,14 @@ class Component:
     #: parameters (names of :attr:`params`) that the members of a batch may hold with different
     #: values (:mod:`weakgrid.sim.batch`): read from ``self.p`` only when evaluating (nothing is
     #: derived from them at setup), so a ``(B, n)`` array of them broadcasts as the batched
-    #: variables do. A parameter outside this list that differs puts members in different batches
+    #: variables do; and set-points that :meth:`init` computes from the operating point (an
+    #: exciter's ``vref0``: attributes over the instances, read only when evaluating), so that
+    #: grids at different loads share a batch. A parameter outside this list that differs puts
+    #: members in different batches
     batch_params: tuple[str, ...] = ()
+    #: attributes holding the last evaluation's intermediate values (not the grid's data):
+    #: ignored when the batch simulator compares grids (:func:`weakgrid.sim.batch.system_fingerprint`)
+    scratch: tuple[str, ...] = ()
     #: outputs that record zero once an instance is disconnected (its power and currents)
     injection_outputs: tuple[str, ...] = ()
     #: per instance 1.0 (connected) or 0.0 (disconnected by a generator trip); None: all connected

@@ -41,6 +41,10 @@ class GTI(Component):
     """Vectorized grid-tie inverters; add instances with :meth:`add_gti`."""
 
     kind = "device"
+    #: set-points computed at init (from the operating point): per batch member
+    batch_params = ("Pin", "phi0", "Vs0", "Q0", "Pac0")
+    #: the last evaluation's values (read by ``finish``)
+    scratch = ("_Pac", "_Q", "_Vs", "_ks", "_phis")
     order = 0
     params = (
         Param("C", 0.01, "pu·s (Sb)", "dc-link capacitance (energy C*Vc^2/2 in pu·s)", "pos"),

@@ -2,12 +2,15 @@
 
 A batched simulator (:func:`weakgrid.sim.batch.simulate_batch`) advances many scenarios of the
 same grid at once (issue #21). A sweep hands it the runs that share :func:`batch_key` — the
-study, the load level and UPQC structure of the run's scenario, the grid variant of its
-controller (the PQ and no-PSS baselines change the grid), the simulated time, the step factor
-and the event times off the step grid (members step together) — and they may differ in
-anything else: the UPQC rating (a batchable parameter of the device,
-:attr:`weakgrid.sim.component.Component.batch_params`), fault times on the step grid, the
-controller and the load it is designed at.
+study, the UPQC structure of the run's scenario, the grid variant of its controller (the PQ and
+no-PSS baselines change the grid), the simulated time, the step factor and the event times off
+the step grid (members step together) — and they may differ in anything else: the UPQC rating
+(a batchable parameter of the device,
+:attr:`weakgrid.sim.component.Component.batch_params`), the load level (each member holds its
+own load admittances and the set-points its initialization computed from them), fault times on
+the step grid, the controller and the load it is designed at. The batch simulator compares the
+members' grids itself (:func:`weakgrid.sim.batch.system_fingerprint`) and splits those that
+differ otherwise.
 
 :func:`simulate_many` prepares every run of a batch (its grid, events and digital
 controller: :func:`weakgrid.study.sweep.prepare_point`), simulates them together
@@ -34,8 +37,9 @@ log = logging.getLogger(__name__)
 
 def batch_key(inputs: dict) -> tuple:
     """The grid and the steps a sweep run (the input of :func:`weakgrid.study.sweep.run_point`)
-    needs: ``(study name, scenario's load level, UPQC structure, the controller's grid variant,
-    t_end [s], step factor, event times off the step grid)``. Runs with equal keys share one
+    needs: ``(study name, scenario's UPQC structure, the controller's grid variant, t_end [s],
+    step factor, event times off the step grid)`` (not the load level: the members of a batch
+    hold their own loads). Runs with equal keys share one
     batched simulation, in lockstep."""
     from types import SimpleNamespace
 
@@ -47,7 +51,7 @@ def batch_key(inputs: dict) -> tuple:
     t_end = inputs.get("t_end") or sc.get("t_end")
     factor = float(inputs.get("dt_factor") or 1.0)
     dt, _ = sim_settings(SimpleNamespace(data=study), factor)
-    return (study["study"]["name"], sc.get("load"), sc.get("upqc"),
+    return (study["study"]["name"], sc.get("upqc"),
             controller_variant(SimpleNamespace(data=study), inputs["controller"]),
             None if t_end is None else float(t_end), factor,
             event_breakpoints(sc.get("events") or (), dt))

@@ -29,6 +29,8 @@ class EXDC2(MachineControl):
     VRMAX, VRMIN [pu]; E1, SE1, E2, SE2 (saturation) [pu]."""
 
     kind = "exciter"
+    #: the voltage reference computed at init (from the operating point): per batch member
+    batch_params = ("vref0",)
     order = 2
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("TR", "KA", "TA", "TB", "TC", "VRMAX", "VRMIN", "KE", "TE", "KF1", "TF1",

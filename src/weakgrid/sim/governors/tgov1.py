@@ -26,6 +26,8 @@ class TGOV1(MachineControl):
     """Steam turbine-governor TGOV1. Parameters: R, VMAX, VMIN, Dt [pu, turbine base]; T1, T2, T3 [s]."""
 
     kind = "governor"
+    #: the power reference computed at init (from the operating point): per batch member
+    batch_params = ("pref0",)
     order = 2
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("R", "T1", "VMAX", "VMIN", "T2", "T3", "Dt")

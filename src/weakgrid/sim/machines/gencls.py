@@ -39,6 +39,8 @@ class GENCLS(SyncMachine):
 
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("H", "D")
+    #: the last evaluation's value (read by ``finish``)
+    scratch = ("_te",)
 
     @classmethod
     def psse_params(cls, values, ctx):

@@ -50,6 +50,8 @@ class GENROU(SyncMachine):
     xl, xd, xq, xd2, xq1, xq2 [pu]; Td10, Td20, Tq10, Tq20 [s]; S10, S12 [pu].
     """
 
+    #: the last evaluation's values (read by ``finish``)
+    scratch = ("_te", "_XadIfd")
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("Td10", "Td20", "Tq10", "Tq20", "H", "D", "xd", "xq", "xd1", "xq1", "xd2",
                    "xl", "S10", "S12")
