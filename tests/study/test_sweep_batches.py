@@ -25,6 +25,35 @@ def _two_ratings_two_loads(controllers):
     return study_from_dict(d)
 
 
+def _alone_and_together(st, runs, monkeypatch):
+    """``(runs alone, runs batched, the batch sizes the batched call made)``."""
+    import weakgrid.sim.batch as batch
+    from weakgrid.study.runner import run_scenarios
+
+    alone = run_scenarios(st, runs, batched=False)
+    sizes = []
+    real = batch.BatchSimulator.__init__
+
+    def counting(self, system, scenarios, **kw):
+        sizes.append(len(scenarios))
+        real(self, system, scenarios, **kw)
+
+    monkeypatch.setattr(batch.BatchSimulator, "__init__", counting)
+    return alone, run_scenarios(st, runs, batched=True), sizes
+
+
+def _same_metrics(a, b):
+    """Run records ``a`` and ``b`` have the same metrics (floats to 1e-8), wall time aside."""
+    ma, mb = (dict(r.metrics) for r in (a, b))
+    ma.pop("wall_s"), mb.pop("wall_s")
+    assert ma.keys() == mb.keys()
+    for k in ma:
+        if isinstance(ma[k], float):
+            assert mb[k] == pytest.approx(ma[k], rel=1e-8, abs=1e-12, nan_ok=True), k
+        else:
+            assert mb[k] == ma[k], k
+
+
 def test_the_case1_quick_sweep_is_one_batch():
     """The ratings, the loads and the controllers share a batch: the rating is a per-member
     parameter of the batched simulator, the load a member's own admittances and the set-points
@@ -149,14 +178,7 @@ def test_a_studys_runs_simulated_together_equal_their_runs_alone():
     alone = run_scenarios(st, runs, batched=False)
     together = run_scenarios(st, runs, batched=True)
     for a, b in zip(alone, together):
-        ma, mb = (dict(r.metrics) for r in (a, b))
-        ma.pop("wall_s"), mb.pop("wall_s")
-        assert ma.keys() == mb.keys()
-        for k in ma:
-            if isinstance(ma[k], float):
-                assert mb[k] == pytest.approx(ma[k], rel=1e-8, abs=1e-12, nan_ok=True), k
-            else:
-                assert mb[k] == ma[k], k
+        _same_metrics(a, b)
         for d_a, d_b in ((a.series, b.series), (a.samples, b.samples)):
             assert d_a.keys() == d_b.keys()
             for k in d_a:
@@ -169,34 +191,17 @@ def test_runs_at_both_loads_simulated_in_one_batch_equal_their_runs_alone(monkey
     initial point and set-points) gives each run's trajectories to 1e-10 and its metrics."""
     import numpy as np
 
-    import weakgrid.sim.batch as batch
-    from weakgrid.study.runner import Run, run_scenarios
+    from weakgrid.study.runner import Run
 
     st = load_study("case1-weak-grid")
     sc = dict(next(s for s in st.scenarios() if s["id"] == "c1-high-conv"), t_end=0.4)
     runs = [Run.of(st, dict(sc, load=load), c)
             for load in ("high", "low") for c in ("nonlinear-29", "hji")]
     assert [r.load for r in runs] == ["high", "high", "low", "low"]
-    alone = run_scenarios(st, runs, batched=False)
-    sizes = []
-    real = batch.BatchSimulator.__init__
-
-    def counting(self, system, scenarios, **kw):
-        sizes.append(len(scenarios))
-        real(self, system, scenarios, **kw)
-
-    monkeypatch.setattr(batch.BatchSimulator, "__init__", counting)
-    together = run_scenarios(st, runs, batched=True)
+    alone, together, sizes = _alone_and_together(st, runs, monkeypatch)
     assert sizes == [4]                      # one batch holds both loads
     for a, b in zip(alone, together):
-        ma, mb = (dict(r.metrics) for r in (a, b))
-        ma.pop("wall_s"), mb.pop("wall_s")
-        assert ma.keys() == mb.keys()
-        for k in ma:
-            if isinstance(ma[k], float):
-                assert mb[k] == pytest.approx(ma[k], rel=1e-8, abs=1e-12, nan_ok=True), k
-            else:
-                assert mb[k] == ma[k], k
+        _same_metrics(a, b)
         assert a.series.keys() == b.series.keys()
         for k in a.series:
             np.testing.assert_allclose(b.series[k], a.series[k], rtol=0, atol=1e-10, err_msg=k)
@@ -220,16 +225,7 @@ def test_machines_without_controls_keep_their_own_initial_signals_in_a_mixed_loa
     st = study_from_dict(d, source=src)
     sc = dict(next(s for s in st.scenarios() if s["id"] == "c1-high-conv"), t_end=0.4)
     runs = [Run.of(st, dict(sc, load=load), "nonlinear-29") for load in ("high", "low")]
-    alone = run_scenarios(st, runs, batched=False)
-    sizes = []
-    real = batch.BatchSimulator.__init__
-
-    def counting(self, system, scenarios, **kw):
-        sizes.append(len(scenarios))
-        real(self, system, scenarios, **kw)
-
-    monkeypatch.setattr(batch.BatchSimulator, "__init__", counting)
-    together = run_scenarios(st, runs, batched=True)
+    alone, together, sizes = _alone_and_together(st, runs, monkeypatch)
     assert sizes == [2]
     for a, b in zip(alone, together):
         assert a.series.keys() == b.series.keys()
