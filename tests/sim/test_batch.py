@@ -23,6 +23,23 @@ from weakgrid.sim.integrate import Simulator
 
 DT = 5e-3
 
+#: NumPy 2 (with SciPy's OpenBLAS) gives a member's batched run the arithmetic of its run alone,
+#: bit for bit where the checks below say "equal". NumPy 1.26 (.ci/lowest.txt) rounds a
+#: vectorized kernel over (B, n) rows differently from one (n,) row, depending on the arrays'
+#: alignment (its SIMD loops): measured 1e-11 relative in a policy's outputs and 1.2e-8 pu in
+#: states, enough to move a Newton count by one. There the checks are to round-off instead.
+EXACT = np.lib.NumpyVersion(np.__version__) >= "2.0.0"
+
+
+def _equal_logs(a, b):
+    """Two sample logs equal: bit for bit on NumPy 2, to round-off (1e-9 relative) on 1.26."""
+    a, b = np.array(a), np.array(b)
+    assert a.shape == b.shape
+    if EXACT:
+        assert np.array_equal(a, b)
+    else:
+        np.testing.assert_allclose(b, a, rtol=1e-9, atol=1e-12)
+
 
 def _alone(system, sc, t_end, **kw):
     return Simulator(copy.deepcopy(system), **kw).run(
@@ -37,7 +54,11 @@ def _same(a, b, atol_states=1e-10, rtol_outputs=1e-9):
     assert a.data.shape == b.data.shape, (a.data.shape, b.data.shape)
     np.testing.assert_allclose(b.t, a.t, atol=1e-12)
     # the same steps, Newton iterations, Jacobians, factorizations and evaluations
-    assert a.stats == b.stats
+    if EXACT:
+        assert a.stats == b.stats
+    else:   # NumPy 1.26: round-off may move a Newton count (EXACT)
+        assert a.stats["steps"] == b.stats["steps"]
+        atol_states, rtol_outputs = max(atol_states, 1e-7), max(rtol_outputs, 1e-5)
     assert (a.failure is None) == (b.failure is None)
     if a.failure is not None:
         assert (a.failure.cause, str(a.failure)) == (b.failure.cause, str(b.failure))
@@ -288,7 +309,7 @@ def test_controlled_at_T_1ms_batched_samples_equal_one_by_one():
         _same(a, b)
         da, db = ca["controllers"][0], cb["controllers"][0]
         assert da.log_t == db.log_t
-        assert np.array_equal(np.array(da.log_u), np.array(db.log_u))
+        _equal_logs(da.log_u, db.log_u)
     u0, u2 = (np.array(sc[k]["controllers"][0].log_u) for k in (0, 2))
     assert u0.shape == u2.shape and np.abs(u0 - u2).max() > 1e-4      # the members' outputs differ
     assert sc[0]["controllers"][0].K.calls <= round((tf - 0.25) / T) + 2    # one call per instant
@@ -420,4 +441,4 @@ def test_policy_objects_with_one_batch_key_are_sampled_in_one_call():
     for a, b, ca, cb in zip(alone, got, alone_sc, sc):
         _same(a, b)
         la, lb = ca["controllers"][0].K.log, cb["controllers"][0].K.log
-        assert len(la) == len(lb) and np.array_equal(np.array(la), np.array(lb))
+        _equal_logs(la, lb)

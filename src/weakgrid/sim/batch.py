@@ -383,7 +383,6 @@ class BatchSimulator:
         nb = system.nb
         self.Y = xp.empty((self.B, 2 * nb, 2 * nb))
         self._ynet = [None] * self.B
-        self._alg_A = [None] * self.B     # (the member's algebraic factor, its J_yy) each
         self.timing = dict.fromkeys(TIMED, 0.0)
         self.steps = 0
         self.halved = 0
@@ -479,22 +478,12 @@ class BatchSimulator:
 
     def _alg_solve(self, ks, R):
         """``A_k x = R[i]`` for members ``k = ks[i]``, ``A_k`` the member's algebraic block
-        ``J_yy`` (factorized when its own :meth:`Simulator._alg_lu_get` refactorizes): one
-        stacked LAPACK ``gesv`` for all of them — ``getrf`` and ``getrs``, the arithmetic of
-        the member's factor and solve alone, bit for bit (tests/sim/test_batch.py); a singular
-        block (no ``gesv``) falls back to the members' own factors (NaN/inf, as alone)."""
-        A = self._alg_A
-        lus = []
-        for k in ks:
-            sim = self.sims[k]
-            lu = sim._alg_lu_get()
-            if A[k] is None or A[k][0] is not lu:
-                A[k] = (lu, sim.linsolver._full()[self.nx:, self.nx:])
-            lus.append(lu)
-        try:
-            return xp.linalg.solve(xp.stack([A[k][1] for k in ks]), R[..., None])[..., 0]
-        except np.linalg.LinAlgError:
-            return xp.stack([lu.solve(r) for lu, r in zip(lus, R)])
+        ``J_yy``, each with the member's own factor (:meth:`Simulator._alg_lu_get`, LAPACK
+        ``getrs``: the arithmetic of its run alone). A stacked ``numpy.linalg.solve`` was tried:
+        bit-equal where NumPy and SciPy share one LAPACK (NumPy 2 with SciPy's OpenBLAS), 1e-8
+        off with another Newton count under NumPy 1.26's own OpenBLAS (.ci/lowest.txt), and it
+        saved little (the chord's time is its residual evaluations)."""
+        return xp.stack([self.sims[k]._alg_lu_get().solve(r) for k, r in zip(ks, R)])
 
     def _solve(self, lus, idx, R):
         """Chord solves ``M_j x = R[i]`` for ``j = idx[i]`` with each member's LU factors (LAPACK
