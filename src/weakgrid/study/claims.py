@@ -37,22 +37,15 @@ from __future__ import annotations
 
 import fnmatch
 import inspect
-import math
 
-from .stability import run_instability
+from .stability import metric, run_instability
 from .ties import compare, run_uncertainty, unc_text
 
 __all__ = ["RULES", "STABILITY_NOTE", "judge_all", "judge_claim", "stability_gate"]
 
 
-def _value(v):
-    """``v``, or None when it is missing or NaN (a metric undefined for the run)."""
-    return None if v is None or (isinstance(v, float) and math.isnan(v)) else v
-
-
 def _get(m, rid, key):
-    r = m.get(rid)
-    return None if r is None else _value(r.get(key))
+    return metric(m.get(rid), key)
 
 
 def _fmt(v, unit="", nd=3):
@@ -77,10 +70,13 @@ STABILITY_NOTE = (
     "overshoot or settling, each run must be stable: finished (no voltage collapse, loss of "
     "synchronism, Newton failure), SG speed and dc link neither unstable (growing, or running "
     "away from the set-point: ending at its largest deviation, on one side of the set-point "
-    "and still moving away) nor undamped (stability verdict). A pair where the claim's run "
+    "and still moving away) nor undamped (stability verdict), and back: a signal that never "
+    "enters its 2 % band and ends beyond half its peak deviation from its set-point is not "
+    "stable. A pair where the claim's run "
     "is not stable is 'not' (named); where only the baseline is not stable, a win without "
     "comparing numbers (named); where both are not stable, 'not' — both runs unstable: no "
     "comparison (a map shows such a cell as 'no comparison').")
+
 
 def stability_gate(m, ia, ib, baseline_unstable="reproduced"):
     """The verdict of a pair decided by stability alone, or None when both runs are stable.

@@ -23,7 +23,7 @@ import math
 
 from .failure import failure_kind
 
-__all__ = ["RETURN_FRACTION", "STABILITY_SIGNALS", "run_failed", "run_instability"]
+__all__ = ["RETURN_FRACTION", "STABILITY_SIGNALS", "metric", "run_failed", "run_instability"]
 
 #: The signals whose stability a run is judged on: metric prefix → name in the verdict text
 #: (the runner's ``<prefix>_verdict``).
@@ -35,7 +35,9 @@ STABILITY_SIGNALS = (("speed", "SG speed"), ("vdc", "dc link"))
 RETURN_FRACTION = 0.5
 
 
-def _get(r, key):
+def metric(r, key):
+    """Metric ``key`` of run ``r`` (a dict or a table row; None: no run), or None when it is
+    missing or NaN (undefined for the run)."""
     v = r.get(key) if r is not None else None
     return None if v is None or (isinstance(v, float) and math.isnan(v)) else v
 
@@ -45,8 +47,8 @@ def run_failed(r) -> bool:
     ``failed`` flag, or a sweep row's ``status`` other than ``"ok"``."""
     if r is None:
         return False
-    status = _get(r, "status")
-    return bool(_get(r, "failed")) or (status is not None and status != "ok")
+    status = metric(r, "status")
+    return bool(metric(r, "failed")) or (status is not None and status != "ok")
 
 
 def run_instability(r) -> str:
@@ -61,15 +63,15 @@ def run_instability(r) -> str:
     otherwise), and so is a signal whose verdict is ``too short``.
     """
     if run_failed(r):
-        return f"failed: {failure_kind(_get(r, 'failure')) or 'failed'}"
+        return f"failed: {failure_kind(metric(r, 'failure')) or 'failed'}"
     why = []
     for key, name in STABILITY_SIGNALS:
-        v = _get(r, f"{key}_verdict")
+        v = metric(r, f"{key}_verdict")
         if v in ("unstable", "undamped"):
             why.append(f"{name} {v}")
         elif v != "too short" and r is not None and f"{key}_settling_s" in r \
-                and _get(r, f"{key}_settling_s") is None:
-            fin, pk = _get(r, f"{key}_final_dev_pu"), _get(r, f"{key}_peak_dev_pu")
+                and metric(r, f"{key}_settling_s") is None:
+            fin, pk = metric(r, f"{key}_final_dev_pu"), metric(r, f"{key}_peak_dev_pu")
             if fin is not None and pk and abs(fin) > RETURN_FRACTION * pk:
                 why.append(f"{name} not back (ends {abs(fin):.3g} pu from its set-point, "
                            f"{abs(fin) / pk * 100:.0f} % of its peak deviation)")
