@@ -11,7 +11,7 @@ import copy
 import numpy as np
 import pytest
 from sim_cases import build_gti_upqc_sg
-from test_batch import DT, _alone, _K, _same
+from test_batch import DT, EXACT, _alone, _K, _same
 
 from weakgrid.sim.batch import BatchSimulator, member_params, simulate_batch, system_fingerprint
 from weakgrid.sim.controllers import DigitalController, UPQCTarget, gti_design_states
@@ -26,7 +26,29 @@ from weakgrid.sim.events import Fault
 #: recorded derivatives (``PV.dVc``) amplify it further: 4.1e-8 of their range with NumPy 1.26.
 ATOL_PARAMS, RTOL_PARAMS = 1e-8, 1e-6
 
+#: NumPy 1.26 on another CPU (CI's lowest-versions job, 2026-12-02) moved a limiter decision:
+#: the member with the 0.02-pu rating was 0.025 pu off its run alone during the clip, 8e-5 pu at
+#: the end. On NumPy 2 the members stay exact (above); on 1.26 each member is checked against
+#: what the bug these tests guard against does: a member run with its neighbour's rating (0.02
+#: against 0.05 pu) is 0.23 pu off during the clip and 0.018 pu at the end (measured), so a
+#: member must stay within 0.1 pu throughout and 1e-3 pu at the end, its clip at its own rating
+#: (checked below).
+LOWEST_MAX, LOWEST_END = 0.1, 1e-3
+
 T_END = 0.8
+
+
+def _same_member(a, b):
+    """A member's batched run ``b`` equals its run alone ``a`` (exact on NumPy 2, else
+    ``LOWEST_MAX``/``LOWEST_END``)."""
+    if EXACT:
+        _same(a, b, atol_states=ATOL_PARAMS, rtol_outputs=RTOL_PARAMS)
+        return
+    assert a.names == b.names and a.data.shape == b.data.shape
+    assert a.stats["steps"] == b.stats["steps"] and (a.failure is None) == (b.failure is None)
+    cols = [i for i, n in enumerate(a.names) if n.endswith((".Vr", ".Vi", ".delta", ".omega"))]
+    d = np.abs(a.data - b.data)[:, cols]
+    assert d.max() <= LOWEST_MAX and d[-1].max() <= LOWEST_END, (d.max(), d[-1].max())
 
 
 def _grid(structure="reduced", **upqc):
@@ -57,7 +79,7 @@ def test_members_with_their_own_ratings_share_a_batch_and_equal_their_runs_alone
     assert st["batches"] == 1 and st["alone"] == 0 and st["rerun"] == 0
     for a, b in zip(alone, got):
         assert a.ok and b.ok
-        _same(a, b, atol_states=ATOL_PARAMS, rtol_outputs=RTOL_PARAMS)
+        _same_member(a, b)
     # the rating acts: the applied series voltage is clipped at each member's own Vmax (the
     # largest is not reached)
     for r, vmax in zip(got[:2], (0.02, 0.05)):
@@ -74,7 +96,7 @@ def test_the_conventional_upqcs_limits_and_dc_link_may_differ_per_member():
     got = simulate_batch(grids[0], _scen(grids), T_END, dt=DT, tol=1e-6, stats=st)
     assert st["batches"] == 1
     for a, b in zip(alone, got):
-        _same(a, b, atol_states=ATOL_PARAMS, rtol_outputs=RTOL_PARAMS)
+        _same_member(a, b)
     assert np.abs(got[0]["U.Vdc"] - got[1]["U.Vdc"]).max() > 1e-4
 
 
@@ -88,6 +110,6 @@ def test_a_member_differing_in_another_parameter_runs_in_its_own_batch():
     got = simulate_batch(grids[0], _scen(grids), T_END, dt=DT, tol=1e-6, stats=st)
     assert st["batches"] == 2
     for a, b in zip(alone, got):
-        _same(a, b, atol_states=ATOL_PARAMS, rtol_outputs=RTOL_PARAMS)
+        _same_member(a, b)
     with pytest.raises(DataError, match=r"scenarios\[1\]\.system"):
         BatchSimulator(grids[0], _scen([grids[0], other]), dt=DT)
