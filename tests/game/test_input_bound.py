@@ -18,7 +18,7 @@ from weakgrid.game import (
 )
 from weakgrid.game.controller import controller_from_dict
 from weakgrid.game.dynamic_programming import DPSettings, solve_game_dp
-from weakgrid.game.input_bound import InputBound
+from weakgrid.game.input_bound import POINTWISE_MAX, InputBound
 from weakgrid.game.optimality import closed_loop_gap, default_starts, value_error
 
 # an open-loop stable oscillator (|λ| = 0.964): with a bounded control and an unbounded
@@ -118,6 +118,28 @@ def test_one_point_path_equals_the_vectorized_iteration(shape, m):
         np.testing.assert_allclose(u, U[k], rtol=1e-12, atol=1e-15 * 0.15)
         assert inf1["n_unconverged"] == 0 and inf1["max_residual"] < 1e-12
     assert info["n_unconverged"] == 0
+
+
+@pytest.mark.parametrize("shape", ["box", "disk"])
+def test_a_few_points_take_each_points_own_arithmetic(shape):
+    """Up to POINTWISE_MAX points (the rows of a small batch of controller samples) are solved
+    point by point: each row bit for bit what the point alone gives (a batched run's policy
+    outputs equal its run's alone), and the info sums the points' own."""
+    rng = np.random.default_rng(11)
+    bd = InputBound.for_inputs(2, 0.15, shape)
+    R = np.eye(2) * 0.8
+    n = 60
+    G = rng.normal(size=(n, 2, 2))
+    M = G @ np.swapaxes(G, -1, -2) * rng.uniform(0, 5, (n, 1, 1)) - 1.5 * R
+    b = rng.normal(size=(n, 2)) * 10.0 ** rng.uniform(-4, 2, (n, 1))
+    k = POINTWISE_MAX
+    for s in range(0, n, k):
+        U, info = bd.minimize(M[s:s + k], b[s:s + k], R, return_info=True)
+        alone = [bd.minimize(M[j], b[j], R, return_info=True) for j in range(s, min(s + k, n))]
+        assert np.array_equal(U, np.array([a[0] for a in alone]))
+        assert info["iterations"] == max(a[1]["iterations"] for a in alone)
+        assert info["n_unconverged"] == 0
+        assert info["max_residual"] == max(a[1]["max_residual"] for a in alone)
 
 
 def test_bound_settings_are_checked():
