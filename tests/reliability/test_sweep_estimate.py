@@ -89,7 +89,8 @@ def test_force_runs_and_cached_runs_are_free(ws, cli, monkeypatch):
     line = stdout.splitlines()[0]
     assert re.fullmatch(r"sweep: 2 runs \(0 cached\), ≈ \d+ CPU-s, ≈ \d+ s in this process, "
                         r"≈ [\d.e+-]+ GiB \(measured on this grid: [\d.e+-]+ ms per quiet step, "
-                        r"[\d.e+-]+ ms from a disturbance on\)", line), line
+                        r"[\d.e+-]+ ms from a disturbance on; [\d.e+-]+ ms per run's quiet step "
+                        r"in a batch of 2\)", line), line
     assert "2 runs, 0 failed" in stdout
     table = out / "case1-weak-grid-sweep.parquet"
     first = pd.read_parquet(table)
@@ -141,3 +142,53 @@ def test_bounded_trainings_are_estimated_with_their_own_basis():
     for k in keys:
         want = pr["train_bounded"] if k.startswith("hji-bounded:") else pr["train"]
         assert _training(pr, k) is want
+
+
+def _fake_probe(calls):
+    """A probe with round numbers: 1 ms a step (quiet or not), a batch of ``b`` runs
+    1 ms + 0.1 ms per run beyond the first, free set-up and trainings."""
+    from types import SimpleNamespace
+
+    free = SimpleNamespace(seconds=0.0, bytes=0.0)
+
+    def probe(inputs, steps=(10, 40), batch=1):
+        calls.append(batch)
+        return {"per_step_s": 1e-3, "transient_step_s": 1e-3, "per_run_s": 0.0, "n_vars": 10,
+                "train": free, "train_bounded": free, "batch": batch,
+                "batch_step_s": 1e-3 + 1e-4 * (batch - 1)}
+    return probe
+
+
+@pytest.mark.parametrize("workers, sizes", [(0, [12]), (2, [6, 6])])
+def test_a_batched_sweep_is_costed_by_its_batches(tmp_path, monkeypatch, workers, sizes):
+    """Case 1's quick sweep (12 runs of one grid): batched, it costs its batches — those the
+    sweep makes, one of 12 serially, two of 6 on 2 workers — each its steps at the probed cost
+    of a batched step (linear in the batch's size); one by one, 12 runs' steps (what the
+    estimate of a batched sweep said before it counted batches: 14 CPU-s for 8 s)."""
+    import weakgrid.study.sweep_estimate as se
+    from weakgrid.study.studyfile import load_study
+
+    calls = []
+    monkeypatch.setattr(se, "probe", _fake_probe(calls))
+    st = load_study("case1-weak-grid")
+    scalar = se.estimate_sweep(st, tmp_path / "c", quick=True, workers=workers, batched=False)
+    batched = se.estimate_sweep(st, tmp_path / "c", quick=True, workers=workers)
+    assert calls == [1, max(sizes)]
+    n = scalar.steps / 12                      # every run: the same steps
+    assert scalar.cpu_s == pytest.approx(12 * n * 1e-3)
+    assert batched.cpu_s == pytest.approx(sum(n * (1e-3 + 1e-4 * (b - 1)) for b in sizes))
+    assert batched.batch == max(sizes) and scalar.batch == 1
+    assert f"in a batch of {max(sizes)}" in batched.line() and "batch" not in scalar.line()
+
+
+def test_the_probe_times_a_batch_of_the_run():
+    """The real probe: a batch of 4 copies of the run, its quiet step at least one run's."""
+    from weakgrid.study.studyfile import load_study
+    from weakgrid.study.sweep import sweep_points
+    from weakgrid.study.sweep_estimate import batch_step_cost, probe
+
+    pts = sweep_points(load_study("case1-weak-grid"), quick=True)
+    pr = probe(pts[0].inputs, batch=4)
+    assert pr["batch"] == 4 and pr["batch_step_s"] >= pr["per_step_s"] > 0
+    assert batch_step_cost(pr, 1) == pr["per_step_s"]
+    assert batch_step_cost(pr, 4) == pytest.approx(pr["batch_step_s"])

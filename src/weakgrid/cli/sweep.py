@@ -57,7 +57,7 @@ def run(args) -> int:
         claim_sweep_outputs(st, out, args.quick, args.maps, args.force, write=False)
     # before anything is written: what the runs still to do will cost (refused beyond limits)
     est = estimate_sweep(st, out / "cache", quick=args.quick, workers=args.workers,
-                         scheduler=args.scheduler)
+                         scheduler=args.scheduler, batched=args.batched)
     print(est.line())
     check_sweep(est, st, quick=args.quick, force=args.force)
     try:

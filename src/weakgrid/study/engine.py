@@ -379,7 +379,8 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
             pts = [p for st in swept for p in sweep_points(st, quick)]
             # the shipped maps' sweep: its estimate is printed, never refused
             log(estimate_sweep(None, out / "sweep-cache", quick, workers=0 if serial else
-                               workers, scheduler=scheduler, points=pts).line("maps"))
+                               workers, scheduler=scheduler, points=pts,
+                               batched=batched).line("maps"))
             sweep_table = run_sweep(pts, run_point, cache_dir=out / "sweep-cache",
                                     workers=0 if serial else None, client=client,
                                     progress=progress, log=log, cost=run_cost,

@@ -7,7 +7,15 @@ the cost of a quiet step, the rest the fixed cost of a run: grid set-up, initial
 then one through the run's disturbances and 60 steps beyond (the cost of a step of the
 transient, ≈ 3× a quiet one: more Newton iterations and Jacobians). Every remaining run then
 costs ``fixed + quiet steps × quiet cost + steps from its first disturbance on × transient
-cost``; the HJI trainings (once per design point and worker process) come from
+cost``. A batched sweep (the default: the runs of one grid advance together,
+:mod:`weakgrid.study.batches`) is costed by its batches, grouped as the sweep will group them:
+the probe also times the first 10 and 40 steps of its largest batch (up to
+:data:`PROBE_BATCH` copies of the probed run, :func:`weakgrid.sim.batch.simulate_batch`), and a
+batch of ``B`` runs costs each run's fixed cost plus its steps at the cost of a batched step,
+interpolated linearly in ``B`` between the probe's one run and its batch (a batched step of
+``B`` runs costs far less than ``B`` steps: case 1's quick sweep, 12 runs, is estimated at
+14 CPU-s one by one and 8 CPU-s in its batch of 12, which took 8.2 s; 2026-12-02); the HJI
+trainings (once per design point and worker process) come from
 :func:`weakgrid.game.estimate.training_estimate`. Rough (±2×): on the development machine a
 case-1 run estimated at 1.4 s took 1.7 s, a case-2 run estimated at 5.5 s took 3.1 s (the
 transient right after a fault is the costliest part of a run). Runs already in
@@ -45,6 +53,7 @@ MAX_SECONDS = 1800.0          # the limits of a training (weakgrid.game.estimate
 PROBE_STEPS = (10, 40)
 TRANSIENT_STEPS = 60          # steps probed after the last disturbance
 CLUSTER_START_S = 2.0         # a local Dask cluster of 2 workers up and importing weakgrid
+PROBE_BATCH = 32              # the largest batch the probe times (larger ones: extrapolated)
 MAX_LISTED = 20000            # runs listed (and looked up in the cache) one by one
 
 
@@ -76,6 +85,10 @@ class SweepEstimate:
         Set when the sweep was too large to list (runs counted, cache not consulted).
     transient_step_s : float
         Measured cost of a step from the first disturbance on [s].
+    batch : int
+        The largest batch of the sweep (1: the runs one by one).
+    batch_step_s : float
+        Measured cost of one quiet step of a batch of ``batch`` runs [s] (all of them).
     """
 
     n_runs: int
@@ -91,6 +104,8 @@ class SweepEstimate:
     note: str = ""
     unlisted: str = ""
     transient_step_s: float = math.nan
+    batch: int = 1
+    batch_step_s: float = math.nan
 
     @property
     def n_todo(self) -> int:
@@ -111,9 +126,12 @@ class SweepEstimate:
             on = "in this process" if self.workers == 0 else \
                 f"on {self.workers} worker{'s' if self.workers != 1 else ''}"
             where = f"≈ {_duration(self.wall_s)} {on}"
+        batched = "" if self.batch <= 1 else \
+            (f"; {self.batch_step_s / self.batch * 1e3:.2g} ms per run's quiet step in a "
+             f"batch of {self.batch}")
         return (f"{head}, ≈ {_cpu(self.cpu_s)}, {where}, ≈ {self.bytes / GiB:.2g} GiB "
                 f"(measured on this grid: {self.per_step_s * 1e3:.2g} ms per quiet step, "
-                f"{self.transient_step_s * 1e3:.2g} ms from a disturbance on)")
+                f"{self.transient_step_s * 1e3:.2g} ms from a disturbance on{batched})")
 
 
 def _duration(s: float) -> str:
@@ -213,13 +231,16 @@ def _training(pr: dict, key: str):
     return pr["train_bounded"] if key.startswith("hji-bounded:") else pr["train"]
 
 
-def probe(inputs: dict, steps=PROBE_STEPS) -> dict:
+def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
     """Time the study's grid of the run ``inputs`` (see the module's text).
 
     Returns ``per_step_s``, ``per_run_s``, ``n_vars`` (variables recorded per step) and
     ``train`` and ``train_bounded`` (the :class:`~weakgrid.game.estimate.Estimate` of one HJI
-    training, unbounded and rating-bounded: their bases differ).
+    training, unbounded and rating-bounded: their bases differ); with ``batch`` > 1 also
+    ``batch`` (at most :data:`PROBE_BATCH`) and ``batch_step_s``, the cost of one quiet step
+    of that many copies of the run advanced together [s].
     """
+    from ..sim.batch import simulate_batch
     from ..sim.controllers import DigitalController, UPQCTarget
     from ..sim.integrate import simulate
     from .build import build_setup
@@ -245,6 +266,20 @@ def probe(inputs: dict, steps=PROBE_STEPS) -> dict:
                       len(res.names)))
     (t1, s1, _), (t2, s2, n_vars) = timed
     per_step = (t2 - t1) / (s2 - s1) if s2 > s1 and t2 > t1 else t2 / max(s2, 1)
+    batch = max(1, min(int(batch), PROBE_BATCH))
+    batch_step = per_step
+    if batch > 1:     # the same quiet steps, ``batch`` copies of the run together
+        tb = []
+        for n in steps:
+            scen = [{"controllers": [DigitalController(
+                lambda m: np.zeros(2), T=setup.design.T, measure=setup.measure,
+                target=UPQCTarget(setup.upqc_name) if setup.upqc_name else _MeasureOnly(),
+                name="probe")]} for _ in range(batch)]
+            t0 = time.perf_counter()
+            simulate_batch(setup.system, scen, n * dt, batch_size=batch, dt=dt, tol=tol)
+            tb.append(time.perf_counter() - t0)
+        batch_step = max((tb[1] - tb[0]) / (s2 - s1) if s2 > s1 else tb[1] / max(s2, 1),
+                         per_step)
     fixed_sim = max(t1 - s1 * per_step, 0.0)
     per_run = t_setup + fixed_sim
     # through the run's disturbances and TRANSIENT_STEPS beyond the last: the cost of a step
@@ -271,7 +306,18 @@ def probe(inputs: dict, steps=PROBE_STEPS) -> dict:
     train, train_bounded = (training_estimate(int(p.mesh.points.shape[0]), p.basis.size,
                                               p.system.n_states) for p in (prob, bounded))
     return {"per_step_s": per_step, "transient_step_s": transient, "per_run_s": per_run,
-            "n_vars": n_vars, "train": train, "train_bounded": train_bounded}
+            "n_vars": n_vars, "train": train, "train_bounded": train_bounded,
+            "batch": batch, "batch_step_s": batch_step}
+
+
+def batch_step_cost(pr: dict, size: int) -> float:
+    """The cost of one quiet step of a batch of ``size`` runs [s]: linear in ``size`` through
+    the probe's one run (``per_step_s``) and its batch (``batch_step_s`` of ``batch`` runs),
+    never below one run's step."""
+    if size <= 1 or pr.get("batch", 1) <= 1:
+        return pr["per_step_s"] * max(size, 1)
+    slope = (pr["batch_step_s"] - pr["per_step_s"]) / (pr["batch"] - 1)
+    return pr["per_step_s"] + max(slope, 0.0) * (size - 1)
 
 
 def planned_runs(study, quick: bool = False) -> int:
@@ -299,11 +345,14 @@ def _first_values(study, quick):
 
 
 def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = None,
-                   scheduler: str | None = None, points=None) -> SweepEstimate:
+                   scheduler: str | None = None, points=None,
+                   batched: bool = True) -> SweepEstimate:
     """Estimate the remaining runs of ``study``'s sweep (cached in ``cache_dir``).
 
     Nothing is written (the cache folder is not created). ``workers``/``scheduler`` as for
-    :func:`weakgrid.sweep.run_sweep` (None: one worker per core; 0: serially here). A sweep
+    :func:`weakgrid.sweep.run_sweep` (None: one worker per core; 0: serially here);
+    ``batched`` as for :func:`weakgrid.study.sweep.run_study_sweep` (the runs of one grid
+    together, in the batches the sweep will make; ``False``: one by one). A sweep
     of more than :data:`MAX_LISTED` runs is not listed (that alone would take minutes): its
     runs are counted from the axes, costed like those at the axes' first values, and the
     cache is not consulted.
@@ -335,8 +384,10 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
         return SweepEstimate(n_runs, n_cached, 0.0, 0.0, 0.0, 0, 0.0, n_par, 0.0,
                              base + table)
     steps = {k: _steps(p.inputs) for k, p in todo.items()}
+    batches = _batches(todo, len(pts), workers) if batched \
+        else [[k] for k in todo]
     try:
-        pr = probe(next(iter(todo.values())).inputs)
+        pr = probe(next(iter(todo.values())).inputs, batch=max(len(b) for b in batches))
     except Exception as exc:  # a grid that does not run: every run will say why, as a row
         return SweepEstimate(n_runs, n_cached, scale * sum(steps.values()),
                              math.nan, math.nan, 0, math.nan, n_par, None, base + table,
@@ -351,8 +402,14 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
     n_train = sum(min(par, n) for n in runs_per_key.values())
     train_s = sum(min(par, n) * _training(pr, tk).seconds for tk, n in runs_per_key.items())
     quiet = {k: _quiet_steps(p.inputs) for k, p in todo.items()}
-    run_s = [pr["per_run_s"] + quiet[k] * pr["per_step_s"]
-             + (n - quiet[k]) * pr["transient_step_s"] for k, n in steps.items()]
+    # a batch: each run's fixed cost, then the members' steps together (in lockstep: the
+    # longest member's, quiet until the first member's disturbance)
+    ratio = pr["transient_step_s"] / pr["per_step_s"] if pr["per_step_s"] > 0 else 1.0
+    run_s = []
+    for b in batches:
+        n, q = max(steps[k] for k in b), min(quiet[k] for k in b)
+        step = batch_step_cost(pr, len(b))
+        run_s.append(len(b) * pr["per_run_s"] + (q + (n - q) * ratio) * step)
     cpu = scale * sum(run_s) + train_s
     # workers beyond the cores share them; a local cluster starts in ≈ 2 s (measured: 1.6 s,
     # then 0.4 s for a worker's first import)
@@ -371,7 +428,20 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
         total = base + table + sig + n_par * (base + extra)
     return SweepEstimate(n_runs, n_cached, scale * sum(steps.values()), pr["per_step_s"],
                          pr["per_run_s"], n_train, cpu, n_par, wall, total, unlisted=unlisted,
-                         transient_step_s=pr["transient_step_s"])
+                         transient_step_s=pr["transient_step_s"], batch=pr["batch"],
+                         batch_step_s=pr["batch_step_s"])
+
+
+def _batches(todo: dict, n_points: int, workers: int | None) -> list[list]:
+    """The keys of ``todo`` in the batches the sweep makes of them
+    (:func:`weakgrid.study.batches.batch_key`, at most
+    :func:`~weakgrid.study.batches.batch_size_for` of the sweep's ``n_points`` runs each)."""
+    from ..sweep.batches import group
+    from .batches import batch_key, batch_size_for
+
+    keys = list(todo)
+    return [[keys[i] for i in b.rows] for b in
+            group([todo[k].inputs for k in keys], batch_key, batch_size_for(n_points, workers))]
 
 
 def check_sweep(est: SweepEstimate, study, quick: bool = False, force: bool = False,
