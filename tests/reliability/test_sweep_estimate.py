@@ -115,7 +115,10 @@ def test_estimate_counts_steps_and_cached_runs(ws, tmp_path):
     assert (est.n_runs, est.n_cached) == (2, 0)
     assert est.steps == pytest.approx(2 * 0.3 / dt, abs=4)
     assert est.per_step_s > 0 and est.per_run_s >= 0
-    assert est.cpu_s >= est.steps * est.per_step_s
+    # batched (the default): the two runs step together, a batched step costs batch_step_s
+    assert est.batch == 2 and est.cpu_s >= est.steps / 2 * est.batch_step_s
+    one = estimate_sweep(st, tmp_path / "cache", workers=0, batched=False)
+    assert one.batch == 1 and one.cpu_s >= one.steps * one.per_step_s
     assert not (tmp_path / "cache").exists()
     pts = sweep_points(st)
     k = run_key(pts[0].inputs, run_point)
