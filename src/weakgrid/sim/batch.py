@@ -200,6 +200,12 @@ OPERATING_POINT = ("z0", "y_load", "Yr", "Yr_dense", "_Yr_mv", "Yr_coo", "sig_de
                    "_sig_stack")
 
 
+#: attributes a component's ``init`` leaves for :meth:`System.setup`'s checks only (the initial
+#: values of its static limits and gates, ``initial_bounds``): the operating point's, never
+#: evaluated, so masked with it
+INIT_CHECKS = ("initial_bounds",)
+
+
 def _bp_get(c, name):
     """Value of the batchable parameter ``name`` of component ``c``: a parameter (``c.p``)
     or a set-point its initialization computed (an attribute)."""
@@ -217,7 +223,8 @@ def _masked(system):
     """``[(setter, saved value)]`` after setting everything of ``system`` that members of a
     batch may hold of their own to None: the batchable parameters
     (:attr:`Component.batch_params`), the last evaluation's values (:attr:`Component.scratch`),
-    :data:`OPERATING_POINT` and the network's loads (``PD``, ``QD``) and power flow."""
+    the initialization's checks (:data:`INIT_CHECKS`), :data:`OPERATING_POINT` and the
+    network's loads (``PD``, ``QD``) and power flow."""
     from .network import PD, QD
 
     saved = []
@@ -234,7 +241,7 @@ def _masked(system):
                     put(lambda x, v=v, n=name: v.__setitem__(n, x), v.get(name), None)
             elif hasattr(c, name):
                 put(lambda v, c=c, n=name: setattr(c, n, v), getattr(c, name), None)
-        for name in getattr(c, "scratch", ()):
+        for name in (*getattr(c, "scratch", ()), *INIT_CHECKS):
             if hasattr(c, name):
                 put(lambda v, c=c, n=name: setattr(c, n, v), getattr(c, name), None)
     for name in OPERATING_POINT:
@@ -278,7 +285,8 @@ def member_params(systems) -> list:
         for name in getattr(c, "batch_params", ()):
             if _bp_get(c, name) is None:
                 continue
-            rows = [xp.asarray(_bp_get(s.comps[j], name), dtype=float) for s in systems]
+            rows = [xp.asarray(_bp_get(s.comps[j], name)) for s in systems]
+            rows = [r.astype(complex if xp.iscomplexobj(r) else float) for r in rows]   # a phasor stays one
             if any(not xp.array_equal(r, rows[0]) for r in rows[1:]):
                 out.append((j, name, xp.stack(rows)))
     return out
