@@ -35,7 +35,8 @@ from weakgrid.sim.batch import member_params, simulate_batch, system_fingerprint
 from weakgrid.sim.events import Fault
 from weakgrid.sim.io.psse import from_psse
 from weakgrid.sim.network import PD, QD
-from weakgrid.sim.renewables import PVD1
+from weakgrid.sim.loads import ZIP
+from weakgrid.sim.renewables import ESD1, PVD1
 from weakgrid.sim.sources import InfiniteBus, PVSource
 from weakgrid.sim.system import System
 
@@ -72,11 +73,11 @@ G1 = dict(Sn=200, M=8.0, D=0.0, ra=0.003, xl=0.15, xd=1.8, xq=1.7, xd1=0.3, xq1=
 SEXS = ("SEXS", dict(TATB=0.4, TB=5.0, K=20.0, TE=1.0, EMIN=-50.0, EMAX=50.0))
 
 
-def _swing(exciter=SEXS, governor=None, pss=None, unit102="GENROU"):
+def _swing(exciter=SEXS, governor=None, pss=None, unit102="GENROU", zip_load=False):
     """The three-bus network of PSID's benchmarks (tests/sim/test_governors_psse.threebus: 200 MW
     at bus 103) with the studied controls on the swing unit at bus 101 (a GENROU behind a
-    compensator ``xc = -0.05``) and ``unit102`` at bus 102: a GENROU with SEXS, a ``PVD1`` or a
-    ``PVSource``."""
+    compensator ``xc = -0.05``) and ``unit102`` at bus 102: a GENROU with SEXS, a ``PVD1``, an
+    ``ESD1`` or a ``PVSource``; ``zip_load``: a ZIP load of 0.5 + j0.1 pu of bus 103's load."""
     def build(k):
         s = System(threebus(70.0, 200.0))
         s.add_generator("G1", 0, ("GENROU", G1), exciter=exciter, governor=governor, pss=pss)
@@ -84,10 +85,13 @@ def _swing(exciter=SEXS, governor=None, pss=None, unit102="GENROU"):
             s.add_compensator("IEEEVC", "G1.vc", "G1", rc=0.0, xc=-0.05)
         if unit102 == "GENROU":
             s.add_generator("G2", 1, ("GENROU", dict(G1, Sn=100)), exciter=SEXS)
-        elif unit102 == "PVD1":
-            s.add_component(PVD1()).add_pvd1("D2", gen=1, Sn=100)
+        elif unit102 in ("PVD1", "ESD1"):
+            s.add_component(PVD1() if unit102 == "PVD1" else ESD1()).add_pvd1("D2", gen=1, Sn=100)
         else:
             s.add_component(PVSource()).add_source("S2", 1)
+        if zip_load:
+            s.add_component(ZIP()).add_zip("Z3", bus=2, P0=0.5, Q0=0.1, kpp=50, kpi=30, kpz=20,
+                                           kqp=10, kqi=0, kqz=90)
         return _scaled(s, k)
     return build
 
@@ -137,7 +141,9 @@ CASES = {
     "ST2CUT": (_swing(pss=("ST2CUT", {})), {("SEXS", "vref0")}),
     "STAB1": (_swing(pss=("STAB1", {})), {("SEXS", "vref0")}),
     "PVD1": (_swing(unit102="PVD1"), {("PVD1", "V0"), ("PVD1", "qref0")}),
+    "ESD1": (_swing(unit102="ESD1"), {("ESD1", "V0"), ("ESD1", "qref0")}),
     "PVSource": (_swing(unit102="PVSource"), {("PVSource", "V0")}),
+    "ZIP": (_swing(zip_load=True), {("ZIP", "v0"), ("ZIP", "y0")}),
 }
 
 
