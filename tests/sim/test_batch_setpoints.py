@@ -31,8 +31,8 @@ from test_exciters_psse import EXAC2, EXPIC1, ST6B, ST8C
 from test_governors_psse import threebus
 
 from weakgrid.sim import batch
-from weakgrid.sim.batch import member_params, simulate_batch, system_fingerprint
-from weakgrid.sim.events import Fault
+from weakgrid.sim.batch import batch_unsupported, member_params, simulate_batch, system_fingerprint
+from weakgrid.sim.events import Fault, LineTrip
 from weakgrid.sim.io.psse import from_psse
 from weakgrid.sim.network import PD, QD
 from weakgrid.sim.loads import ZIP
@@ -199,3 +199,26 @@ def test_loads_at_an_ideal_sources_bus_keep_grids_apart():
     base = system_fingerprint(at(1.0, 1.0))
     assert system_fingerprint(at(1.0, 1.2)) == base
     assert system_fingerprint(at(1.5, 1.0)) != base
+
+
+def test_an_event_at_an_ideal_sources_bus_runs_alone():
+    """A member whose event changes the network rows of the infinite bus's bus (PSID's trip of
+    line 101-102, a fault at bus 101) is run one by one, equal to its run alone; the batch
+    evaluated the source with the pre-event rows (on the code before: 0.88 pu off its run alone
+    after the trip)."""
+    build, _ = CASES["SEXS"]
+    grids = [build(k) for k in LEVELS[:2]]
+
+    def scen():
+        return [{"system": grids[0], "events": [LineTrip(0, 0.1)]},             # 101-102
+                {"system": grids[1], "events": [Fault(101, 0.1, 0.15, xf=0.1)]},
+                {"system": grids[1], "events": [Fault(103, 0.1, 0.15, xf=0.1)]},
+                {"system": grids[0], "events": [LineTrip(2, 0.1)]}]              # 102-103
+    alone = [_alone(sc["system"], sc, T_END, dt=DT) for sc in scen()]
+    assert "InfiniteBus" in batch_unsupported(grids[0], [LineTrip(0, 0.1)])
+    assert batch_unsupported(grids[0], [LineTrip(2, 0.1)]) is None
+    st = {}
+    got = simulate_batch(grids[0], scen(), T_END, dt=DT, stats=st)
+    assert st["alone"] == 2 and st["batches"] == 1
+    for a, b in zip(alone, got):
+        _same(a, b)

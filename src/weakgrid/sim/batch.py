@@ -51,7 +51,8 @@ batches.
 Scope: dense networks (``nb <= system.DENSE_NETWORK_MAX``), members whose grids differ only in
 their loads and batchable parameters, events that change the network (:class:`Fault`,
 :class:`LineTrip`, :class:`LoadStep`). A member outside it (a :class:`GeneratorTrip`, a model
-whose limits move with the solution or with discrete memory) is run one-by-one by
+whose limits move with the solution or with discrete memory, an event that changes the network
+rows of an ideal source's bus) is run one-by-one by
 :func:`simulate_batch`; the results are the same, only slower.
 """
 
@@ -190,6 +191,42 @@ def batch_unsupported(system, events=()) -> str | None:
         return "a disconnected unit"
     if any(isinstance(e, GeneratorTrip) for e in flatten(list(events))):
         return "a GeneratorTrip event (it changes the devices, not the network)"
+    return _source_rows_changed(system, events)
+
+
+def _source_rows_changed(system, events) -> str | None:
+    """Why ``events`` cannot be batched on ``system`` because one changes the network rows of
+    a bus an ideal source holds (None if none does). An ideal source
+    (:class:`~weakgrid.sim.sources.InfiniteBus`, :class:`~weakgrid.sim.sources.PVSource`)
+    balances its bus with the evaluating grid's rows of the network matrix, and the batch
+    evaluates every member on one grid whose network the members' events do not change: a
+    fault or load step at the source's bus, or a trip of a branch ending there, would leave the
+    member on the pre-event rows."""
+    from .events import LineTrip, LoadStep, _FaultSwitch, flatten
+    from .network import F_BUS, T_BUS
+    from .sources.ideal import _BusConstraint
+
+    held = {int(b): c for c in system.comps if isinstance(c, _BusConstraint) for b in np.atleast_1d(c.bus)}
+    if not held:
+        return None
+    net = system.network
+    for e in flatten(list(events)):
+        if isinstance(e, _FaultSwitch):
+            buses = [e.owner.bus]
+        elif isinstance(e, LoadStep):
+            buses = [e.bus]
+        elif isinstance(e, LineTrip) and isinstance(e.branch, (int, np.integer)) and 0 <= e.branch < len(net.branch):
+            buses = [int(net.branch[e.branch, F_BUS]), int(net.branch[e.branch, T_BUS])]
+        else:
+            continue
+        try:
+            hit = sorted({net.index_of(b) for b in buses} & held.keys())
+        except DataError:      # an unknown bus: the member's run reports it
+            continue
+        if hit:
+            return (f"{e!r} changes the network rows of bus {net.bus_ids[hit[0]]}, which "
+                    f"{held[hit[0]].type_name} holds (an ideal source balances its bus with the "
+                    "evaluating grid's rows, which the batch does not change per member)")
     return None
 
 
