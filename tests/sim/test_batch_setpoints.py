@@ -34,7 +34,7 @@ from weakgrid.sim import batch
 from weakgrid.sim.batch import batch_unsupported, member_params, simulate_batch, system_fingerprint
 from weakgrid.sim.events import Fault, LineTrip
 from weakgrid.sim.io.psse import from_psse
-from weakgrid.sim.network import PD, QD
+from weakgrid.sim.network import PD, PG, QD
 from weakgrid.sim.loads import ZIP
 from weakgrid.sim.renewables import ESD1, PVD1
 from weakgrid.sim.sources import InfiniteBus, PVSource
@@ -220,5 +220,36 @@ def test_an_event_at_an_ideal_sources_bus_runs_alone():
     st = {}
     got = simulate_batch(grids[0], scen(), T_END, dt=DT, stats=st)
     assert st["alone"] == 2 and st["batches"] == 1
+    for a, b in zip(alone, got):
+        _same(a, b)
+
+
+@pytest.mark.parametrize("folder, dyr, raw", [
+    ("HYGOV", "ThreeBus_HYGOV.dyr", "ThreeBusMulti.raw"),
+    ("GAST", "ThreeBus_GAST.dyr", "ThreeBusMulti.raw"),
+    ("PIDGOV", "ThreeBus_PIDGOV_GateFlag.dyr", "ThreeBusMulti.raw"),
+    ("EXST1", "TVC_System.dyr", "TVC_System_32.raw")])
+def test_a_grid_at_several_dispatches_is_one_batch_equal_to_its_runs_alone(folder, dyr, raw):
+    """The studied unit's dispatch changed (its generator row's PG, a power-flow input, as a
+    study's per-level ``add_gen`` does): its governor's ``pref0`` and its exciter's ``vref0``
+    are the members' own; one batch (on the code before: a batch per dispatch)."""
+    def at(k):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            s, _ = from_psse(PSID / folder / raw, PSID / folder / dyr, include_events=False)
+        net = s.network
+        pv = net.bus[[net.index_of(int(b)) for b in net.gen[:, 0]], 1] == 2
+        row = int(np.argmax(np.where(pv, net.gen[:, PG], -np.inf)))     # the largest PV unit
+        for tab in (net.gen, net.case["gen"]):
+            tab[row, PG] *= k
+        return _scaled(s, 1.0)
+    grids = [at(k) for k in (1.0, 0.8, 0.9)]
+    assert len({system_fingerprint(g) for g in grids}) == 1
+    differ = {name for _, name, _ in member_params(grids)}
+    assert {"pref0", "vref0"} <= differ, differ
+    alone = [_alone(g, sc, T_END, dt=DT) for g, sc in zip(grids, _scenarios(grids))]
+    st = {}
+    got = simulate_batch(grids[0], _scenarios(grids), T_END, dt=DT, stats=st)
+    assert st["batches"] == 1 and st["alone"] == 0
     for a, b in zip(alone, got):
         _same(a, b)

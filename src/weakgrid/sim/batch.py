@@ -40,8 +40,9 @@ it for large batches; the linear solves stay per member (LAPACK through
 :mod:`weakgrid.sim.linsolve`, exactly the one-by-one factorization and solve).
 
 Per-member parameters: a member may bring its own grid (``scenario["system"]``, e.g. built by a
-sweep at its point) that differs from the others only in its operating point (its loads, power
-flow, initial point and the machines' initial signals: each member's network matrix is its own)
+sweep at its point) that differs from the others only in its operating point (its loads, its
+generators' dispatch and voltage set points, power flow, initial point and the machines' initial
+signals: each member's network matrix is its own)
 and in the parameters its components declare
 batchable (:attr:`Component.batch_params`, e.g. the UPQC's rating ``Vmax``): these are held as
 ``(B, n)`` arrays, a row per member, bound into the evaluating copy like the controllers'
@@ -261,8 +262,9 @@ def _masked(system):
     batch may hold of their own to None: the batchable parameters
     (:attr:`Component.batch_params`), the last evaluation's values (:attr:`Component.scratch`),
     the initialization's checks (:data:`INIT_CHECKS`), :data:`OPERATING_POINT` and the
-    network's loads (``PD``, ``QD``) and power flow."""
-    from .network import PD, QD
+    network's loads (``PD``, ``QD``), dispatch and voltage set points (the generators' ``PG``,
+    ``QG``, ``VG``: the power flow's inputs, read by nothing else) and power flow."""
+    from .network import PD, PG, QD, QG, VG
 
     saved = []
 
@@ -286,22 +288,21 @@ def _masked(system):
             put(lambda v, n=name: setattr(system, n, v), getattr(system, name), None)
     net = system.network
     put(lambda v: setattr(net, "pf", v), getattr(net, "pf", None), None)
-    tables = [net.bus] + ([net.case["bus"]] if isinstance(getattr(net, "case", None), dict)
-                          and "bus" in net.case else [])
-    for tab in tables:
-        cols = tab[:, [PD, QD]].copy()
-
-        def setter(v, tab=tab):
-            tab[:, [PD, QD]] = v
-        put(setter, cols, 0.0)
+    case = net.case if isinstance(getattr(net, "case", None), dict) else {}
+    for key, table, cols in (("bus", net.bus, [PD, QD]), ("gen", net.gen, [PG, QG, VG])):
+        for tab in [table] + ([case[key]] if key in case else []):
+            def setter(v, tab=tab, cols=cols):
+                tab[:, cols] = v
+            put(setter, tab[:, cols].copy(), 0.0)
     return saved
 
 
 def system_fingerprint(system) -> str:
     """A digest of everything of a set-up ``system`` but what the members of a batch hold of
     their own: its batchable parameters (:attr:`Component.batch_params`, including the
-    set-points its initialization computed), its loads and its operating point (the initial
-    point, the power flow, the load admittances: :data:`OPERATING_POINT`). Grids with equal
+    set-points its initialization computed), its loads, its generators' dispatch and voltage
+    set points and its operating point (the initial point, the power flow, the load
+    admittances: :data:`OPERATING_POINT`). Grids with equal
     fingerprints can be members of one batch; grids that differ in their topology, lines,
     shunts, devices, models or other parameters cannot."""
     saved = _masked(system)
