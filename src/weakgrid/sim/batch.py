@@ -386,18 +386,29 @@ class BatchSimulator:
         self.timing = dict.fromkeys(TIMED, 0.0)
         self.steps = 0
         self.halved = 0
+        self._all = list(range(self.B))     # every member, in order (see _every)
+        self._bound_all = False             # the stacks themselves are bound in self.tmpl
 
     # ------------------------------------------------------------- evaluations
+    def _every(self, rows):
+        """Whether ``rows`` are all the members in order (then the batched arrays are used as
+        they are: no gather)."""
+        return len(rows) == self.B and list(rows) == self._all
+
     def _bind_inputs(self, rows, rep=1):
+        every = self._every(rows)
+        if every and rep == 1 and self._bound_all:
+            return      # the stacks themselves are bound (row writes show through)
         for c, attr, stack in self._inputs:
-            a = stack[rows]
+            a = stack if every else stack[rows]
             setattr(c, attr, a if rep == 1 else xp.repeat(a, rep, axis=0))
         for c, name, stack in self._params:
-            a = stack[rows]
+            a = stack if every else stack[rows]
             _bp_set(c, name, a if rep == 1 else xp.repeat(a, rep, axis=0))
         if self._signals is not None:   # Context reads them with the batch axis
-            a = self._signals[:, rows]
+            a = self._signals if every else self._signals[:, rows]
             self.tmpl._sig_stack = a if rep == 1 else xp.repeat(a, rep, axis=1)
+        self._bound_all = every and rep == 1
 
     def _sync_network(self, rows):
         for k in rows:
@@ -412,7 +423,8 @@ class BatchSimulator:
         nx = self.nx
         self._bind_inputs(rows)
         F, ctx = self.tmpl.device_residual(t, Z)
-        F[:, nx:] += xp.matmul(self.Y[rows], Z[:, nx:, None])[..., 0]
+        Y = self.Y if self._every(rows) else self.Y[rows]
+        F[:, nx:] += xp.matmul(Y, Z[:, nx:, None])[..., 0]
         self.timing["residual"] += time.perf_counter() - t0
         return F, ctx
 
