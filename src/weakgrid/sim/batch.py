@@ -67,6 +67,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from .component import fast_index
 from .errors import DataError, SimulationError
 from .integrate import Simulator, _held, _output_path
 from .results import Results
@@ -136,16 +137,19 @@ class _BatchRecorder:
         bus[:, 2::4] = xp.hypot(Vr, Vi)
         bus[:, 3::4] = xp.arctan2(Vi, Vr)
         if self._ocols is None:
-            self._ocols = xp.asarray([c for _, sl in rec._outs for c in range(sl.start, sl.stop)], dtype=int)
-        if len(self._ocols):    # every output of the rows in one gather
-            n = ctx.x.shape[0]
-            cols = []
-            for key, sl in rec._outs:
-                v = ctx.out[key]
-                cols.append(v if np.ndim(v) >= 2 else xp.broadcast_to(v, (n, sl.stop - sl.start)))
-            row[:, self._ocols] = xp.concatenate(cols, axis=1)[pos]
-        row[:, rec._tm] = ctx.sig["tm"][pos]
-        row[:, rec._vs] = ctx.sig["vs"][pos]
+            self._ocols = fast_index([c for _, sl in rec._outs for c in range(sl.start, sl.stop)])
+            self._okeys = [(key, sl.stop - sl.start) for key, sl in rec._outs]
+        n = ctx.x.shape[0]
+        every = len(pos) == n and list(pos) == list(range(n))    # all rows, in order: no gather
+        if self._okeys:    # every output of the rows in one gather
+            out = ctx.out
+            cols = [v if getattr(v, "ndim", 0) >= 2 else xp.broadcast_to(v, (n, w))
+                    for v, w in ((out[key], w) for key, w in self._okeys)]
+            cat = xp.concatenate(cols, axis=1)
+            row[:, self._ocols] = cat if every else cat[pos]
+        tm, vs = ctx.sig["tm"], ctx.sig["vs"]
+        row[:, rec._tm] = tm if every else tm[pos]
+        row[:, rec._vs] = vs if every else vs[pos]
         if rec.sel is not None:
             row = row[:, rec.sel]
         self.blocks.append((t, xp.asarray(members), row))

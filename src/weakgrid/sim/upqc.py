@@ -114,13 +114,16 @@ def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p, imax=None):
     if imax is None:
         imax = current_limit(p["Imax"])   # 0: no limit
     over = np.abs(Id) > imax
-    if over.any():
+    limited = over.any()
+    if limited:
         Id = np.clip(Id, -imax, imax)
     Psh = Id * vr_abs
     Ploss = p["Rsh"] * Id ** 2
-    Vdcs = Vdc if (Vdc > 1e-6).all() else np.maximum(Vdc, 1e-6)
+    Vdcs = Vdc if np.all(Vdc > 1e-6) else np.maximum(Vdc, 1e-6)   # Vdc: an array or a float (EMT)
     dVdc = (Psh - Ploss - Pdc) / (p["Cdc"] * Vdcs)
-    dxi = np.where(over, 0.0, p["ki_dc"] * err)
+    dxi = p["ki_dc"] * err
+    if limited:
+        dxi = np.where(over, 0.0, dxi)
     return Id, over, Psh, Ploss, dVdc, dxi
 
 
