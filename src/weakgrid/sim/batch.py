@@ -391,7 +391,7 @@ class BatchSimulator:
         self.steps = 0
         self.halved = 0
         self._all = list(range(self.B))     # every member, in order (see _every)
-        self._bound_all = False             # the stacks themselves are bound in self.tmpl
+        self._bound = None                  # (rows, rep) bound in self.tmpl (_bind_inputs)
 
     # ------------------------------------------------------------- evaluations
     def _every(self, rows):
@@ -400,19 +400,28 @@ class BatchSimulator:
         return len(rows) == self.B and list(rows) == self._all
 
     def _bind_inputs(self, rows, rep=1):
+        """Bind the rows ``rows`` of the members' inputs, parameters and initial signals into
+        the evaluating copy (each repeated ``rep`` times, for the Jacobian's perturbed points).
+        Every member in order: the batched arrays themselves (no gather). The parameters and
+        signals do not change during a run: bound again only for other rows; the inputs (a
+        controller's hold writes their rows) whenever they are copies."""
         every = self._every(rows)
-        if every and rep == 1 and self._bound_all:
+        key = (True if every else tuple(rows), rep)
+        same = key == self._bound
+        if same and every and rep == 1:
             return      # the stacks themselves are bound (row writes show through)
         for c, attr, stack in self._inputs:
             a = stack if every else stack[rows]
             setattr(c, attr, a if rep == 1 else xp.repeat(a, rep, axis=0))
+        if same:
+            return
         for c, name, stack in self._params:
             a = stack if every else stack[rows]
             _bp_set(c, name, a if rep == 1 else xp.repeat(a, rep, axis=0))
         if self._signals is not None:   # Context reads them with the batch axis
             a = self._signals if every else self._signals[:, rows]
             self.tmpl._sig_stack = a if rep == 1 else xp.repeat(a, rep, axis=1)
-        self._bound_all = every and rep == 1
+        self._bound = key
 
     def _sync_network(self, rows):
         for k in rows:
