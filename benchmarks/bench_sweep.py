@@ -402,7 +402,8 @@ def batch_breakdown(repeats=3):
     """Where a batch's time goes, in this process: the high-load half of the case-1 quick
     sweep (6 runs: 2 ratings × 3 controllers, one batch of the batched sweep) prepared (grid,
     events, controller; the trained controllers are built once before), simulated one by one
-    and together, finished (metrics); medians of ``repeats``, and the batched step's parts."""
+    and together, finished (metrics); medians of ``repeats`` (wall and CPU time of the
+    simulations), and the batched step's parts."""
     from weakgrid.study.runner import simulate_prepared
     from weakgrid.study.sweep import finish_point, prepare_point
 
@@ -410,15 +411,17 @@ def batch_breakdown(repeats=3):
            if p.params["scenarios.c1-high-conv.load"] == "high"]
     [prepare_point(i) for i in pts]            # the trainings and design models, once
     out = {"prepare": [], "scalar": [], "batched": [], "finish": []}
+    cpu = {"scalar": [], "batched": []}     # CPU time of this process: what the load inflates less
     stats = {}
     for k in range(repeats):
         for path in ("scalar", "batched")[::1 if k % 2 == 0 else -1]:
             t0 = time.perf_counter()
             preps = [prepare_point(i) for i in pts]
-            t1 = time.perf_counter()
+            t1, c1 = time.perf_counter(), time.process_time()
             sims = simulate_prepared(preps, batched=path == "batched",
                                      stats=stats if path == "batched" else None)
             t2 = time.perf_counter()
+            cpu[path].append(time.process_time() - c1)
             [finish_point(i, p, *s) for i, p, s in zip(pts, preps, sims)]
             t3 = time.perf_counter()
             out["prepare"].append(t1 - t0)
@@ -430,6 +433,8 @@ def batch_breakdown(repeats=3):
     print(f"prepare {med['prepare']:.2f} s, simulate one by one {med['scalar']:.2f} s, "
           f"together {med['batched']:.2f} s ({med['scalar'] / med['batched']:.2f}x), finish "
           f"{med['finish']:.2f} s")
+    cs, cb = statistics.median(cpu["scalar"]), statistics.median(cpu["batched"])
+    print(f"CPU time: simulate one by one {cs:.2f} s, together {cb:.2f} s ({cs / cb:.2f}x)")
     tim = stats.get("timing", {})
     tot = sum(tim.values()) or 1.0
     print("batched step, share of its timed parts: " + ", ".join(

@@ -69,6 +69,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from .component import fast_index
 from .errors import DataError, SimulationError
 from .integrate import Simulator, _held, _output_path
 from .results import Results
@@ -138,16 +139,19 @@ class _BatchRecorder:
         bus[:, 2::4] = xp.hypot(Vr, Vi)
         bus[:, 3::4] = xp.arctan2(Vi, Vr)
         if self._ocols is None:
-            self._ocols = xp.asarray([c for _, sl in rec._outs for c in range(sl.start, sl.stop)], dtype=int)
-        if len(self._ocols):    # every output of the rows in one gather
-            n = ctx.x.shape[0]
-            cols = []
-            for key, sl in rec._outs:
-                v = ctx.out[key]
-                cols.append(v if np.ndim(v) >= 2 else xp.broadcast_to(v, (n, sl.stop - sl.start)))
-            row[:, self._ocols] = xp.concatenate(cols, axis=1)[pos]
-        row[:, rec._tm] = ctx.sig["tm"][pos]
-        row[:, rec._vs] = ctx.sig["vs"][pos]
+            self._ocols = fast_index([c for _, sl in rec._outs for c in range(sl.start, sl.stop)])
+            self._okeys = [(key, sl.stop - sl.start) for key, sl in rec._outs]
+        n = ctx.x.shape[0]
+        every = len(pos) == n and list(pos) == list(range(n))    # all rows, in order: no gather
+        if self._okeys:    # every output of the rows in one gather
+            out = ctx.out
+            cols = [v if getattr(v, "ndim", 0) >= 2 else xp.broadcast_to(v, (n, w))
+                    for v, w in ((out[key], w) for key, w in self._okeys)]
+            cat = xp.concatenate(cols, axis=1)
+            row[:, self._ocols] = cat if every else cat[pos]
+        tm, vs = ctx.sig["tm"], ctx.sig["vs"]
+        row[:, rec._tm] = tm if every else tm[pos]
+        row[:, rec._vs] = vs if every else vs[pos]
         if rec.sel is not None:
             row = row[:, rec.sel]
         self.blocks.append((t, xp.asarray(members), row))
@@ -432,18 +436,38 @@ class BatchSimulator:
         self.timing = dict.fromkeys(TIMED, 0.0)
         self.steps = 0
         self.halved = 0
+        self._all = list(range(self.B))     # every member, in order (see _every)
+        self._bound = None                  # (rows, rep) bound in self.tmpl (_bind_inputs)
 
     # ------------------------------------------------------------- evaluations
+    def _every(self, rows):
+        """Whether ``rows`` are all the members in order (then the batched arrays are used as
+        they are: no gather)."""
+        return len(rows) == self.B and list(rows) == self._all
+
     def _bind_inputs(self, rows, rep=1):
+        """Bind the rows ``rows`` of the members' inputs, parameters and initial signals into
+        the evaluating copy (each repeated ``rep`` times, for the Jacobian's perturbed points).
+        Every member in order: the batched arrays themselves (no gather). The parameters and
+        signals do not change during a run: bound again only for other rows; the inputs (a
+        controller's hold writes their rows) whenever they are copies."""
+        every = self._every(rows)
+        key = (True if every else tuple(rows), rep)
+        same = key == self._bound
+        if same and every and rep == 1:
+            return      # the stacks themselves are bound (row writes show through)
         for c, attr, stack in self._inputs:
-            a = stack[rows]
+            a = stack if every else stack[rows]
             setattr(c, attr, a if rep == 1 else xp.repeat(a, rep, axis=0))
+        if same:
+            return
         for c, name, stack in self._params:
-            a = stack[rows]
+            a = stack if every else stack[rows]
             _bp_set(c, name, a if rep == 1 else xp.repeat(a, rep, axis=0))
         if self._signals is not None:   # Context reads them with the batch axis
-            a = self._signals[:, rows]
+            a = self._signals if every else self._signals[:, rows]
             self.tmpl._sig_stack = a if rep == 1 else xp.repeat(a, rep, axis=1)
+        self._bound = key
 
     def _sync_network(self, rows):
         for k in rows:
@@ -458,7 +482,8 @@ class BatchSimulator:
         nx = self.nx
         self._bind_inputs(rows)
         F, ctx = self.tmpl.device_residual(t, Z)
-        F[:, nx:] += xp.matmul(self.Y[rows], Z[:, nx:, None])[..., 0]
+        Y = self.Y if self._every(rows) else self.Y[rows]
+        F[:, nx:] += xp.matmul(Y, Z[:, nx:, None])[..., 0]
         self.timing["residual"] += time.perf_counter() - t0
         return F, ctx
 

@@ -123,6 +123,14 @@ class LeadLag:
             return (u - x) / self._T2s
         return np.where(self._on, (u - x) / self._T2s, 0.0)
 
+    def output_deriv(self, x, u):
+        """``(output(x, u), deriv(x, u))``, the same values with ``u - x`` formed once."""
+        if self._all:
+            e = u - x
+            y = self._r * e + x
+            return (y if self._unit else self.K * y), e / self._T2s
+        return self.output(x, u), self.deriv(x, u)
+
 
 class Washout:
     r"""Washout (high-pass) :math:`sK/(1+sT)`.
@@ -162,6 +170,13 @@ class Washout:
             return (u - x) / self._Ts
         return np.where(self._on, (u - x) / self._Ts, 0.0)
 
+    def output_deriv(self, x, u):
+        """``(output(x, u), deriv(x, u))``, the same values with ``u - x`` formed once."""
+        if self._all:
+            e = u - x
+            return self._g * e, e / self._Ts
+        return self.output(x, u), self.deriv(x, u)
+
 
 class WashoutBypass(Washout):
     r"""Washout :math:`sT/(1+sT)` that is bypassed (output = input) when ``T = 0``.
@@ -183,6 +198,13 @@ class WashoutBypass(Washout):
         if self._all:
             return u - x
         return np.where(self._on, u - x, u)
+
+    def output_deriv(self, x, u):
+        """``(output(x, u), deriv(x, u))``, the same values with ``u - x`` formed once."""
+        if self._all:
+            e = u - x
+            return e, e / self._Ts
+        return self.output(x, u), self.deriv(x, u)
 
 
 class Integrator:

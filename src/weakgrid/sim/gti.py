@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from .blocks import PID
-from .component import Component, scatter_add
+from .component import Component, fast_index, scatter_add
 from .errors import DataError
 from .params import Param
 
@@ -101,6 +101,9 @@ class GTI(Component):
         self.p_series = np.zeros(self.n)
         self._any_pq = bool(self.pq.any())
         self._uniq = len(set(self.bus.tolist())) == self.n
+        # the buses as slices where they can be (basic indexing: no gather per evaluation)
+        self._bi = fast_index(self.bus) if self._uniq else self.bus
+        self._refi = fast_index(self.ref)
 
     def pattern(self, system):
         groups = []
@@ -137,8 +140,9 @@ class GTI(Component):
         x = ctx.x
         sl = self._sls
         Vc, ph = x[..., sl[0]], x[..., sl[1]]
-        V = ctx.V[..., self.bus]
-        th_r = np.angle(ctx.V[..., self.ref])
+        V = ctx.V[..., self._bi]
+        Vref = ctx.V[..., self._refi]
+        th_r = np.arctan2(Vref.imag, Vref.real)     # np.angle's arithmetic
         phi_s = self.phi0 + ph
         Vs_ref = self.Vs0
         if self._any_pq:
@@ -156,7 +160,7 @@ class GTI(Component):
         Vs = ks * Vc
         Es = Vs * np.exp(1j * (th_r + phi_s))
         I = -1j * p["B"] * (Es - V)
-        scatter_add(ctx.I, self.bus, I, self._uniq)
+        scatter_add(ctx.I, self._bi, I, self._uniq)
         self._Pac = (Es * np.conj(I)).real
         self._Q = (V * np.conj(I)).imag
         self._Vs, self._ks, self._phis = Vs, ks, phi_s

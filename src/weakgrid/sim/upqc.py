@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .component import Component, scatter_add
+from .component import Component, fast_index, scatter_add
 from .errors import DataError
 from .network import BR_B, BR_R, BR_X, F_BUS, SHIFT, T_BUS, TAP
 from .params import Param
@@ -77,7 +77,13 @@ def link_vmax(Vmax, Vdc, Vdc0):
     return np.where(Vdc < Vdc0, Vmax * np.maximum(Vdc, 0.0) / Vdc0, Vmax)
 
 
-def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p):
+def current_limit(Imax):
+    """The shunt converter's current limit [pu on Sb] as :func:`shunt_dc_law` applies it:
+    ``Imax``, and no limit (``inf``) where ``Imax = 0``."""
+    return np.where(Imax > 0, Imax, np.inf)
+
+
+def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p, imax=None):
     """The conventional UPQC's shunt converter and dc link (the module docstring's equations),
     the one law every engine evaluates.
 
@@ -93,6 +99,8 @@ def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p):
     p : mapping
         ``Vdc0``, ``kp_dc``, ``ki_dc``, ``Imax`` (0: no limit), ``Rsh``, ``Cdc``
         (:attr:`UPQC.params`).
+    imax : array_like, optional
+        ``current_limit(p["Imax"])``, when the caller holds it (computed otherwise).
 
     Returns
     -------
@@ -103,15 +111,19 @@ def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p):
     """
     err = p["Vdc0"] - Vdc
     Id = (Pdc + p["kp_dc"] * err + xi_dc) / vr_safe
-    imax = np.where(p["Imax"] > 0, p["Imax"], np.inf)   # 0: no limit
+    if imax is None:
+        imax = current_limit(p["Imax"])   # 0: no limit
     over = np.abs(Id) > imax
-    if np.any(over):
+    limited = over.any()
+    if limited:
         Id = np.clip(Id, -imax, imax)
     Psh = Id * vr_abs
     Ploss = p["Rsh"] * Id ** 2
-    Vdcs = Vdc if np.all(Vdc > 1e-6) else np.maximum(Vdc, 1e-6)
+    Vdcs = Vdc if np.all(Vdc > 1e-6) else np.maximum(Vdc, 1e-6)   # Vdc: an array or a float (EMT)
     dVdc = (Psh - Ploss - Pdc) / (p["Cdc"] * Vdcs)
-    dxi = np.where(over, 0.0, p["ki_dc"] * err)
+    dxi = p["ki_dc"] * err
+    if limited:
+        dxi = np.where(over, 0.0, dxi)
     return Id, over, Psh, Ploss, dVdc, dxi
 
 
@@ -124,6 +136,9 @@ class UPQC(Component):
     #: the device's rating, current limit and dc link may differ per member of a batch (a
     #: sweep over the rating)
     batch_params = ("Vmax", "Imax", "Cdc", "kp_dc", "ki_dc", "Rsh")
+
+    #: the last evaluation's values and the cached current limit (not the grid's data)
+    scratch = ("_f", "_imax")
 
     kind = "device"
     order = 3
@@ -205,6 +220,18 @@ class UPQC(Component):
         self._all_conv = bool(self._conv.all())
         self._any_chi = bool((self.p["chi"] > 0).any())
         self._uniq_g = len(set(self.gti_i[self.reduced].tolist())) == int(self.reduced.sum())
+        # the buses as slices where they can be (basic indexing: no gather per evaluation)
+        self._ri, self._b1i = (fast_index(self.r), fast_index(self.b1)) if self._uniq else (self.r, self.b1)
+        self._r_conv = fast_index(self.r[self._conv]) if self._uniq else self.r[self._conv]
+        self._imax = (None, None)    # (the Imax it was computed from, current_limit(Imax))
+
+    def _current_limit(self):
+        """:func:`current_limit` of ``p["Imax"]``, recomputed only when ``Imax`` is another
+        array (a batch binds its members' own)."""
+        Imax = self.p["Imax"]
+        if self._imax[0] is not Imax:
+            self._imax = (Imax, current_limit(Imax))
+        return self._imax[1]
 
     def set_input(self, name, Vup, Vuq):
         """Hold series-voltage commands ``Vup`` (quadrature) and ``Vuq`` (in phase) [pu] for UPQC ``name``."""
@@ -231,8 +258,8 @@ class UPQC(Component):
     def compute(self, ctx):
         on = ctx.system.branch_status[self.branch]
         p = self.p
-        Vr = ctx.V[..., self.r]
-        V1 = ctx.V[..., self.b1]
+        Vr = ctx.V[..., self._ri]
+        V1 = ctx.V[..., self._b1i]
         vr_abs = np.abs(Vr)
         if (vr_abs > 1e-6).all():      # fast path (same values as the guarded expressions)
             ur = Vr / vr_abs
@@ -247,7 +274,8 @@ class UPQC(Component):
         if self._any_conv:   # the series voltage the dc link can carry: Vmax at Vdc >= Vdc0
             Vdc = ctx.x[..., self.sl(0)]
             if (Vdc < p["Vdc0"]).any():
-                Vmax = np.where(conv, link_vmax(Vmax, Vdc, p["Vdc0"]), Vmax)
+                lv = link_vmax(Vmax, Vdc, p["Vdc0"])
+                Vmax = lv if self._all_conv else np.where(conv, lv, Vmax)
         if (mag > Vmax).any():
             Vu = Vu * np.where(mag > Vmax, Vmax / np.where(mag > 0, mag, 1.0), 1.0)
             mag = np.abs(Vu)
@@ -255,8 +283,8 @@ class UPQC(Component):
             Vu = np.where(on, Vu, 0.0)
             mag = np.abs(Vu)
         Isrc = self.yu * Vu
-        scatter_add(ctx.I, self.b1, Isrc, self._uniq)
-        scatter_add(ctx.I, self.r, -Isrc, self._uniq)
+        scatter_add(ctx.I, self._b1i, Isrc, self._uniq)
+        scatter_add(ctx.I, self._ri, -Isrc, self._uniq)
         I = self.yu * (Vr + Vu - V1) * on
         S = Vu * np.conj(I)
         P = S.real
@@ -264,12 +292,14 @@ class UPQC(Component):
         o = ctx.out
         if self._any_conv:
             Id, over, Psh, Ploss, dVdc, dxi = shunt_dc_law(Pdc, Vdc, ctx.x[..., self.sl(1)],
-                                                          vr_abs, vr_safe, p)
-            if not self._all_conv:
+                                                          vr_abs, vr_safe, p, self._current_limit())
+            if self._all_conv:
+                scatter_add(ctx.I, self._r_conv, -(Id * ur), self._uniq)
+            else:
                 Id, Psh, Ploss, dVdc, dxi = (np.where(conv, a, 0.0)
                                              for a in (Id, Psh, Ploss, dVdc, dxi))
                 over = over & conv
-            scatter_add(ctx.I, self.r[conv], -(Id * ur)[..., conv], self._uniq)
+                scatter_add(ctx.I, self._r_conv, -(Id * ur)[..., conv], self._uniq)
             self._f = (dVdc, dxi)
             o["UPQC.P_shunt"], o["UPQC.S_shunt"] = Psh, np.abs(Psh)
             o["UPQC.I_shunt"], o["UPQC.P_loss"], o["UPQC.limited"] = Id, Ploss, over * 1.0

@@ -108,17 +108,17 @@ class EXDC2(MachineControl):
         ls, ll, vr, vp, w = x[..., sls[0]], x[..., sls[1]], x[..., sls[2]], x[..., sls[3]], x[..., sls[4]]
         v = ctx.sig["Ecomp"][..., m]
         omega = ctx.sig["omega"][..., m]
-        W = self.W.output(w, vp)
+        W, dw = self.W.output_deriv(w, vp)
         vi = self.vref0 - self.LS.output(ls, v) - W + ctx.sig["vs"][..., m]
-        vll = self.LL.output(ll, vi)
+        vll, dll = self.LL.output_deriv(ll, vi)
         vout = omega * vp if self.speed_times_vp else vp
         sat = 0.0 if self._nosat else np.where(vout >= self.SA, quad_saturation(vp, self.SA, self.SB), 0.0)
         f = ctx.f
         f[..., self._sls[0]] = self.LS.deriv(ls, v)
-        f[..., self._sls[1]] = self.LL.deriv(ll, vi)
+        f[..., self._sls[1]] = dll
         f[..., self._sls[2]] = self.LA.deriv(vr, vll)
         f[..., self._sls[3]] = (vr - p["KE"] * vp - sat) / p["TE"]
-        f[..., self._sls[4]] = self.W.deriv(w, vp)
+        f[..., self._sls[4]] = dw
         ctx.sig["vf"][..., m] = vout
         o = ctx.out
         k = self._keys

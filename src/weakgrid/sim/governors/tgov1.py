@@ -76,7 +76,7 @@ class TGOV1(MachineControl):
         wd = ctx.sig["omega"][..., m] - p["wref0"]
         pd = self._pd(wd)
         ctx.f[..., self._sls[0]] = self.LAG.deriv(lag, pd)
-        ctx.f[..., self._sls[1]] = self.LL.deriv(ll, lag)
-        pout = self.LL.output(ll, lag) - p["Dt"] * wd
+        y, ctx.f[..., self._sls[1]] = self.LL.output_deriv(ll, lag)
+        pout = y - p["Dt"] * wd
         ctx.sig["tm"][..., m] = pout
         ctx.out[self._key] = pout

@@ -112,7 +112,7 @@ class SyncMachine(Component):
         sig["Pe"][..., m] = Pe
         sig["Qe"][..., m] = Qe
         sig["Vt"][..., m] = sig["Ecomp"][..., m] = np.abs(V)
-        sig["theta"][..., m] = np.angle(V)
+        sig["theta"][..., m] = np.arctan2(V.imag, V.real)     # np.angle's arithmetic
         sig["XadIfd"][..., m] = XadIfd
 
 

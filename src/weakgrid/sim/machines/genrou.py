@@ -197,8 +197,9 @@ class GENROU(SyncMachine):
             psiq = -(ra * Id + vd)
         # injected current (Id + j Iq) exp(j(delta - pi/2))
         self.inject(ctx, (Id * sd + Iq * cd) + 1j * (Iq * sd - Id * cd))
-        XadIfd = e1q + self._kd1 * Id + self._kd2 * (e1q - e2d)
-        XaqI1q = e1d + self._kq2 * (e1d - e2q) - self._kq1 * Iq
+        dq, dd = e1q - e2d, e1d - e2q       # each once: the flux and the damper equations read them
+        XadIfd = e1q + self._kd1 * Id + self._kd2 * dq
+        XaqI1q = e1d + self._kq2 * dd - self._kq1 * Iq
         if self._nosat:
             Se = np.zeros_like(psi2)
         else:
@@ -212,8 +213,8 @@ class GENROU(SyncMachine):
         self.publish(ctx, omega, delta, Pe, Qe, V, XadIfd)
         f = ctx.f
         f[..., sl[3]] = XaqI1q * self._iTq10
-        f[..., sl[4]] = (e1q - e2d) * self._iTd20 - self._xd1l_iTd20 * Id
-        f[..., sl[5]] = (e1d - e2q) * self._iTq20 + self._xq1l_iTq20 * Iq
+        f[..., sl[4]] = dq * self._iTd20 - self._xd1l_iTd20 * Id
+        f[..., sl[5]] = dd * self._iTq20 + self._xq1l_iTq20 * Iq
         o, k = ctx.out, self._pre
         o[k + "Pe"], o[k + "Qe"], o[k + "te"] = Pe, Qe, self._te
         o[k + "Id"], o[k + "Iq"], o[k + "XadIfd"] = Id, Iq, XadIfd

@@ -194,15 +194,12 @@ class IEEEST(MachineControl):
         else:
             y2 = y1
         x4, x5, x6 = x[..., sl[4]], x[..., sl[5]], x[..., sl[6]]
-        y3 = self.LL1.output(x4, y2)
-        f[..., sl[4]] = self.LL1.deriv(x4, y2)
-        y4 = self.LL2.output(x5, y3)
-        f[..., sl[5]] = self.LL2.deriv(x5, y3)
+        y3, f[..., sl[4]] = self.LL1.output_deriv(x4, y2)
+        y4, f[..., sl[5]] = self.LL2.output_deriv(x5, y3)
         vks = p["KS"] * y4
-        vss = self.WO.output(x6, vks)
+        vss, f[..., sl[6]] = self.WO.output_deriv(x6, vks)
         if self._any_wo_lag:
             vss = np.where(self._wo_lag, x6, vss)
-        f[..., sl[6]] = self.WO.deriv(x6, vks)
         vs = np.minimum(np.maximum(vss, p["LSMIN"]), p["LSMAX"])
         if not self._no_cut:
             vt = ctx.sig["Vt"][..., self._mi]
