@@ -40,8 +40,9 @@ it for large batches; the linear solves stay per member (LAPACK through
 :mod:`weakgrid.sim.linsolve`, exactly the one-by-one factorization and solve).
 
 Per-member parameters: a member may bring its own grid (``scenario["system"]``, e.g. built by a
-sweep at its point) that differs from the others only in its operating point (its loads, power
-flow, initial point and the machines' initial signals: each member's network matrix is its own)
+sweep at its point) that differs from the others only in its operating point (its loads, its
+generators' dispatch and voltage set points, power flow, initial point and the machines' initial
+signals: each member's network matrix is its own)
 and in the parameters its components declare
 batchable (:attr:`Component.batch_params`, e.g. the UPQC's rating ``Vmax``): these are held as
 ``(B, n)`` arrays, a row per member, bound into the evaluating copy like the controllers'
@@ -51,7 +52,8 @@ batches.
 Scope: dense networks (``nb <= system.DENSE_NETWORK_MAX``), members whose grids differ only in
 their loads and batchable parameters, events that change the network (:class:`Fault`,
 :class:`LineTrip`, :class:`LoadStep`). A member outside it (a :class:`GeneratorTrip`, a model
-whose limits move with the solution or with discrete memory) is run one-by-one by
+whose limits move with the solution or with discrete memory, an event that changes the network
+rows of an ideal source's bus) is run one-by-one by
 :func:`simulate_batch`; the results are the same, only slower.
 """
 
@@ -190,6 +192,42 @@ def batch_unsupported(system, events=()) -> str | None:
         return "a disconnected unit"
     if any(isinstance(e, GeneratorTrip) for e in flatten(list(events))):
         return "a GeneratorTrip event (it changes the devices, not the network)"
+    return _source_rows_changed(system, events)
+
+
+def _source_rows_changed(system, events) -> str | None:
+    """Why ``events`` cannot be batched on ``system`` because one changes the network rows of
+    a bus an ideal source holds (None if none does). An ideal source
+    (:class:`~weakgrid.sim.sources.InfiniteBus`, :class:`~weakgrid.sim.sources.PVSource`)
+    balances its bus with the evaluating grid's rows of the network matrix, and the batch
+    evaluates every member on one grid whose network the members' events do not change: a
+    fault or load step at the source's bus, or a trip of a branch ending there, would leave the
+    member on the pre-event rows."""
+    from .events import LineTrip, LoadStep, _FaultSwitch, flatten
+    from .network import F_BUS, T_BUS
+    from .sources.ideal import _BusConstraint
+
+    held = {int(b): c for c in system.comps if isinstance(c, _BusConstraint) for b in np.atleast_1d(c.bus)}
+    if not held:
+        return None
+    net = system.network
+    for e in flatten(list(events)):
+        if isinstance(e, _FaultSwitch):
+            buses = [e.owner.bus]
+        elif isinstance(e, LoadStep):
+            buses = [e.bus]
+        elif isinstance(e, LineTrip) and isinstance(e.branch, (int, np.integer)) and 0 <= e.branch < len(net.branch):
+            buses = [int(net.branch[e.branch, F_BUS]), int(net.branch[e.branch, T_BUS])]
+        else:
+            continue
+        try:
+            hit = sorted({net.index_of(b) for b in buses} & held.keys())
+        except DataError:      # an unknown bus: the member's run reports it
+            continue
+        if hit:
+            return (f"{e!r} changes the network rows of bus {net.bus_ids[hit[0]]}, which "
+                    f"{held[hit[0]].type_name} holds (an ideal source balances its bus with the "
+                    "evaluating grid's rows, which the batch does not change per member)")
     return None
 
 
@@ -198,6 +236,12 @@ def batch_unsupported(system, events=()) -> str | None:
 #: they enter, the machines' initial signals (held per member by :class:`BatchSimulator`)
 OPERATING_POINT = ("z0", "y_load", "Yr", "Yr_dense", "_Yr_mv", "Yr_coo", "sig_defaults",
                    "_sig_stack")
+
+
+#: attributes a component's ``init`` leaves for :meth:`System.setup`'s checks only (the initial
+#: values of its static limits and gates, ``initial_bounds``): the operating point's, never
+#: evaluated, so masked with it
+INIT_CHECKS = ("initial_bounds",)
 
 
 def _bp_get(c, name):
@@ -217,8 +261,10 @@ def _masked(system):
     """``[(setter, saved value)]`` after setting everything of ``system`` that members of a
     batch may hold of their own to None: the batchable parameters
     (:attr:`Component.batch_params`), the last evaluation's values (:attr:`Component.scratch`),
-    :data:`OPERATING_POINT` and the network's loads (``PD``, ``QD``) and power flow."""
-    from .network import PD, QD
+    the initialization's checks (:data:`INIT_CHECKS`), :data:`OPERATING_POINT` and the
+    network's loads (``PD``, ``QD``), dispatch and voltage set points (the generators' ``PG``,
+    ``QG``, ``VG``: the power flow's inputs, read by nothing else) and power flow."""
+    from .network import PD, PG, QD, QG, VG
 
     saved = []
 
@@ -234,7 +280,7 @@ def _masked(system):
                     put(lambda x, v=v, n=name: v.__setitem__(n, x), v.get(name), None)
             elif hasattr(c, name):
                 put(lambda v, c=c, n=name: setattr(c, n, v), getattr(c, name), None)
-        for name in getattr(c, "scratch", ()):
+        for name in (*getattr(c, "scratch", ()), *INIT_CHECKS):
             if hasattr(c, name):
                 put(lambda v, c=c, n=name: setattr(c, n, v), getattr(c, name), None)
     for name in OPERATING_POINT:
@@ -242,22 +288,21 @@ def _masked(system):
             put(lambda v, n=name: setattr(system, n, v), getattr(system, name), None)
     net = system.network
     put(lambda v: setattr(net, "pf", v), getattr(net, "pf", None), None)
-    tables = [net.bus] + ([net.case["bus"]] if isinstance(getattr(net, "case", None), dict)
-                          and "bus" in net.case else [])
-    for tab in tables:
-        cols = tab[:, [PD, QD]].copy()
-
-        def setter(v, tab=tab):
-            tab[:, [PD, QD]] = v
-        put(setter, cols, 0.0)
+    case = net.case if isinstance(getattr(net, "case", None), dict) else {}
+    for key, table, cols in (("bus", net.bus, [PD, QD]), ("gen", net.gen, [PG, QG, VG])):
+        for tab in [table] + ([case[key]] if key in case else []):
+            def setter(v, tab=tab, cols=cols):
+                tab[:, cols] = v
+            put(setter, tab[:, cols].copy(), 0.0)
     return saved
 
 
 def system_fingerprint(system) -> str:
     """A digest of everything of a set-up ``system`` but what the members of a batch hold of
     their own: its batchable parameters (:attr:`Component.batch_params`, including the
-    set-points its initialization computed), its loads and its operating point (the initial
-    point, the power flow, the load admittances: :data:`OPERATING_POINT`). Grids with equal
+    set-points its initialization computed), its loads, its generators' dispatch and voltage
+    set points and its operating point (the initial point, the power flow, the load
+    admittances: :data:`OPERATING_POINT`). Grids with equal
     fingerprints can be members of one batch; grids that differ in their topology, lines,
     shunts, devices, models or other parameters cannot."""
     saved = _masked(system)
@@ -278,7 +323,8 @@ def member_params(systems) -> list:
         for name in getattr(c, "batch_params", ()):
             if _bp_get(c, name) is None:
                 continue
-            rows = [xp.asarray(_bp_get(s.comps[j], name), dtype=float) for s in systems]
+            rows = [xp.asarray(_bp_get(s.comps[j], name)) for s in systems]
+            rows = [r.astype(complex if xp.iscomplexobj(r) else float) for r in rows]   # a phasor stays one
             if any(not xp.array_equal(r, rows[0]) for r in rows[1:]):
                 out.append((j, name, xp.stack(rows)))
     return out

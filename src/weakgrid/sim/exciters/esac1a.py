@@ -47,6 +47,8 @@ class ESAC1A(MachineControl):
     """
 
     kind = "exciter"
+    #: the voltage reference computed at init (from the operating point): per batch member
+    batch_params = ("vref0",)
     order = 2
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("TR", "TB", "TC", "KA", "TA", "VAMAX", "VAMIN", "TE", "KF", "TF", "KC", "KD",

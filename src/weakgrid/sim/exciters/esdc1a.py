@@ -44,6 +44,8 @@ class ESDC1A(MachineControl):
     VRMAX, VRMIN [pu]; E1, SE1, E2, SE2 (saturation of the DC exciter, pu of Efd)."""
 
     kind = "exciter"
+    #: the voltage reference and the compensated voltage at init (ESDC2A's limit): per batch member
+    batch_params = ("vref0", "_vt0")
     order = 2
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("TR", "KA", "TA", "TB", "TC", "VRMAX", "VRMIN", "KE", "TE", "KF", "TF1",

@@ -59,6 +59,8 @@ class ESST3A(MachineControl):
     reactance XL [pu]; THETAP [deg]; limits VIMAX, VIMIN, VRMAX, VRMIN, VMMAX, VMMIN, VBMAX, VGMAX [pu]."""
 
     kind = "exciter"
+    #: the voltage reference computed at init (from the operating point): per batch member
+    batch_params = ("vref0",)
     order = 2
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("TR", "VIMAX", "VIMIN", "KM", "TC", "TB", "KA", "TA", "VRMAX", "VRMIN", "KG",

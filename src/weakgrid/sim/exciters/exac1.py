@@ -75,6 +75,8 @@ class EXAC1(MachineControl):
     VRMAX, VRMIN [pu]; E1, SE1, E2, SE2 (saturation)."""
 
     kind = "exciter"
+    #: the voltage reference computed at init (from the operating point): per batch member
+    batch_params = ("vref0",)
     order = 2
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("TR", "TB", "TC", "KA", "TA", "VRMAX", "VRMIN", "TE", "KF", "TF", "KC", "KD",

@@ -48,6 +48,8 @@ class EXAC2(MachineControl):
     reference); E1, SE1, E2, SE2 (saturation)."""
 
     kind = "exciter"
+    #: the voltage reference computed at init (from the operating point): per batch member
+    batch_params = ("vref0",)
     order = 2
     params = (
         Param("TR", 0.0, "s", "sensing time constant", "nonneg"),

@@ -35,6 +35,8 @@ class IEEET3(MachineControl):
     limits [pu]: VRMAX, VRMIN (regulator), VBMAX (exciter input)."""
 
     kind = "exciter"
+    #: the voltage reference computed at init (from the operating point): per batch member
+    batch_params = ("vref0",)
     order = 2
     params = (
         Param("TR", 0.02, "s", "sensing time constant", "nonneg"),

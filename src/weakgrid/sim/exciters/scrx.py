@@ -35,6 +35,8 @@ class SCRX(MachineControl):
     allowed; > 0: crowbar resistance / field resistance)."""
 
     kind = "exciter"
+    #: the voltage reference computed at init (from the operating point): per batch member
+    batch_params = ("vref0",)
     order = 2
     params = (
         Param("TATB", 0.1, "-", "ratio TA/TB of the lead-lag", "nonneg"),

@@ -22,6 +22,8 @@ class SEXS(MachineControl):
     """Simplified exciter. Parameters: TATB [-], TB, TE [s], K [pu], EMIN, EMAX [pu]."""
 
     kind = "exciter"
+    #: the voltage reference computed at init (from the operating point): per batch member
+    batch_params = ("vref0",)
     order = 2
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("TATB", "TB", "K", "TE", "EMIN", "EMAX")

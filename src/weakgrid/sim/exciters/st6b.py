@@ -56,6 +56,8 @@ class ST6B(MachineControl):
     current]; OEL input selector (0, 1, 2; unused)."""
 
     kind = "exciter"
+    #: the voltage reference computed at init (from the operating point): per batch member
+    batch_params = ("vref0",)
     order = 2
     params = (
         Param("OEL", 0.0, "-", "OEL input selector (0 none, 1 before UEL, 2 after UEL; no OEL modelled)", ""),

@@ -61,6 +61,8 @@ class ST8C(MachineControl):
     VRMIN, VB1MAX, VB2MAX [pu, machine base]; flags OEL, UEL, SCL (unused), SW1 (power source)."""
 
     kind = "exciter"
+    #: the voltage reference computed at init (from the operating point): per batch member
+    batch_params = ("vref0",)
     order = 2
     params = (
         Param("OEL", 0.0, "-", "OEL input flag (<2 summation, 2 take-over; no OEL modelled)", ""),

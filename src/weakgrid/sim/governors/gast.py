@@ -33,6 +33,8 @@ class GAST(MachineControl):
     KT [pu/pu]; T1, T2, T3 [s]."""
 
     kind = "governor"
+    #: the power reference computed at init (from the operating point): per batch member
+    batch_params = ("pref0",)
     order = 2
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("R", "T1", "T2", "T3", "AT", "KT", "VMAX", "VMIN", "Dt")

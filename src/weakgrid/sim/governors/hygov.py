@@ -58,6 +58,8 @@ class HYGOV(MachineControl):
     flags Tr_used, Tw_sysbase, Dt_sysbase, VELM_offset (module docstring)."""
 
     kind = "governor"
+    #: the power reference computed at init (from the operating point): per batch member
+    batch_params = ("pref0",)
     order = 2
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("R", "r", "Tr", "Tf", "Tg", "VELM", "GMAX", "GMIN", "Tw", "At", "Dt", "qNL")

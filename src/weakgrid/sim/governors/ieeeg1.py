@@ -33,6 +33,8 @@ class IEEEG1(MachineControl):
     (LP power). Parameters: K [pu], T1..T7 [s], UO, UC [pu/s], PMAX, PMIN [pu], K1..K8 [-]."""
 
     kind = "governor"
+    #: the initial gate/power reference computed at init (from the operating point): per batch member
+    batch_params = ("P0",)
     order = 2
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("_JBUS", "_M", "K", "T1", "T2", "T3", "UO", "UC", "PMAX", "PMIN", "T4", "K1",

@@ -27,6 +27,8 @@ class IEESGO(MachineControl):
     """IEEE standard governor. Parameters: T1..T6 [s]; K1 [pu/pu speed], K2, K3 [-]; PMAX, PMIN [pu]."""
 
     kind = "governor"
+    #: the power reference computed at init (from the operating point): per batch member
+    batch_params = ("pref0",)
     order = 2
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("T1", "T2", "T3", "T4", "T5", "T6", "K1", "K2", "K3", "PMAX", "PMIN")

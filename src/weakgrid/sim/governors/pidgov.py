@@ -51,6 +51,8 @@ class PIDGOV(MachineControl):
     Velmax, Velmin [pu/s]."""
 
     kind = "governor"
+    #: the power reference computed at init (from the operating point): per batch member
+    batch_params = ("pref0",)
     order = 2
     params = (
         Param("Flag", 0.0, "-", "feedback: 0 electrical power, 1 gate position", "flag"),

@@ -26,6 +26,8 @@ class TG2(MachineControl):
     """Turbine-governor type 2. Parameters: R, pmax, pmin [pu, turbine base]; T1, T2 [s]."""
 
     kind = "governor"
+    #: the power reference computed at init (from the operating point): per batch member
+    batch_params = ("pref0",)
     order = 2
     params = (
         Param("Tn", 0.0, "MVA", "turbine rating (0: machine Sn)", "nonneg"),

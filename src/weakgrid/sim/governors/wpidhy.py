@@ -52,6 +52,8 @@ class WPIDHY(MachineControl):
     KI [1/s], KD [s]; VELMX, VELMN [pu/s]; GATMX, GATMN, PMAX, PMIN, D [pu]; gate table G0..P3."""
 
     kind = "governor"
+    #: the power reference computed at init (from the operating point): per batch member
+    batch_params = ("pref0",)
     order = 2
     params = (
         Param("TREG", 0.0, "s", "droop (power measurement) time constant", "nonneg"),

@@ -26,6 +26,9 @@ class ZIP(Component):
     """Polynomial loads, one per bus load share; add with :meth:`add_zip`."""
 
     kind = "device"
+    #: the power-flow voltage magnitude and the admittance it gives the share (from the operating
+    #: point, read only when evaluating): per batch member; the share ``P0``, ``Q0`` is the grid's
+    batch_params = ("v0", "y0")
     order = 0
     params = (
         Param("kpp", None, "%", "constant-power share of P", ""),

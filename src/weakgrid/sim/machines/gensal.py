@@ -60,6 +60,8 @@ class GENSAL(SyncMachine):
     input is power, divided by the speed; :mod:`~weakgrid.sim.machines.shaft`).
     """
 
+    #: the last evaluation's values (read by ``finish``)
+    scratch = ("_te", "_XadIfd")
     params = with_default(BASE_PARAMS, "psse_shaft", 1.0) + (
         Param("xl", 0.0, "pu (machine base)", "leakage reactance", "nonneg", "z"),
         Param("xd", 1.9, "pu (machine base)", "d-axis synchronous reactance", "pos", "z"),

@@ -48,6 +48,8 @@ class PVD1(Component):
     """Distributed PV (WECC PVD1); several devices may share one static generator row."""
 
     kind = "device"
+    #: the power-flow voltage and power references computed at init: per batch member
+    batch_params = ("V0", "pref0", "qref0", "Vqu", "Vql")
     order = 0
     gen_shared = True
     params = (

@@ -32,6 +32,7 @@ import numpy as np
 
 from ..component import Component, scatter_add
 from ..errors import DataError
+from ..network import PD, QD
 
 
 class _BusConstraint(Component):
@@ -42,6 +43,10 @@ class _BusConstraint(Component):
     params = ()
     outputs = ("P", "Q")
     units = {"P": "power", "Q": "power"}
+    #: the power-flow phasor ``V0`` [pu] and scheduled power ``p0`` [pu, system base] it holds
+    #: (from the operating point, read only when evaluating): per batch member
+    #: (:mod:`weakgrid.sim.batch`); the loads at its buses are not (``bus_load``)
+    batch_params = ("V0", "p0")
 
     def add_source(self, name, gen, also=()):
         """Add a source for the gen-table row ``gen`` (0-based, in service).
@@ -116,6 +121,11 @@ class _BusConstraint(Component):
         self.p0 = net.pf.Pg[self.gen].copy()
         for i, rows in enumerate(getattr(self, "gen_also", [])):
             self.p0[i] += float(np.sum(net.pf.Pg[rows])) if rows else 0.0
+        # the loads at its buses (PD, QD [MW, Mvar]): its rows of the network matrix, which
+        # ``finish`` reads from the evaluating grid, hold their admittances, so the batch
+        # simulator must not give members with other loads there one evaluating copy (this
+        # attribute is part of the grid's fingerprint, the loads elsewhere are not)
+        self.bus_load = net.bus[self.bus][:, [PD, QD]].copy()
         self._nb = net.nb
 
     def _rows(self, system):
