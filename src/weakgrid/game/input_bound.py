@@ -314,7 +314,7 @@ class InputBound:
             # call overhead whatever the count, a point ~0.09 ms (measured, m = 2)
             Ms = np.broadcast_to(M, shape + (m, m)).reshape(-1, m, m).tolist()
             twoR = [2.0 * r for r in np.diag(R).tolist()]
-            out = [_minimize_point(self, Mk, bk, twoR, max_iter)
+            out = [_minimize_point(self, Mk, bk, twoR, max_iter, return_info)
                    for Mk, bk in zip(Ms, b.reshape(-1, m).tolist())]
             u = np.asarray([o[0] for o in out], float).reshape(shape + (m,))
             if not return_info:
@@ -369,12 +369,12 @@ class InputBound:
                     | (dv <= 1e-15 * (np.abs(vn).max(-1) + L)))
             active[idx[done]] = False
         n_left = int(active.sum())
-        res = np.abs(G(v, M, b)).max(-1) / scale
         # the Abu-Khalaf–Lewis form at the solution: u = −ū·tanh((2R)⁻¹(b + Mu)/ū)
         u = self.squash(-(b + np.einsum("pij,pj->pi", M, self.squash(v))) / twoR)
         u = u.reshape(shape + (m,))
         if not return_info:
             return u
+        res = np.abs(G(v, M, b)).max(-1) / scale    # only for the info (u does not read it)
         return u, {"iterations": it, "n_unconverged": n_left,
                    "max_residual": float(res.max()) if res.size else 0.0}
 
@@ -450,8 +450,12 @@ def _pt_solve(A, b):
     return [(A[1][1] * b[0] - A[0][1] * b[1]) / det, (A[0][0] * b[1] - A[1][0] * b[0]) / det]
 
 
-def _minimize_point(bd, M, b, twoR, max_iter):
-    """:meth:`InputBound.minimize` at one point: ``(u, info)`` (lists and floats)."""
+def _minimize_point(bd, M, b, twoR, max_iter, return_info=True):
+    """:meth:`InputBound.minimize` at one point: ``(u, info)`` (lists and floats; ``info``
+    None unless ``return_info``: its residual costs one more evaluation of G).
+
+    Nothing is evaluated twice at the same point: F at the point a step accepted is the next
+    step's ``f0`` (the same floats in, the same float out)."""
     m = len(b)
     if not hasattr(bd, "_lim"):
         object.__setattr__(bd, "_lim", [float(x) for x in bd.limit])
@@ -472,6 +476,7 @@ def _minimize_point(bd, M, b, twoR, max_iter):
     A = [[M[i][j] + (twoR[i] if i == j else 0.0) for j in range(m)] for i in range(m)]
     v = _pt_solve(A, [-x for x in b])
     it, active = 0, True
+    f_v = None      # F(v), when the last step's backtracking evaluated it at the accepted v
     for it in range(1, max_iter + 1):
         if not active:
             break
@@ -490,11 +495,14 @@ def _minimize_point(bd, M, b, twoR, max_iter):
             d = [-gi / r2 for gi, r2 in zip(g, twoR)]
             slope = slope_of(d)
         alpha = 1.0
-        f0 = F(v)
+        f0 = F(v) if f_v is None else f_v
         tol_f = 1e-15 * (abs(f0) + 1.0)
+        f_v = None
         for _ in range(60):
             vn = [vi + alpha * di for vi, di in zip(v, d)]
-            if not F(vn) > f0 + 1e-4 * alpha * min(slope, 0.0) + tol_f:
+            fn = F(vn)
+            if not fn > f0 + 1e-4 * alpha * min(slope, 0.0) + tol_f:
+                f_v = fn        # F at the accepted point (vn is recomputed below, equal)
                 break
             alpha = 0.5 * alpha
         vn = [vi + alpha * di for vi, di in zip(v, d)]
@@ -503,7 +511,9 @@ def _minimize_point(bd, M, b, twoR, max_iter):
         if (max(abs(x) for x in g) <= 1e-14 * scale
                 or dv <= 1e-15 * (max(abs(x) for x in vn) + L)):
             active = False
-    res = max(abs(x) for x in G(v)) / scale
     Ms = _pt_mv(M, _pt_squash(bd, v))
     u = _pt_squash(bd, [-(bi + mi) / r2 for bi, mi, r2 in zip(b, Ms, twoR)])
+    if not return_info:
+        return u, None
+    res = max(abs(x) for x in G(v)) / scale
     return u, {"iterations": it, "n_unconverged": int(active), "max_residual": float(res)}
