@@ -106,12 +106,12 @@ CASES = {
     # initial bounds, the operating point's, are masked)
     "ST8C": (_psse("ST8C", "ThreeBus_ST8C.dyr"), {("InfiniteBus", "p0")}),
     "ESAC1A": (_psse("AC1A", "ThreeBus_ESAC1A_SAT.dyr"), {("ESAC1A", "vref0")}),
-    "HYGOV": (_psse("HYGOV", "ThreeBus_HYGOV.dyr"), {("SEXS", "vref0"), ("HYGOV", "pref0")}),
-    "GAST": (_psse("GAST", "ThreeBus_GAST.dyr"), {("ESAC1A", "vref0"), ("GAST", "pref0")}),
+    "HYGOV": (_psse("HYGOV", "ThreeBus_HYGOV.dyr"), {("SEXS", "vref0")}),
+    "GAST": (_psse("GAST", "ThreeBus_GAST.dyr"), {("ESAC1A", "vref0")}),
     "PIDGOV": (_psse("PIDGOV", "ThreeBus_PIDGOV_GateFlag.dyr"), {("SEXS", "vref0")}),
     "IEEEST": (_psse("IEEEST", "ThreeBus_IEEEST_with_filter.dyr"), {("SEXS", "vref0")}),
     "EXST1-GENSAL": (_psse("EXST1", "TVC_System.dyr", "TVC_System_32.raw"),
-                     {("EXST1", "vref0"), ("HYGOV", "pref0")}),
+                     {("EXST1", "vref0")}),
     "EXAC1-GENSAL": (_psse("EXAC1", "TVC_System.dyr", "TVC_System_32.raw"), {("EXAC1", "vref0")}),
     "GENSAE": (_psse("GENSAE", "ThreeBus_GENSAE.dyr"), {("InfiniteBus", "p0")}),
     "GENROE": (_psse("GENROE", "ThreeBus_GENROE.dyr"), {("InfiniteBus", "p0")}),
@@ -157,8 +157,12 @@ def test_a_grid_at_several_loads_is_one_batch_equal_to_its_runs_alone(case):
     build, declared = CASES[case]
     grids = [build(k) for k in LEVELS]
     assert len({system_fingerprint(g) for g in grids}) == 1
-    differ = {(grids[0].comps[j].type_name, name) for j, name, _ in member_params(grids)}
-    assert declared <= differ, differ                # the set-points do differ per member
+    # the set-points do differ per member, beyond round-off: in these PSS/E cases the
+    # governors' units are not the slack, so their pref0 moves by 1 ulp between load levels
+    # (NumPy 2) or not at all (NumPy 1.26); the *-swing cases put them on the slack
+    differ = {(grids[0].comps[j].type_name, name) for j, name, v in member_params(grids)
+              if np.abs(v - v[0]).max() > 1e-9 * np.abs(v).max()}
+    assert declared <= differ, differ
     alone = [_alone(g, sc, T_END, dt=DT) for g, sc in zip(grids, _scenarios(grids))]
     st = {}
     got = simulate_batch(grids[0], _scenarios(grids), T_END, dt=DT, stats=st)
