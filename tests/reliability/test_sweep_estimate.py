@@ -48,8 +48,10 @@ def _refused(ws, cli, argv, runs):
 
 
 def test_huge_sweep_is_refused_before_any_run(ws, cli):
-    """540 runs of 600 s (≈ 4·10⁸ steps): refused with the count, the limits and the fix."""
-    study = _study(ws, (AXIS, f'"upqc.rating" = {RATINGS}'), (T_END, "t_end = 600.0\ndesign_load"))
+    """540 runs of 6000 s (≈ 6·10⁸ steps; batched, the runs' steps cost ≈ 0.06 ms each: ≈ 10
+    CPU-h — 600-s runs were close enough to the limits to run on a fast machine once batches
+    were counted): refused with the count, the limits and the fix."""
+    study = _study(ws, (AXIS, f'"upqc.rating" = {RATINGS}'), (T_END, "t_end = 6000.0\ndesign_load"))
     stdout, err = _refused(ws, cli, ["sweep", study], 540)
     assert re.search(r"sweep: 540 runs \(0 cached\), ≈ [\d.]+ CPU-h", stdout), stdout
     assert "limits 30 min" in err and "more workers" in err and "--quick" in err, err
@@ -149,14 +151,15 @@ def test_bounded_trainings_are_estimated_with_their_own_basis():
 
 def _fake_probe(calls):
     """A probe with round numbers: 1 ms a step (quiet or not), a batch of ``b`` runs
-    1 ms + 0.1 ms per run beyond the first, free set-up and trainings."""
+    1 ms + 0.1 ms per run beyond the first, free set-up and trainings, 10⁵ variables (their
+    trajectories outweigh the process's own memory)."""
     from types import SimpleNamespace
 
     free = SimpleNamespace(seconds=0.0, bytes=0.0)
 
     def probe(inputs, steps=(10, 40), batch=1):
         calls.append(batch)
-        return {"per_step_s": 1e-3, "transient_step_s": 1e-3, "per_run_s": 0.0, "n_vars": 10,
+        return {"per_step_s": 1e-3, "transient_step_s": 1e-3, "per_run_s": 0.0, "n_vars": 10**5,
                 "train": free, "train_bounded": free, "batch": batch,
                 "batch_step_s": 1e-3 + 1e-4 * (batch - 1)}
     return probe
@@ -181,6 +184,10 @@ def test_a_batched_sweep_is_costed_by_its_batches(tmp_path, monkeypatch, workers
     assert scalar.cpu_s == pytest.approx(12 * n * 1e-3)
     assert batched.cpu_s == pytest.approx(sum(n * (1e-3 + 1e-4 * (b - 1)) for b in sizes))
     assert batched.batch == max(sizes) and scalar.batch == 1
+    # a worker holds the trajectories of its batch's runs (2 × 8 bytes × variables × steps each)
+    run_bytes = 2 * 8.0 * 10**5 * n
+    held = (max(sizes) - 1) * run_bytes * max(workers, 1)
+    assert batched.bytes - scalar.bytes == pytest.approx(held, rel=0.01)
     assert f"in a batch of {max(sizes)}" in batched.line() and "batch" not in scalar.line()
 
 

@@ -25,7 +25,8 @@ on 2 cores, the quick maps' sweep of `reproduce`, 18 runs, estimated at 14 s too
 
 The memory: one worker process holds what this process holds after the probe (the
 package, the grid; its resident size is measured), plus the trajectories of its longest
-run (steps × variables × 8 bytes, twice: while they grow and as the final array), plus a
+run (steps × variables × 8 bytes, twice: while they grow and as the final array) times the
+runs of its largest batch, plus a
 training's working memory; this process holds the table (a row per run) and, with
 ``signals``, one run's signals in transit.
 """
@@ -88,7 +89,8 @@ class SweepEstimate:
     batch : int
         The largest batch of the sweep (1: the runs one by one).
     batch_step_s : float
-        Measured cost of one quiet step of a batch of ``batch`` runs [s] (all of them).
+        Cost of one quiet step of a batch of ``batch`` runs [s] (all of them; measured up to
+        :data:`PROBE_BATCH` runs, extrapolated beyond).
     """
 
     n_runs: int
@@ -419,7 +421,10 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
     longest = max(steps.values())
     run_bytes = 2 * 8.0 * pr["n_vars"] * longest
     sig = 8.0 * pr["n_vars"] * longest if signals else 0.0
-    extra = max([run_bytes + sig] + [_training(pr, tk).bytes for tk in runs_per_key])
+    # a batch's members hold their trajectories until the batch ends
+    largest = max(len(b) for b in batches)
+    extra = max([largest * (run_bytes + sig)]
+                + [_training(pr, tk).bytes for tk in runs_per_key])
     if n_par is None:     # an existing cluster: its workers are elsewhere; one of them
         total = base + extra
     elif n_par == 0:      # serially in this process
@@ -428,8 +433,8 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
         total = base + table + sig + n_par * (base + extra)
     return SweepEstimate(n_runs, n_cached, scale * sum(steps.values()), pr["per_step_s"],
                          pr["per_run_s"], n_train, cpu, n_par, wall, total, unlisted=unlisted,
-                         transient_step_s=pr["transient_step_s"], batch=pr["batch"],
-                         batch_step_s=pr["batch_step_s"])
+                         transient_step_s=pr["transient_step_s"], batch=largest,
+                         batch_step_s=batch_step_cost(pr, largest))
 
 
 def _batches(todo: dict, n_points: int, workers: int | None) -> list[list]:
