@@ -6,8 +6,6 @@ limit and dc link) shares their batch with its own values; one that differs in a
 is put in another batch (and refused by :class:`BatchSimulator` itself, naming the member).
 """
 
-import copy
-
 import numpy as np
 import pytest
 from sim_cases import build_gti_upqc_sg

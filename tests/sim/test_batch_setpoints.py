@@ -20,7 +20,6 @@ field follow the load) behind a voltage compensator (IEEEVC: the exciter's input
 moves with the load too).
 """
 
-import copy
 import warnings
 from pathlib import Path
 
