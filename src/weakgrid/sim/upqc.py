@@ -77,13 +77,7 @@ def link_vmax(Vmax, Vdc, Vdc0):
     return np.where(Vdc < Vdc0, Vmax * np.maximum(Vdc, 0.0) / Vdc0, Vmax)
 
 
-def current_limit(Imax):
-    """The shunt converter's current limit [pu on Sb] as :func:`shunt_dc_law` applies it:
-    ``Imax``, and no limit (``inf``) where ``Imax = 0``."""
-    return np.where(Imax > 0, Imax, np.inf)
-
-
-def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p, imax=None):
+def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p):
     """The conventional UPQC's shunt converter and dc link (the module docstring's equations),
     the one law every engine evaluates.
 
@@ -99,8 +93,6 @@ def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p, imax=None):
     p : mapping
         ``Vdc0``, ``kp_dc``, ``ki_dc``, ``Imax`` (0: no limit), ``Rsh``, ``Cdc``
         (:attr:`UPQC.params`).
-    imax : array_like, optional
-        ``current_limit(p["Imax"])``, when the caller holds it (computed otherwise).
 
     Returns
     -------
@@ -111,8 +103,7 @@ def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p, imax=None):
     """
     err = p["Vdc0"] - Vdc
     Id = (Pdc + p["kp_dc"] * err + xi_dc) / vr_safe
-    if imax is None:
-        imax = current_limit(p["Imax"])   # 0: no limit
+    imax = np.where(p["Imax"] > 0, p["Imax"], np.inf)   # 0: no limit
     over = np.abs(Id) > imax
     limited = over.any()
     if limited:
@@ -137,8 +128,8 @@ class UPQC(Component):
     #: sweep over the rating)
     batch_params = ("Vmax", "Imax", "Cdc", "kp_dc", "ki_dc", "Rsh")
 
-    #: the last evaluation's values and the cached current limit (not the grid's data)
-    scratch = ("_f", "_imax")
+    #: the last evaluation's values (not the grid's data)
+    scratch = ("_f",)
 
     kind = "device"
     order = 3
@@ -223,15 +214,6 @@ class UPQC(Component):
         # the buses as slices where they can be (basic indexing: no gather per evaluation)
         self._ri, self._b1i = (fast_index(self.r), fast_index(self.b1)) if self._uniq else (self.r, self.b1)
         self._r_conv = fast_index(self.r[self._conv]) if self._uniq else self.r[self._conv]
-        self._imax = (None, None)    # (the Imax it was computed from, current_limit(Imax))
-
-    def _current_limit(self):
-        """:func:`current_limit` of ``p["Imax"]``, recomputed only when ``Imax`` is another
-        array (a batch binds its members' own)."""
-        Imax = self.p["Imax"]
-        if self._imax[0] is not Imax:
-            self._imax = (Imax, current_limit(Imax))
-        return self._imax[1]
 
     def set_input(self, name, Vup, Vuq):
         """Hold series-voltage commands ``Vup`` (quadrature) and ``Vuq`` (in phase) [pu] for UPQC ``name``."""
@@ -292,7 +274,7 @@ class UPQC(Component):
         o = ctx.out
         if self._any_conv:
             Id, over, Psh, Ploss, dVdc, dxi = shunt_dc_law(Pdc, Vdc, ctx.x[..., self.sl(1)],
-                                                          vr_abs, vr_safe, p, self._current_limit())
+                                                          vr_abs, vr_safe, p)
             if self._all_conv:
                 scatter_add(ctx.I, self._r_conv, -(Id * ur), self._uniq)
             else:

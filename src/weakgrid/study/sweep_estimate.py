@@ -256,11 +256,15 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
     t0 = time.perf_counter()
     setup = build_setup(st, run.load, run.upqc, controller_variant(st, run.controller))
     t_setup = time.perf_counter() - t0
+
+    def idle(**kw):     # the run's digital controller, measuring and holding zero
+        return DigitalController(lambda m: np.zeros(2), T=setup.design.T, measure=setup.measure,
+                                 target=UPQCTarget(setup.upqc_name) if setup.upqc_name
+                                 else _MeasureOnly(), name="probe", **kw)
+
     timed = []
     for n in steps:    # at the operating point: the fixed cost and the cost of a quiet step
-        dc = DigitalController(lambda m: np.zeros(2), T=setup.design.T, measure=setup.measure,
-                               target=UPQCTarget(setup.upqc_name) if setup.upqc_name
-                               else _MeasureOnly(), name="probe")
+        dc = idle()
         t0 = time.perf_counter()
         res = simulate(setup.system, n * dt, dt=dt, tol=tol, controllers=[dc],
                        on_failure="return")
@@ -273,10 +277,7 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
     if batch > 1:     # the same quiet steps, ``batch`` copies of the run together
         tb = []
         for n in steps:
-            scen = [{"controllers": [DigitalController(
-                lambda m: np.zeros(2), T=setup.design.T, measure=setup.measure,
-                target=UPQCTarget(setup.upqc_name) if setup.upqc_name else _MeasureOnly(),
-                name="probe")]} for _ in range(batch)]
+            scen = [{"controllers": [idle()]} for _ in range(batch)]
             t0 = time.perf_counter()
             simulate_batch(setup.system, scen, n * dt, batch_size=batch, dt=dt, tol=tol)
             tb.append(time.perf_counter() - t0)
@@ -290,10 +291,7 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
     first, last = _event_window(run.events)
     if first is not None:
         t_probe = min(run.t_end, last + TRANSIENT_STEPS * dt)
-        dc = DigitalController(lambda m: np.zeros(2), T=setup.design.T, measure=setup.measure,
-                               target=UPQCTarget(setup.upqc_name) if setup.upqc_name
-                               else _MeasureOnly(), enable=enable_windows(run.bypass, t_probe),
-                               name="probe")
+        dc = idle(enable=enable_windows(run.bypass, t_probe))
         t0 = time.perf_counter()
         res = simulate(setup.system, t_probe, dt=dt, tol=tol, controllers=[dc],
                        events=make_events(setup, run), on_failure="return")
@@ -388,8 +386,9 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
     steps = {k: _steps(p.inputs) for k, p in todo.items()}
     batches = _batches(todo, len(pts), workers) if batched \
         else [[k] for k in todo]
+    largest = max(len(b) for b in batches)
     try:
-        pr = probe(next(iter(todo.values())).inputs, batch=max(len(b) for b in batches))
+        pr = probe(next(iter(todo.values())).inputs, batch=largest)
     except Exception as exc:  # a grid that does not run: every run will say why, as a row
         return SweepEstimate(n_runs, n_cached, scale * sum(steps.values()),
                              math.nan, math.nan, 0, math.nan, n_par, None, base + table,
@@ -422,7 +421,6 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
     run_bytes = 2 * 8.0 * pr["n_vars"] * longest
     sig = 8.0 * pr["n_vars"] * longest if signals else 0.0
     # a batch's members hold their trajectories until the batch ends
-    largest = max(len(b) for b in batches)
     extra = max([largest * (run_bytes + sig)]
                 + [_training(pr, tk).bytes for tk in runs_per_key])
     if n_par is None:     # an existing cluster: its workers are elsewhere; one of them
