@@ -75,6 +75,12 @@ class PolynomialBasis:
         E.setflags(write=False)
         object.__setattr__(self, "exponents", E)
         object.__setattr__(self, "_tables", self._build_tables(E))
+        object.__setattr__(self, "_states", np.arange(E.shape[1]))
+        n = E.shape[1]
+        planes = np.empty((n, n), dtype=np.int64)
+        for m, (j, k) in enumerate(self._tables[2]):
+            planes[j, k] = planes[k, j] = 1 + n + m
+        object.__setattr__(self, "_hessian_planes", planes)
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -90,7 +96,7 @@ class PolynomialBasis:
 
     @property
     def degree(self) -> int:
-        return int(self.exponents.sum(axis=1).max())
+        return self._tables[3]
 
     # ------------------------------------------------------------ evaluation
     @staticmethod
@@ -116,7 +122,7 @@ class PolynomialBasis:
                 c = c * _falling(E[:, i], int(a[i]))
             coef[m] = c
             exps[m] = np.maximum(E - a, 0)
-        return exps, coef, pairs
+        return exps, coef, pairs, int(E.sum(axis=1).max())
 
     def _check_x(self, x) -> tuple[np.ndarray, tuple]:
         x = np.asarray(x, dtype=float)
@@ -131,18 +137,19 @@ class PolynomialBasis:
         first derivatives, then the second derivatives ∂²/∂x_j∂x_k for ``j ≤ k`` in
         row-major order (K = 1, 1 + n or 1 + n + n(n+1)/2 for order 0, 1, 2).
         """
-        exps, coef, _ = self._tables
+        exps, coef, _, dmax = self._tables
         n = self.n_states
         k = {0: 1, 1: 1 + n, 2: len(coef)}[order]
-        dmax = self.degree
-        out = None
-        for i in range(n):
-            pw = np.empty((dmax + 1, xT.shape[1]))
-            pw[0] = 1.0
-            for d in range(1, dmax + 1):
-                pw[d] = pw[d - 1] * xT[i]
-            g = pw[exps[:k, :, i]]  # (k, L, p)
-            out = g if out is None else out * g
+        # the powers x_i^d, d = 0 … degree, of every state at once: a cumulative product,
+        # pw[d] = pw[d − 1]·x (the same products as one multiplication per power)
+        base = np.empty((dmax + 1, n, xT.shape[1]))
+        base[0] = 1.0
+        base[1:] = xT
+        pw = np.multiply.accumulate(base, axis=0)
+        g = pw[exps[:k], self._states]  # (k, L, n, p): each monomial's factors
+        out = g[:, :, 0]
+        for i in range(1, n):
+            out = out * g[:, :, i]
         return out * coef[:k, :, None]
 
     def evaluate(self, x, order: int = 2):
@@ -160,7 +167,6 @@ class PolynomialBasis:
         hess : ndarray, shape (..., L, n, n)   (if order = 2)
         """
         x2, batch = self._check_x(x)
-        _, _, pairs = self._tables
         n, L = self.n_states, self.size
         mono = self.planes(x2.T, order)  # (k, L, p)
         phi = mono[0].T.reshape(*batch, L)
@@ -169,10 +175,7 @@ class PolynomialBasis:
         grad = mono[1 : 1 + n].transpose(2, 1, 0).reshape(*batch, L, n)
         if order == 1:
             return phi, grad
-        hess = np.empty((n, n, L, x2.shape[0]))
-        for m, (j, kk) in enumerate(pairs):
-            hess[j, kk] = mono[1 + n + m]
-            hess[kk, j] = mono[1 + n + m]
+        hess = mono[self._hessian_planes]  # (n, n, L, p): plane of ∂²/∂x_j∂x_k at [j, k]
         return phi, grad, hess.transpose(3, 2, 0, 1).reshape(*batch, L, n, n)
 
     def second_derivative_pairs(self):

@@ -173,7 +173,7 @@ class _BatchRecorder:
         for k in range(B):
             if self.blocks:
                 a, b = cut[k], cut[k + 1]
-                t, data = T[a:b].copy(), D[a:b].copy()
+                t, data = T[a:b], D[a:b]     # views of the arrays sorted above: no copy
             else:
                 t, data = xp.zeros(0), xp.zeros((0, len(rec.names)))
             out.append(Results(t, list(rec.names), data, list(rec.kinds), list(rec.fac),
