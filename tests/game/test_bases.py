@@ -84,3 +84,35 @@ def test_bad_bases_are_refused():
         paper_basis()(np.zeros(3))
     with pytest.raises(ParameterError):
         even_monomials(2, 3)
+
+
+@given(basis_and_points())
+def test_a_batch_row_is_its_point_alone_bit_for_bit(bp):
+    # the batch simulator evaluates many members' policies in one call and promises each
+    # member its run alone: every row of a batched evaluation must be the one-point evaluation
+    basis, x = bp
+    rows = basis.evaluate(x)
+    for i, xi in enumerate(x):
+        for batched, alone in zip(rows, basis.evaluate(xi)):
+            assert np.array_equal(batched[i], alone)
+
+
+@given(basis_and_points())
+def test_derivatives_are_the_monomials_derivatives(bp):
+    # each derivative of x^e is a falling-factorial constant times a monomial (analytic, to
+    # round-off): ∂/∂x_j x^e = e_j x^(e - 1_j), ∂²/∂x_j∂x_k = e_j (e_k - δ_jk) x^(e - 1_j - 1_k)
+    basis, x = bp
+    _, grad, hess = basis.evaluate(x)
+    E, n = basis.exponents, basis.n_states
+    for j in range(n):
+        d = E.copy()
+        d[:, j] -= 1
+        want = E[:, j] * np.prod(x[:, None, :] ** np.maximum(d, 0)[None], axis=-1)
+        np.testing.assert_allclose(grad[..., j], want, rtol=1e-12, atol=1e-12)
+        for k in range(n):
+            dd = d.copy()
+            dd[:, k] -= 1
+            c = E[:, j] * (E[:, k] - (j == k))
+            want2 = np.where(dd.min(axis=1) >= 0, c, 0) * np.prod(
+                x[:, None, :] ** np.maximum(dd, 0)[None], axis=-1)
+            np.testing.assert_allclose(hess[..., j, k], want2, rtol=1e-12, atol=1e-12)
