@@ -71,7 +71,7 @@ import numpy as np
 
 from .component import fast_index
 from .errors import DataError, SimulationError
-from .integrate import Simulator, _held, _output_path
+from .integrate import Simulator, _held, _held_change, _output_path, jump_guess
 from .results import Results
 
 xp = np     # the array namespace of the batched arithmetic (array API: swap for another backend)
@@ -909,7 +909,7 @@ class BatchSimulator:
         if not jumps:
             return
         self._sync_network(jumps)
-        guesses = {}
+        guesses, du = {}, {}
         fresh = [k for k in jumps if new_jac.get(k)]
         if fresh:
             self.refresh_jacobian(self.t, xp.stack([self.sims[k].z for k in fresh]), fresh)
@@ -919,7 +919,8 @@ class BatchSimulator:
                 sim._jump = None
                 sim._corr = None
             elif sim._jump is not None and sim._jump_t > self.t - 1.5 * _gap(ctls[k]):
-                guesses[k] = sim.z[nx:] + sim._jump
+                du[k] = _held_change(ctls[k], held[k])
+                guesses[k] = jump_guess(sim.z[nx:], sim._jump, du[k])
         paths = {k: (ctls[k], held[k]) for k in jumps}   # the jump's path, made if it is needed
         y_before = {k: self.sims[k].z[nx:] for k in jumps}
         self._solve_jump(self.t, jumps, guesses, paths, fail)
@@ -927,7 +928,8 @@ class BatchSimulator:
         for k in jk:
             sim = self.sims[k]
             if not new_jac.get(k):
-                sim._jump = sim.z[nx:] - y_before[k]
+                sim._jump = (sim.z[nx:] - y_before[k],
+                             du[k] if k in du else _held_change(ctls[k], held[k]))
                 sim._jump_t = self.t
             sim._release_held(sim._f)
         if jk:

@@ -677,20 +677,21 @@ class Simulator:
                             discont |= c.sample(self, self.t, self.z)
                     if discont:
                         y_before = self.z[self.nx:]
+                        du = _held_change(controllers, u_held)
                         guess = None
                         if new_jac:
                             self._refresh_jacobian(self.t, self.z)
                             self._jump = None
                             self._corr = None
                         elif self._jump is not None and self._jump_t > self.t - 1.5 * jump_gap:
-                            # consecutive ZOH samples of a smooth control: the algebraic jump
-                            # is close to the previous one; start the re-solve from there
-                            guess = y_before + self._jump
+                            # consecutive ZOH samples of a smooth control: start the re-solve
+                            # from the previous jump, scaled to this sample's output change
+                            guess = jump_guess(y_before, self._jump, du)
                         self.z, F, self._ctx = self.solve_algebraic(self.t, self.z, return_eval=True,
                                                                     y_guess=guess,
                                                                     path=_output_path(controllers, u_held))
                         if not new_jac:
-                            self._jump = self.z[self.nx:] - y_before
+                            self._jump = (self.z[self.nx:] - y_before, du)
                             self._jump_t = self.t
                         self._f = F[:self.nx].copy()
                         # a held state whose input fell inside its limit at the event (a fault
@@ -713,6 +714,39 @@ def _held(c):
     """The output a controller's target holds (None if it cannot tell)."""
     get = getattr(getattr(c, "target", None), "get", None)
     return None if get is None else np.array(get(), dtype=float)
+
+
+def _held_change(controllers, held):
+    """The change of every controller's held output since ``held`` (their outputs before a
+    sample), one flat array; None if a target cannot tell its output."""
+    parts = []
+    for c, u0 in zip(controllers, held):
+        u1 = _held(c)
+        if u0 is None or u1 is None:
+            return None
+        parts.append(u1 - u0)
+    return np.concatenate(parts) if parts else None
+
+
+def jump_guess(y, jump, du):
+    """A start for the network re-solve after a sample: the algebraic variables ``y`` moved
+    by the previous jump ``jump = (Δy, Δu)`` scaled to this sample's output change ``du``.
+
+    The network's response to the held outputs is nearly linear over one sample,
+    ``Δy ≈ S·Δu``; with ``c = ⟨du, Δu⟩ / ⟨Δu, Δu⟩`` (the least-squares multiple of the
+    previous change, on Python floats: the same in a batch and alone) the guess is
+    ``y + c·Δy``, exact when the output changes along the previous direction. A control
+    signal that turns (``du`` against ``Δu``) gets a guess on the right side, where
+    ``y + Δy`` would double the distance. Without a usable ``Δu``: ``y + Δy``.
+    """
+    dy, du_prev = jump
+    if du is None or du_prev is None or du.shape != du_prev.shape:
+        return y + dy
+    a, b = du.tolist(), du_prev.tolist()
+    nb = sum(x * x for x in b)
+    if not nb > 0.0:
+        return y + dy
+    return y + (sum(x * z for x, z in zip(a, b)) / nb) * dy
 
 
 def _output_path(controllers, held):
