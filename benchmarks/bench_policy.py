@@ -11,9 +11,10 @@ model (the ``case1-paper`` preset's controller, trained here first, about a seco
 of NumPy calls, not arithmetic; compare two versions of the code by running this file with
 each on ``PYTHONPATH``, back to back.
 
-Measured 2026-12-02 (load ≈ 0.5, the code before → after the basis' powers became one
-cumulative product, its factors one gather, the Hessian planes one index and the saddle
-point's constant matrix built once; the outputs bit for bit the same): one state 116 → 54 µs.
+Measured 2026-12-02 (load ≈ 0.7, the code before and after the basis' powers became one
+cumulative product, its factors one gather and the Hessian planes one index, alternated
+twice; the outputs bit for bit the same): one state 57–61 → 46–65 µs, 45 rows 112–119 →
+98–169 µs — within this machine's noise at this size.
 
 Run:  PYTHONPATH=src python benchmarks/bench_policy.py
 """

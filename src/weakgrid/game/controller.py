@@ -102,23 +102,15 @@ class GameController:
         m, q = g.shape[-1], h.shape[-1]
         B = np.concatenate([g, h], axis=-1)  # (..., n, m+q)
         M = np.einsum("...ni,...nk,...kj->...ij", B, HJ, B)
+        reg = np.zeros((m + q, m + q))
+        reg[:m, :m] = 2 * self.cost.R
+        reg[m:, m:] = -2 * self.cost.gamma**2 * self.cost.P
         rhs = np.einsum("...ni,...n->...i", B, gJ + np.einsum("...ij,...j->...i", HJ, f - x))
         if self.cost.bound is not None:
             return self._bounded_saddle_point(M, rhs, m)
-        M = M + self._regularizer(m, q)
+        M = M + reg
         z = -np.linalg.solve(M, rhs[..., None])[..., 0]
         return z[..., :m], z[..., m:]
-
-    def _regularizer(self, m, q):
-        """``blockdiag(2R, −2γ²P)``, the constant part of the saddle point's matrix (built once
-        per cost)."""
-        cached = self.__dict__.get("_reg")
-        if cached is None or cached[0] is not self.cost:
-            reg = np.zeros((m + q, m + q))
-            reg[:m, :m] = 2 * self.cost.R
-            reg[m:, m:] = -2 * self.cost.gamma**2 * self.cost.P
-            cached = self._reg = (self.cost, reg)
-        return cached[1]
 
     def _bounded_saddle_point(self, M, rhs, m):
         """``u* = argmin_{bound} max_w`` of (22) with ``W(u)``; ``M = B'∇²J B``, ``rhs = B'r``."""
