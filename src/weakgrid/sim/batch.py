@@ -162,16 +162,29 @@ class _BatchRecorder:
         if not rec._layout_done:    # nothing recorded (every member failed at t = 0)
             return [Results(xp.zeros(0), [], xp.zeros((0, 0)), [], [], failure=failures[k], stats=stats[k])
                     for k in range(B)]
-        if self.blocks:
-            T = xp.concatenate([xp.broadcast_to(xp.asarray(t, dtype=float), (len(m),)) for t, m, _ in self.blocks])
+        recorded = bool(self.blocks)
+        if recorded:
+            # each recorded row straight to its place in the rows sorted by member (stable: in
+            # time within a member), block by block, each block released once placed: one copy
+            # of the records, not a concatenation and a gather of it (two copies, 3× the memory)
             K = xp.concatenate([m for _, m, _ in self.blocks])
-            D = xp.concatenate([d for _, _, d in self.blocks])
             order = xp.argsort(K, kind="stable")
-            T, K, D = T[order], K[order], D[order]
-            cut = xp.searchsorted(K, xp.arange(B + 1))
+            cut = xp.searchsorted(K[order], xp.arange(B + 1))
+            dest = xp.empty_like(order)
+            dest[order] = xp.arange(len(order))
+            T = xp.empty(len(K))
+            D = xp.empty((len(K), self.blocks[0][2].shape[1]))
+            s = 0
+            blocks, self.blocks = self.blocks, []
+            for i, (t, m, d) in enumerate(blocks):
+                at = dest[s:s + len(m)]
+                T[at] = t
+                D[at] = d
+                s += len(m)
+                blocks[i] = None
         out = []
         for k in range(B):
-            if self.blocks:
+            if recorded:
                 a, b = cut[k], cut[k + 1]
                 t, data = T[a:b], D[a:b]     # views of the arrays sorted above: no copy
             else:
