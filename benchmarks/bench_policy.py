@@ -14,7 +14,10 @@ each on ``PYTHONPATH``, back to back.
 Measured 2026-12-02 (load ≈ 0.7, the code before and after the basis' powers became one
 cumulative product, its factors one gather and the Hessian planes one index, alternated
 twice; the outputs bit for bit the same): one state 57–61 → 46–65 µs, 45 rows 112–119 →
-98–169 µs — within this machine's noise at this size.
+98–169 µs — within this machine's noise at this size. Late that evening (load ≈ 1.3, old and
+new alternated twice), the bounded law's point form with its sums written out (the same
+floats): one state 157/190 → 120/122 µs, 6 rows 513/526 → 295/301 µs; 45 rows (the
+vectorized iteration) 1032/1085 → 1053/1087 µs, unchanged.
 
 Run:  PYTHONPATH=src python benchmarks/bench_policy.py
 """
