@@ -33,22 +33,13 @@ def _squash_jacobian(bd, v):
         return [[(1.0 / math.cosh(min(abs(v[i] / bd._lim[i]), 350.0)) ** 2) if i == j else 0.0
                  for j in range(m)] for i in range(m)]
     L = bd._lim[0]
-    t = math.sqrt(sum(x * x for x in v)) / L
-    t2 = t * t
-    if t < 1e-3:
-        fac = 1.0 - t2 / 3.0 + 2.0 * t2 * t2 / 15.0
-        c = -2.0 / 3.0 + 8.0 * t2 / 15.0 - 34.0 * t2 * t2 / 105.0
-    else:
-        fac = math.tanh(t) / t
-        c = (1.0 / math.cosh(min(t, 350.0)) ** 2 - fac) / (t * t)
+    fac, c = ib._pt_disk_jacobian_coeffs(math.sqrt(sum(x * x for x in v)) / L)
     return [[(fac if i == j else 0.0) + c * v[i] * v[j] / (L * L) for j in range(m)]
             for i in range(m)]
 
 
 def _penalty_of_v(bd, v, twoR):
-    def val(t, L2):
-        lc = t - math.log(2.0) if t > 20.0 else math.log1p(2.0 * math.sinh(0.5 * t) ** 2)
-        return 2.0 * L2 * (t * math.tanh(t) - lc)
+    val = ib._pt_penalty_val      # the scalar formulas are shared; the sums are the subject
     if bd.shape == "box":
         return sum(0.5 * r2 * val(abs(x) / L, L * L) for x, L, r2 in zip(v, bd._lim, twoR))
     L = bd._lim[0]
@@ -59,11 +50,7 @@ def _mv(M, x):
     return [sum(Mi[j] * x[j] for j in range(len(x))) for Mi in M]
 
 
-def _solve(A, b):
-    if len(b) == 1:
-        return [b[0] / A[0][0]]
-    det = A[0][0] * A[1][1] - A[0][1] * A[1][0]
-    return [(A[1][1] * b[0] - A[0][1] * b[1]) / det, (A[0][0] * b[1] - A[1][0] * b[0]) / det]
+_solve = ib._pt_solve      # no sums in it
 
 
 def _reference(bd, M, b, twoR, max_iter):

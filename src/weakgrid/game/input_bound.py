@@ -434,14 +434,7 @@ def _pt_squash_jacobian(bd, v):
         d = [1.0 / math.cosh(min(abs(x / L), 350.0)) ** 2 for x, L in zip(v, bd._lim)]
         return [[d[0], 0.0], [0.0, d[1]]] if m == 2 else [[d[0]]]
     L = bd._lim[0]
-    t = math.sqrt(_pt_dot(v, v)) / L
-    t2 = t * t
-    if t < 1e-3:
-        fac = 1.0 - t2 / 3.0 + 2.0 * t2 * t2 / 15.0
-        c = -2.0 / 3.0 + 8.0 * t2 / 15.0 - 34.0 * t2 * t2 / 105.0
-    else:
-        fac = math.tanh(t) / t
-        c = (1.0 / math.cosh(min(t, 350.0)) ** 2 - fac) / (t * t)
+    fac, c = _pt_disk_jacobian_coeffs(math.sqrt(_pt_dot(v, v)) / L)
     LL = L * L
     if m == 2:
         v0, v1 = v
@@ -450,15 +443,28 @@ def _pt_squash_jacobian(bd, v):
     return [[fac + c * v[0] * v[0] / LL]]
 
 
+def _pt_disk_jacobian_coeffs(t):
+    """``(fac, c)`` of the disk's ``∂squash/∂v = fac·I + c·vv'/ū²`` at ``t = ‖v‖/ū``."""
+    t2 = t * t
+    if t < 1e-3:
+        return (1.0 - t2 / 3.0 + 2.0 * t2 * t2 / 15.0,
+                -2.0 / 3.0 + 8.0 * t2 / 15.0 - 34.0 * t2 * t2 / 105.0)
+    fac = math.tanh(t) / t
+    return fac, (1.0 / math.cosh(min(t, 350.0)) ** 2 - fac) / (t * t)
+
+
+def _pt_penalty_val(t, L2):
+    """``2ū²(t·tanh t − ln cosh t)`` (``L2 = ū²``): the penalty of one saturating component."""
+    lc = t - math.log(2.0) if t > 20.0 else math.log1p(2.0 * math.sinh(0.5 * t) ** 2)
+    return 2.0 * L2 * (t * math.tanh(t) - lc)
+
+
 def _pt_penalty_of_v(bd, v, twoR):
-    def val(t, L2):
-        lc = t - math.log(2.0) if t > 20.0 else math.log1p(2.0 * math.sinh(0.5 * t) ** 2)
-        return 2.0 * L2 * (t * math.tanh(t) - lc)
     if bd.shape == "box":
-        w = [0.5 * r2 * val(abs(x) / L, L * L) for x, L, r2 in zip(v, bd._lim, twoR)]
+        w = [0.5 * r2 * _pt_penalty_val(abs(x) / L, L * L) for x, L, r2 in zip(v, bd._lim, twoR)]
         return 0.0 + w[0] + w[1] if len(w) == 2 else 0.0 + w[0]
     L = bd._lim[0]
-    return 0.5 * twoR[0] * val(math.sqrt(_pt_dot(v, v)) / L, L * L)
+    return 0.5 * twoR[0] * _pt_penalty_val(math.sqrt(_pt_dot(v, v)) / L, L * L)
 
 
 def _pt_solve(A, b):
