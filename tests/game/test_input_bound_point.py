@@ -156,7 +156,8 @@ def test_point_form_gives_the_floats_of_the_sums_as_written(m, shape, seed, dege
 
 def test_point_form_in_deep_saturation_and_at_the_origin():
     """The regimes the iteration branches on: ‖v‖/ū above 20 (the penalty's ln 2 form) and
-    below 1e-8 and 1e-3 (the series), a direction that is not one of descent."""
+    below 1e-8 and 1e-3 (the series), and a Newton direction that is not one of descent (the
+    fixed-point step: taken by the box in deep saturation and with M indefinite, checked)."""
     R2 = [1.6, 1.6]
     for shape in ("disk", "box"):
         bd = InputBound.for_inputs(2, 0.15, shape)

@@ -399,7 +399,7 @@ class InputBound:
 # start, directions, Armijo rule and stopping tests; tests/game/test_input_bound.py compares
 # the two). Vectors are lists of m floats, matrices lists of rows; every sum is written out
 # for m = 1 and m = 2 in the order of Python's ``sum`` (from 0, left to right), so a point
-# gives the same floats as the generator form it replaced (2 → 3× less interpreter time).
+# gives the same floats as the generator form it replaced (about 2× less interpreter time).
 
 def _pt_dot(a, c):
     if len(a) == 2:
