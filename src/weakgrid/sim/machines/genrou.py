@@ -33,8 +33,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..blocks import quad_saturation_coeffs
+from ..blocks import exp_saturation, quad_saturation_coeffs
 from ..errors import DataError
+from ..kernels import Kernel
 from ..params import Param
 from .base import BASE_PARAMS, SyncMachine, psse_subtransient_params
 from .shaft import swing
@@ -126,18 +127,28 @@ class GENROU(SyncMachine):
         self._nosat = bool(np.all(self.SB == 0))
         self._xd1l_iTd20 = self._xd1l * self._iTd20
         self._xq1l_iTq20 = self._xq1l * self._iTq20
+        # the constants of the elementwise core (genrou_core's p), one row each
+        self._P = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(c, float), (self.n,)) for c in (
+            self.gd1, self._c_e2d, self.gq1, self._c_e2q, self._cIda, self._cIdb, self._cIqb,
+            self._kd1, self._kd2, self._kq1, self._kq2, self._iTq10, self._iTd20, self._iTq20,
+            self._xd1l_iTd20, self._xq1l_iTq20, self.gqd, p["ra"], self.SA, self.SB)]))
+        # the core's branches: the stator with or without ra, the saturation curve (0 none,
+        # 1 GENROU's quadratic, 2 GENROE's exponential); compiled (weakgrid.sim.kernels)
+        # except the exponential, whose power function does not round as NumPy's
+        sat = 0 if self._nosat else (1 if self._exp_sat is None else 2)
+        self._flags = (self._ra0, sat)
+        self._compiled_flags = self._flags if sat < 2 else None
 
     @staticmethod
     def _sat_coeffs(S10, S12):
         """``(A, B)`` of the saturation curve through ``(1.0, S10)``, ``(1.2, S12)``."""
         return quad_saturation_coeffs(1.0, S10, 1.2, S12)
 
+    #: the exponential saturation curve (GENROE), None for GENROU's quadratic one
+    _exp_sat = None
+
     def _sat(self, psi2):
-        if (psi2 > 0).all():   # fast path: same values as below for psi2 > 0
-            return self.SB * np.maximum(psi2 - self.SA, 0.0) ** 2 / psi2
-        with np.errstate(divide="ignore", invalid="ignore"):
-            Se = np.where(psi2 >= self.SA, self.SB * (psi2 - self.SA) ** 2 / psi2, 0.0)
-        return np.where(np.isfinite(Se), Se, 0.0)
+        return quad_sat(psi2, self.SA, self.SB)
 
     def init(self, system, x, sig):
         p = self.p
@@ -173,50 +184,22 @@ class GENROU(SyncMachine):
         x = ctx.x
         sl = self._sls
         delta, omega = x[..., sl[0]], x[..., sl[1]]
-        e1q, e1d, e2d, e2q = x[..., sl[2]], x[..., sl[3]], x[..., sl[4]], x[..., sl[5]]
-        psi2d = self.gd1 * e1q + self._c_e2d * e2d
-        psi2q = self.gq1 * e1d + self._c_e2q * e2q
-        psi2 = np.sqrt(psi2d * psi2d + psi2q * psi2q)
         V = ctx.V[..., self._bi]
         sd, cd = np.sin(delta), np.cos(delta)
-        Vre, Vim = V.real, V.imag
-        vd = Vre * sd - Vim * cd
-        vq = Vre * cd + Vim * sd
-        # stator: xd2*Id + ra*Iq = psi2d - vq,  -ra*Id + xq2*Iq = vd - psi2q
-        a = psi2d - vq
-        b = vd - psi2q
-        if self._ra0:
-            Id = self._cIda * a
-            Iq = self._cIqb * b
-            psid, psiq = vq, -vd
-        else:
-            ra = self.p["ra"]
-            Id = self._cIda * a - self._cIdb * b
-            Iq = self._cIqb * b + self._cIdb * a
-            psid = ra * Iq + vq
-            psiq = -(ra * Id + vd)
+        (Ire, Iim, Id, Iq, XadIfd, Se, psi2, te, Pe, Qe, f3, f4, f5) = _KERNEL(
+            (x[..., sl[2]], x[..., sl[3]], x[..., sl[4]], x[..., sl[5]], sd, cd, V.real, V.imag),
+            self._P, self._flags, self._compiled_flags)
         # injected current (Id + j Iq) exp(j(delta - pi/2))
-        self.inject(ctx, (Id * sd + Iq * cd) + 1j * (Iq * sd - Id * cd))
-        dq, dd = e1q - e2d, e1d - e2q       # each once: the flux and the damper equations read them
-        XadIfd = e1q + self._kd1 * Id + self._kd2 * dq
-        XaqI1q = e1d + self._kq2 * dd - self._kq1 * Iq
-        if self._nosat:
-            Se = np.zeros_like(psi2)
-        else:
-            Se = self._sat(psi2)
-            XadIfd = XadIfd + Se * psi2d
-            XaqI1q = XaqI1q + (Se * self.gqd) * psi2q
-        self._te = psid * Iq - psiq * Id
+        self.inject(ctx, Ire + 1j * Iim)
+        self._te = te
         self._XadIfd = XadIfd
-        Pe = vd * Id + vq * Iq
-        Qe = vq * Id - vd * Iq
         self.publish(ctx, omega, delta, Pe, Qe, V, XadIfd)
         f = ctx.f
-        f[..., sl[3]] = XaqI1q * self._iTq10
-        f[..., sl[4]] = dq * self._iTd20 - self._xd1l_iTd20 * Id
-        f[..., sl[5]] = dd * self._iTq20 + self._xq1l_iTq20 * Iq
+        f[..., sl[3]] = f3
+        f[..., sl[4]] = f4
+        f[..., sl[5]] = f5
         o, k = ctx.out, self._pre
-        o[k + "Pe"], o[k + "Qe"], o[k + "te"] = Pe, Qe, self._te
+        o[k + "Pe"], o[k + "Qe"], o[k + "te"] = Pe, Qe, te
         o[k + "Id"], o[k + "Iq"], o[k + "XadIfd"] = Id, Iq, XadIfd
         o[k + "psi2"], o[k + "Se"] = psi2, Se
 
@@ -233,3 +216,90 @@ class GENROU(SyncMachine):
         f[..., sl[0]] = d_delta
         f[..., sl[1]] = d_omega
         f[..., sl[2]] = (vf - self._XadIfd) * self._iTd10
+
+
+def genrou_core(s, p, ra0, sat):
+    """GENROU's flux, stator and rotor equations, elementwise (:class:`~weakgrid.sim.kernels.Kernel`:
+    arrays or scalars, the same floats).
+
+    ``s = (e1q, e1d, e2d, e2q, sin delta, cos delta, Re V, Im V)`` (states and terminal voltage,
+    pu on the system base); ``p``: the constants :meth:`GENROU.setup` packs (``_P``); ``ra0``:
+    every ``ra`` is 0 (the stator's solution without it); ``sat``: the saturation factor
+    ``Se(psi2)``, 0 none, 1 quadratic (:func:`quad_sat`), 2 exponential
+    (:func:`~weakgrid.sim.blocks.exp_saturation`, GENROE). Returns
+    ``(Re I, Im I, Id, Iq, XadIfd, Se, psi2, te, Pe, Qe, de1d/dt, de2d/dt, de2q/dt)``: the
+    network current injected, the outputs and three of the derivatives (pu, pu/s).
+    """
+    e1q, e1d, e2d, e2q, sd, cd, Vre, Vim = s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7]
+    gd1, c_e2d, gq1, c_e2q, cIda, cIdb, cIqb = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
+    kd1, kd2, kq1, kq2, iTq10, iTd20, iTq20 = p[7], p[8], p[9], p[10], p[11], p[12], p[13]
+    xd1l_iTd20, xq1l_iTq20, gqd, ra, SA, SB = p[14], p[15], p[16], p[17], p[18], p[19]
+    psi2d = gd1 * e1q + c_e2d * e2d          # d-axis air-gap flux
+    psi2q = gq1 * e1d + c_e2q * e2q          # q-axis air-gap flux
+    psi2 = np.sqrt(psi2d * psi2d + psi2q * psi2q)
+    vd = Vre * sd - Vim * cd
+    vq = Vre * cd + Vim * sd
+    # stator: xd2*Id + ra*Iq = psi2d - vq,  -ra*Id + xq2*Iq = vd - psi2q
+    a = psi2d - vq
+    b = vd - psi2q
+    if ra0:
+        Id = cIda * a
+        Iq = cIqb * b
+        psid, psiq = vq, -vd
+    else:
+        Id = cIda * a - cIdb * b
+        Iq = cIqb * b + cIdb * a
+        psid = ra * Iq + vq
+        psiq = -(ra * Id + vd)
+    # injected current (Id + j Iq) exp(j(delta - pi/2))
+    Ire = Id * sd + Iq * cd
+    Iim = Iq * sd - Id * cd
+    dq, dd = e1q - e2d, e1d - e2q       # each once: the flux and the damper equations read them
+    XadIfd = e1q + kd1 * Id + kd2 * dq
+    XaqI1q = e1d + kq2 * dd - kq1 * Iq
+    if sat == 0:
+        Se = psi2 * 0.0
+    else:
+        Se = quad_sat(psi2, SA, SB) if sat == 1 else exp_saturation(psi2, SA, SB)
+        XadIfd = XadIfd + Se * psi2d
+        XaqI1q = XaqI1q + (Se * gqd) * psi2q
+    te = psid * Iq - psiq * Id
+    Pe = vd * Id + vq * Iq
+    Qe = vq * Id - vd * Iq
+    return (Ire, Iim, Id, Iq, XadIfd, Se, psi2, te, Pe, Qe,
+            XaqI1q * iTq10, dq * iTd20 - xd1l_iTd20 * Id, dd * iTq20 + xq1l_iTq20 * Iq)
+
+
+def quad_sat(psi2, A, B):
+    """GENROU's saturation factor ``Se = B (psi2 - A)^2 / psi2`` for ``psi2 >= A``, else 0, and
+    0 where that is not finite (arrays; :func:`quad_sat_scalar` is its compiled form)."""
+    if ((psi2 > 0) & (psi2 < np.inf)).all():   # fast path: same values as below there
+        return B * np.maximum(psi2 - A, 0.0) ** 2 / psi2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        Se = np.where(psi2 >= A, B * (psi2 - A) ** 2 / psi2, 0.0)
+    return np.where(np.isfinite(Se), Se, 0.0)
+
+
+def quad_sat_scalar(psi2, A, B):
+    """:func:`quad_sat` for one element (the same floats)."""
+    if 0.0 < psi2 < np.inf:        # _sat's fast path
+        m = psi2 - A
+        if not m > 0.0:
+            m = 0.0
+        return B * (m * m) / psi2
+    if psi2 >= A:
+        Se = B * ((psi2 - A) * (psi2 - A)) / psi2
+        if Se - Se == 0.0:         # finite
+            return Se
+    return 0.0
+
+
+def exp_saturation_scalar(x, A, B):
+    """:func:`~weakgrid.sim.blocks.exp_saturation` for one element, for the compiler's typing
+    of :func:`genrou_core` only: GENROE, which uses it, runs on NumPy (a power function need not
+    round as NumPy's)."""
+    return B * abs(x) ** A if x > 0 else 0.0
+
+
+_KERNEL = Kernel(genrou_core, 13, ((quad_sat, quad_sat_scalar),
+                                   (exp_saturation, exp_saturation_scalar)))
