@@ -15,11 +15,12 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from sim_cases import build_gti_upqc_sg
+from sim_cases import build_gti_upqc_sg, classical_smib, machine_smib
 
 from weakgrid.sim import kernels
 from weakgrid.sim.batch import simulate_batch
 from weakgrid.sim.events import Fault
+from weakgrid.sim.machines import gencls
 from weakgrid.sim.machines.genrou import _KERNEL, GENROU, quad_sat, quad_sat_scalar
 
 numba = pytest.importorskip("numba")
@@ -70,6 +71,38 @@ def test_quad_sat_scalar_equals_genrou_sat():
         assert np.array_equal(np.array([quad_sat_scalar(float(x), 0.8, 0.3) for x in psi2]), ref)
 
 
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), B=st.integers(1, 7), n=st.integers(1, 4), ra0=st.booleans())
+def test_gencls_core_compiled_equals_numpy(seed, B, n, ra0):
+    """GENCLS's core, compiled and on NumPy, bit for bit."""
+    rng = np.random.default_rng(seed)
+    S = _signals(rng, B, n, 1.0)[4:] + [1 + 0.3 * rng.normal(size=(B, n))]   # sin, cos, V, vf
+    P = np.abs(rng.normal(size=(3, n))) + 0.01
+    if ra0:
+        P[1] = P[2] = 0.0
+    ref = gencls._KERNEL(S, P, ())
+    got = gencls._KERNEL(S, P, (), ())
+    assert gencls._KERNEL._loops[(5, ())] is not None
+    for r, g in zip(ref, got):
+        assert np.array_equal(g, r)
+
+
+def _runs(system, scenarios, t_end, monkeypatch):
+    out = {}
+    for mode in ("numpy", "numba"):
+        monkeypatch.setenv("WEAKGRID_KERNELS", mode)
+        out[mode] = simulate_batch(system, copy.deepcopy(scenarios), t_end, dt=5e-3, tol=1e-6)
+    for k in (_KERNEL, gencls._KERNEL):       # nothing fell back to NumPy for want of compiling
+        assert None not in k._loops.values()
+    for a, b in zip(out["numpy"], out["numba"]):
+        assert a.failure is None and b.failure is None
+        assert a.names == b.names
+        assert np.array_equal(a.t, b.t)
+        assert np.array_equal(a.data, b.data)
+        assert a.stats == b.stats
+    return out
+
+
 def test_batched_run_compiled_equals_numpy(monkeypatch):
     """Whole batched runs with a fault (GENROU saturated, the UPQC and GTI beside it): every
     recorded trajectory and statistic the same with the compiled kernels as on NumPy."""
@@ -77,16 +110,18 @@ def test_batched_run_compiled_equals_numpy(monkeypatch):
     assert _genrou(sys0)._compiled_flags is not None     # this grid's GENROU compiles
     scenarios = [{"events": [Fault(bus, 0.1, 0.1 + dur, xf=0.05)]}
                  for bus, dur in ((1, 0.1), (2, 0.15), (3, 0.05))]
-    out = {}
-    for mode in ("numpy", "numba"):
-        monkeypatch.setenv("WEAKGRID_KERNELS", mode)
-        out[mode] = simulate_batch(sys0, copy.deepcopy(scenarios), 1.0, dt=5e-3, tol=1e-6)
-    for a, b in zip(out["numpy"], out["numba"]):
-        assert a.failure is None and b.failure is None
-        assert a.names == b.names
-        assert np.array_equal(a.t, b.t)
-        assert np.array_equal(a.data, b.data)
-        assert a.stats == b.stats
+    _runs(sys0, scenarios, 1.0, monkeypatch)
+
+
+@pytest.mark.parametrize("build", [
+    lambda: classical_smib(ra=0.01),                                    # GENCLS with ra
+    lambda: machine_smib("GENROE", gen={"S10": 0.05, "S12": 0.3}),      # GENROE: on NumPy
+], ids=["gencls", "genroe"])
+def test_machine_runs_compiled_equal_numpy(build, monkeypatch):
+    """A fault on each single-machine grid: the same trajectories compiled and on NumPy
+    (GENROE's exponential saturation always runs on NumPy; its runs must not change)."""
+    scenarios = [{"events": [Fault(1, 0.1, 0.1 + dur, xf=0.1)]} for dur in (0.05, 0.1)]
+    _runs(build(), scenarios, 1.0, monkeypatch)
 
 
 def test_backend_choice(monkeypatch):

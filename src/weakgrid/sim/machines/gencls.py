@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kernels import Kernel
 from .base import BASE_PARAMS, SyncMachine
 from .shaft import swing
 
@@ -83,29 +84,22 @@ class GENCLS(SyncMachine):
         det = xq * xq + ra * ra
         # folded constants of the stator equations (module docstring): det = xd1^2 + ra^2
         self._cIa, self._cIb = xq / det, ra / det
+        # the constants of gencls_core (its p), one row each
+        self._P = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(c, float), (self.n,))
+                                                 for c in (self._cIa, self._cIb, ra)]))
 
     def compute(self, ctx):
         x = ctx.x
         delta, omega = x[..., self._sls[0]], x[..., self._sls[1]]
         V = ctx.V[..., self._bi]
-        sd, cd = np.sin(delta), np.cos(delta)
-        Vre, Vim = V.real, V.imag
-        vd = Vre * sd - Vim * cd               # dq_voltage
-        vq = Vre * cd + Vim * sd
         vf = ctx.sig["vf"][..., self._mi]
-        a, b = vf - vq, vd                     # xd1*Id + ra*Iq = a,  -ra*Id + xd1*Iq = b
-        cIa, cIb = self._cIa, self._cIb
-        Id = cIa * a - cIb * b
-        Iq = cIa * b + cIb * a
-        # injected current (Id + j Iq) exp(j(delta - pi/2)), as network_current
-        self.inject(ctx, (Id * sd + Iq * cd) + 1j * (Iq * sd - Id * cd))
-        Pe = vd * Id + vq * Iq
-        Qe = vq * Id - vd * Iq
-        ra = self.p["ra"]
-        self._te = Pe + ra * (Iq * Iq + Id * Id)   # (vq + ra Iq) Iq + (vd + ra Id) Id
+        Ire, Iim, Id, Iq, Pe, Qe, te = _KERNEL(
+            (np.sin(delta), np.cos(delta), V.real, V.imag, vf), self._P, (), ())
+        self.inject(ctx, Ire + 1j * Iim)
+        self._te = te
         self.publish(ctx, omega, delta, Pe, Qe, V, vf)
         o = ctx.out
-        o["GENCLS.Pe"], o["GENCLS.Qe"], o["GENCLS.te"] = Pe, Qe, self._te
+        o["GENCLS.Pe"], o["GENCLS.Qe"], o["GENCLS.te"] = Pe, Qe, te
         o["GENCLS.Id"], o["GENCLS.Iq"] = Id, Iq
 
     def finish(self, ctx):
@@ -119,3 +113,28 @@ class GENCLS(SyncMachine):
                                  self._psse_shaft)
         ctx.f[..., self._sls[0]] = d_delta
         ctx.f[..., self._sls[1]] = d_omega
+
+
+def gencls_core(s, p):
+    """GENCLS's stator and air-gap power, elementwise (:class:`~weakgrid.sim.kernels.Kernel`:
+    arrays or scalars, the same floats).
+
+    ``s = (sin delta, cos delta, Re V, Im V, vf)`` (pu, system base); ``p = (xd1/det, ra/det,
+    ra)``, ``det = xd1^2 + ra^2``. Returns ``(Re I, Im I, Id, Iq, Pe, Qe, te)``: the network
+    current injected and the outputs.
+    """
+    sd, cd, Vre, Vim, vf = s[0], s[1], s[2], s[3], s[4]
+    cIa, cIb, ra = p[0], p[1], p[2]
+    vd = Vre * sd - Vim * cd               # dq_voltage
+    vq = Vre * cd + Vim * sd
+    a, b = vf - vq, vd                     # xd1*Id + ra*Iq = a,  -ra*Id + xd1*Iq = b
+    Id = cIa * a - cIb * b
+    Iq = cIa * b + cIb * a
+    Pe = vd * Id + vq * Iq
+    Qe = vq * Id - vd * Iq
+    # injected current (Id + j Iq) exp(j(delta - pi/2)), as network_current
+    return (Id * sd + Iq * cd, Iq * sd - Id * cd, Id, Iq, Pe, Qe,
+            Pe + ra * (Iq * Iq + Id * Id))   # te = (vq + ra Iq) Iq + (vd + ra Id) Id
+
+
+_KERNEL = Kernel(gencls_core, 7)
