@@ -19,6 +19,7 @@ from sim_cases import build_gti_upqc_sg, classical_smib, machine_smib
 
 from weakgrid.sim import kernels
 from weakgrid.sim.batch import simulate_batch
+from weakgrid.sim.errors import DataError
 from weakgrid.sim.events import Fault
 from weakgrid.sim.machines import gencls
 from weakgrid.sim.machines.genrou import _KERNEL, GENROU, quad_sat, quad_sat_scalar
@@ -125,18 +126,30 @@ def test_machine_runs_compiled_equal_numpy(build, monkeypatch):
 
 
 def test_backend_choice(monkeypatch):
-    """WEAKGRID_KERNELS: a wrong value names the variable and the choices; ``numba`` without
-    numba says how to install it; ``auto`` falls back to NumPy."""
+    """WEAKGRID_KERNELS: a wrong value names the variable, the value and the choices;
+    ``numba`` without numba says how to install it; ``auto`` falls back to NumPy."""
     monkeypatch.setenv("WEAKGRID_KERNELS", "fortran")
-    with pytest.raises(ValueError, match="WEAKGRID_KERNELS = 'fortran'.*auto, numpy, numba"):
+    with pytest.raises(DataError, match="WEAKGRID_KERNELS' = 'fortran'.*auto, numpy, numba"):
         kernels.backend()
     monkeypatch.setattr(kernels, "_numba", False)      # as if numba were not installed
     monkeypatch.setattr(kernels, "_LAST", [0, None])
     monkeypatch.setenv("WEAKGRID_KERNELS", "numba")
-    with pytest.raises(RuntimeError, match=r"weakgrid\[fast\]"):
+    with pytest.raises(DataError, match=r"weakgrid\[fast\]"):
         kernels.backend()
     monkeypatch.setenv("WEAKGRID_KERNELS", "auto")
     assert kernels.backend() == "numpy"
+
+
+def test_cli_refuses_a_wrong_backend_before_any_work(tmp_path, monkeypatch, capsys):
+    """The command stops at once with the input-error status and the variable's name, rather
+    than failing every run of a sweep one by one."""
+    from weakgrid.cli.main import main
+
+    monkeypatch.setenv("WEAKGRID_KERNELS", "gpu")
+    out = tmp_path / "c.json"
+    assert main(["train", "--preset", "case1-paper", "--quiet", "--output", str(out)]) == 2
+    assert "WEAKGRID_KERNELS" in capsys.readouterr().err
+    assert not out.exists()
 
 
 def test_unwritable_cache_compiles_in_memory(tmp_path, monkeypatch):

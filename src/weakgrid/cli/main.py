@@ -171,6 +171,9 @@ def main(argv=None) -> int:
     from ..logs import console
 
     try:
+        from ..sim.kernels import choice   # WEAKGRID_KERNELS checked before any work
+
+        choice()
         with console(-1 if getattr(args, "quiet", False) else getattr(args, "verbose", 0)):
             return int(args.func(args) or 0)
     except BaseException as exc:  # the one error boundary

@@ -42,7 +42,9 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Kernel", "backend", "cache_dir", "compiled_available"]
+from .errors import DataError
+
+__all__ = ["Kernel", "backend", "cache_dir", "choice", "compiled_available"]
 
 log = logging.getLogger(__name__)
 
@@ -67,19 +69,28 @@ def compiled_available() -> bool:
     return _import_numba() is not None
 
 
+def choice() -> str:
+    """``WEAKGRID_KERNELS`` checked (``auto``, ``numpy`` or ``numba``), without compiling
+    anything; :class:`~weakgrid.sim.errors.DataError` naming the variable, its value and the fix
+    for any other value, or for ``numba`` where numba does not import."""
+    raw = os.environ.get("WEAKGRID_KERNELS")
+    want = (raw or "auto").strip().lower() or "auto"
+    if want not in _CHOICES:
+        raise DataError("the environment", "WEAKGRID_KERNELS", raw,
+                        f"use one of {', '.join(_CHOICES)}, or unset it (auto)")
+    if want == "numba" and not compiled_available():
+        raise DataError("the environment", "WEAKGRID_KERNELS", raw,
+                        "numba does not import here: pip install 'weakgrid[fast]', or unset it")
+    return want
+
+
 def backend() -> str:
-    """``"numba"`` or ``"numpy"``: how :class:`Kernel` runs now (``WEAKGRID_KERNELS``, read at
-    each call so that a test or a benchmark may switch it)."""
+    """``"numba"`` or ``"numpy"``: how :class:`Kernel` runs now (:func:`choice`, read at each
+    call so that a test or a benchmark may switch it)."""
     raw = os.environ.get("WEAKGRID_KERNELS")
     if raw == _LAST[0]:
         return _LAST[1]
-    want = (raw or "auto").strip().lower() or "auto"
-    if want not in _CHOICES:
-        raise ValueError(f"WEAKGRID_KERNELS = {want!r}: use one of {', '.join(_CHOICES)}")
-    if want == "numba" and not compiled_available():
-        raise RuntimeError("WEAKGRID_KERNELS = 'numba' but numba does not import: "
-                           "pip install 'weakgrid[fast]', or unset WEAKGRID_KERNELS")
-    got = "numba" if want != "numpy" and compiled_available() else "numpy"
+    got = "numba" if choice() != "numpy" and compiled_available() else "numpy"
     _LAST[:] = [raw, got]
     return got
 
