@@ -88,6 +88,23 @@ def test_gencls_core_compiled_equals_numpy(seed, B, n, ra0):
         assert np.array_equal(g, r)
 
 
+@pytest.mark.parametrize("shapes", [((5,), (5,)), ((3, 5), (5,)), ((3, 5), (1, 5)), ((2, 3, 5), (3, 5))],
+                         ids=["one point", "held signal", "one member", "three axes"])
+def test_kernel_broadcasts_and_keeps_shapes(shapes):
+    """Signals of one shape, or a signal held the same for every member beside per-member ones
+    (broadcast as NumPy would): the compiled outputs have NumPy's shapes and values."""
+    full, held = shapes
+    rng = np.random.default_rng(7)
+    S = [rng.normal(size=full) for _ in range(4)] + [rng.normal(size=held)]
+    P = np.abs(rng.normal(size=(3, full[-1]))) + 0.01
+    ref = gencls._KERNEL(S, P, ())
+    got = gencls._KERNEL(S, P, (), ())
+    assert None not in gencls._KERNEL._loops.values()
+    for r, g in zip(ref, got):
+        assert g.shape == r.shape
+        assert np.array_equal(g, r)
+
+
 def _runs(system, scenarios, t_end, monkeypatch):
     out = {}
     for mode in ("numpy", "numba"):

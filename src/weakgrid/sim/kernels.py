@@ -257,18 +257,22 @@ class Kernel:
         if loop is None:
             return self.core(signals, P, *flags)
         shape = signals[0].shape
+        sig = signals
+        if any(a.shape != shape for a in signals):   # e.g. a signal held the same for all members
+            shape = np.broadcast_shapes(*(a.shape for a in signals))
+            sig = [a if a.shape == shape else np.broadcast_to(a, shape) for a in signals]
         if len(shape) != 2:
-            signals = [a.reshape(-1, shape[-1]) for a in signals]
-        out = np.empty((self.nout,) + signals[0].shape)
+            sig = [a.reshape(-1, shape[-1]) for a in sig]
+        out = np.empty((self.nout,) + sig[0].shape)
         if (key := (len(signals), compiled_flags)) not in self._ready:
             try:      # its first call compiles it, or loads it from numba's cache
-                loop(P, out, *signals)
-            except _numba.core.errors.NumbaError as exc:
+                loop(P, out, *sig)
+            except Exception as exc:   # numba's typing or caching errors: NumPy rather than fail
                 log.warning("could not compile %s.%s (%s); it runs on NumPy", *_ref(self.core),
                             str(exc).splitlines()[0])
                 self._loops[key] = None
                 return self.core(signals, P, *flags)
             self._ready.add(key)
         else:
-            loop(P, out, *signals)
+            loop(P, out, *sig)
         return out if len(shape) == 2 else out.reshape((self.nout,) + shape)
