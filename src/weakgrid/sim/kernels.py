@@ -20,7 +20,8 @@ The two give the same floats: IEEE 754 rounds ``+ - * /`` and the square root ex
 compiles without fast-math (no re-association, no fused multiply-add), and the transcendental
 functions (``sin``, ``cos``, ...), whose last bit differs between libraries, stay outside the
 core, computed by NumPy and passed in as signals. ``tests/sim/test_kernels.py`` checks it bit
-for bit, model by model and on whole batched runs.
+for bit, model by model and on whole batched runs (those to round-off under NumPy 1.26, whose
+own array arithmetic depends on the arrays' alignment).
 
 ``WEAKGRID_KERNELS`` chooses: ``auto`` (default: compiled when numba imports, else NumPy),
 ``numpy`` (never compile: the reference path, e.g. to compare) or ``numba`` (compiled, an error
@@ -44,7 +45,7 @@ import numpy as np
 
 from .errors import DataError
 
-__all__ = ["Kernel", "backend", "cache_dir", "choice", "compiled_available"]
+__all__ = ["Kernel", "backend", "cache_dir", "choice", "compiled_available", "constants"]
 
 log = logging.getLogger(__name__)
 
@@ -204,6 +205,13 @@ def _build_loop(core, nout: int, nsig: int, flags: tuple, scalar_forms=()):
         text = text.replace("cache=True", "cache=False")   # numba needs the file to cache
         exec(compile(text, str(path), "exec"), mod.__dict__)   # noqa: S102 (our own template)
     return mod.loop
+
+
+def constants(n: int, values) -> np.ndarray:
+    """A core's constants ``p``: each of ``values`` (scalar or one per instance) as a row of
+    ``n`` float64, one contiguous ``(len(values), n)`` array."""
+    return np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(v, float), (n,))
+                                          for v in values]))
 
 
 class Kernel:

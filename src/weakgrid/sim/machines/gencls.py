@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels import Kernel
+from ..kernels import Kernel, constants
 from .base import BASE_PARAMS, SyncMachine
 from .shaft import swing
 
@@ -83,10 +83,7 @@ class GENCLS(SyncMachine):
         ra, xq = self.p["ra"], self.p["xd1"]
         det = xq * xq + ra * ra
         # folded constants of the stator equations (module docstring): det = xd1^2 + ra^2
-        self._cIa, self._cIb = xq / det, ra / det
-        # the constants of gencls_core (its p), one row each
-        self._P = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(c, float), (self.n,))
-                                                 for c in (self._cIa, self._cIb, ra)]))
+        self._P = constants(self.n, (xq / det, ra / det, ra))
 
     def compute(self, ctx):
         x = ctx.x

@@ -50,7 +50,5 @@ class GENROE(GENROU):
     def _sat_coeffs(S10, S12):
         return exp_saturation_coeffs(1.0, S10, 1.2, S12)
 
-    _exp_sat = True     # GENROU's core with the exponential curve (on NumPy: weakgrid.sim.kernels)
-
-    def _sat(self, psi2):
-        return exp_saturation(psi2, self.SA, self.SB)
+    #: GENROU's core with the exponential curve (it runs on NumPy: weakgrid.sim.kernels)
+    _curve = staticmethod(exp_saturation)

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..blocks import exp_saturation, quad_saturation_coeffs
 from ..errors import DataError
-from ..kernels import Kernel
+from ..kernels import Kernel, constants
 from ..params import Param
 from .base import BASE_PARAMS, SyncMachine, psse_subtransient_params
 from .shaft import swing
@@ -108,35 +108,23 @@ class GENROU(SyncMachine):
         self.gqd = (p["xq"] - xl) / (p["xd"] - xl)
         self.SA, self.SB = self._sat_coeffs(p["S10"], p["S12"])
         self._pre = f"{self.type_name}."
-        # constants of compute
-        self._c_e2d = self.gd2 * (p["xd1"] - xl)
-        self._c_e2q = 1 - self.gq1
-        self._det = p["xd2"] * p["xq2"] + p["ra"] * p["ra"]
-        self._xdd1 = p["xd"] - p["xd1"]
-        self._xqq1 = p["xq"] - p["xq1"]
-        self._xd1l = p["xd1"] - xl
-        self._xq1l = p["xq1"] - xl
-        # folded constants of compute (same equations, fewer array operations)
-        self._ra0 = bool(np.all(p["ra"] == 0))
-        self._cIda, self._cIdb = p["xq2"] / self._det, p["ra"] / self._det
-        self._cIqb = p["xd2"] / self._det
-        self._kd1, self._kd2 = self._xdd1 * self.gd1, self._xdd1 * self.gd2
-        self._kq1, self._kq2 = self._xqq1 * self.gq1, self._xqq1 * self.gq2
-        self._iTq10, self._iTd20, self._iTq20 = -1.0 / p["Tq10"], 1.0 / p["Td20"], 1.0 / p["Tq20"]
+        # folded constants of the core (same equations, fewer operations), genrou_core's p
+        det = p["xd2"] * p["xq2"] + p["ra"] * p["ra"]
+        xdd1, xqq1 = p["xd"] - p["xd1"], p["xq"] - p["xq1"]
+        iTd20, iTq20 = 1.0 / p["Td20"], 1.0 / p["Tq20"]
+        self._P = constants(self.n, (
+            self.gd1, self.gd2 * (p["xd1"] - xl), self.gq1, 1 - self.gq1,
+            p["xq2"] / det, p["ra"] / det, p["xd2"] / det,
+            xdd1 * self.gd1, xdd1 * self.gd2, xqq1 * self.gq1, xqq1 * self.gq2,
+            -1.0 / p["Tq10"], iTd20, iTq20, (p["xd1"] - xl) * iTd20, (p["xq1"] - xl) * iTq20,
+            self.gqd, p["ra"], self.SA, self.SB))
         self._iTd10 = 1.0 / p["Td10"]
-        self._nosat = bool(np.all(self.SB == 0))
-        self._xd1l_iTd20 = self._xd1l * self._iTd20
-        self._xq1l_iTq20 = self._xq1l * self._iTq20
-        # the constants of the elementwise core (genrou_core's p), one row each
-        self._P = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(c, float), (self.n,)) for c in (
-            self.gd1, self._c_e2d, self.gq1, self._c_e2q, self._cIda, self._cIdb, self._cIqb,
-            self._kd1, self._kd2, self._kq1, self._kq2, self._iTq10, self._iTd20, self._iTq20,
-            self._xd1l_iTd20, self._xq1l_iTq20, self.gqd, p["ra"], self.SA, self.SB)]))
         # the core's branches: the stator with or without ra, the saturation curve (0 none,
         # 1 GENROU's quadratic, 2 GENROE's exponential); compiled (weakgrid.sim.kernels)
         # except the exponential, whose power function does not round as NumPy's
-        sat = 0 if self._nosat else (1 if self._exp_sat is None else 2)
-        self._flags = (self._ra0, sat)
+        nosat = bool(np.all(self.SB == 0))
+        sat = 0 if nosat else (1 if self._curve is quad_sat else 2)
+        self._flags = (bool(np.all(p["ra"] == 0)), sat)
         self._compiled_flags = self._flags if sat < 2 else None
 
     @staticmethod
@@ -144,11 +132,9 @@ class GENROU(SyncMachine):
         """``(A, B)`` of the saturation curve through ``(1.0, S10)``, ``(1.2, S12)``."""
         return quad_saturation_coeffs(1.0, S10, 1.2, S12)
 
-    #: the exponential saturation curve (GENROE), None for GENROU's quadratic one
-    _exp_sat = None
-
     def _sat(self, psi2):
-        return quad_sat(psi2, self.SA, self.SB)
+        """The saturation factor ``Se(psi2)`` of this model's curve (:attr:`_curve`)."""
+        return self._curve(psi2, self.SA, self.SB)
 
     def init(self, system, x, sig):
         p = self.p
@@ -300,6 +286,9 @@ def exp_saturation_scalar(x, A, B):
     round as NumPy's)."""
     return B * abs(x) ** A if x > 0 else 0.0
 
+
+#: the saturation curve ``Se(psi2, A, B)`` (GENROE's: the exponential one)
+GENROU._curve = staticmethod(quad_sat)
 
 _KERNEL = Kernel(genrou_core, 13, ((quad_sat, quad_sat_scalar),
                                    (exp_saturation, exp_saturation_scalar)))
