@@ -160,8 +160,9 @@ def _fake_probe(calls):
     def probe(inputs, steps=(10, 40), batch=1):
         calls.append(batch)
         return {"per_step_s": 1e-3, "transient_step_s": 1e-3, "per_run_s": 0.0, "n_vars": 10**5,
-                "train": free, "train_bounded": free, "batch": batch,
-                "batch_step_s": 1e-3 + 1e-4 * (batch - 1)}
+                "per_process_s": 0.0, "train": free, "train_bounded": free, "batch": batch,
+                "batch_step_s": 1e-3 + 1e-4 * (batch - 1),
+                "batch_transient_step_s": 1e-3 + 1e-4 * (batch - 1)}
     return probe
 
 
@@ -202,3 +203,55 @@ def test_the_probe_times_a_batch_of_the_run():
     assert pr["batch"] == 4 and pr["batch_step_s"] >= pr["per_step_s"] > 0
     assert batch_step_cost(pr, 1) == pr["per_step_s"]
     assert batch_step_cost(pr, 4) == pytest.approx(pr["batch_step_s"])
+
+
+FIRST_CALL_S = 0.5     # an injected one-time cost (a process loading or compiling its kernels)
+
+
+def _slow_first_call(fn):
+    """``fn`` whose first call first sleeps :data:`FIRST_CALL_S` (as a process's first
+    simulation loads or compiles the compiled kernels, weakgrid.sim.kernels: measured 0.5–1 s)."""
+    import time
+
+    calls = []
+
+    def wrapped(*a, **k):
+        if not calls:
+            time.sleep(FIRST_CALL_S)
+        calls.append(1)
+        return fn(*a, **k)
+    return wrapped
+
+
+def test_the_probe_counts_a_first_call_once_per_process_not_per_run(monkeypatch):
+    """A one-time cost of a process's first simulation is its own (``per_process_s``), not a
+    run's fixed cost: before the untimed first steps, it entered every run's cost (the
+    case-2 sweep, 96 runs that take 129 s serially, was estimated at 7.1 CPU-h and refused
+    once the kernels were compiled on first call; 2026-12-03)."""
+    import weakgrid.sim.integrate as integrate
+    from weakgrid.study.studyfile import load_study
+    from weakgrid.study.sweep import sweep_points
+    from weakgrid.study.sweep_estimate import probe
+
+    monkeypatch.setattr(integrate, "simulate", _slow_first_call(integrate.simulate))
+    pts = sweep_points(load_study("case1-weak-grid"), quick=True)
+    pr = probe(pts[0].inputs)
+    assert pr["per_run_s"] < FIRST_CALL_S / 2, pr
+    assert pr["per_step_s"] * 30 < FIRST_CALL_S / 2, pr
+    assert pr["per_process_s"] >= FIRST_CALL_S
+
+
+def test_a_plain_run_estimate_pays_a_first_call_before_timing(monkeypatch):
+    """The plain case's probe (weakgrid simulate): its timed steps come after untimed ones,
+    so a process's one-time cost is not spread over every step of the run."""
+    from weakgrid.sim.integrate import Simulator
+    from weakgrid.sim.run_estimate import PROBE_STEPS, run_estimate
+    from weakgrid.study.build import build_setup
+    from weakgrid.study.studyfile import load_study
+
+    st = load_study("case1-weak-grid")
+    setup = build_setup(st)
+    monkeypatch.setattr(Simulator, "run", _slow_first_call(Simulator.run))
+    dt = st.data["design"]["T"]
+    est = run_estimate(setup.system, 100 * dt, dt)
+    assert est.seconds < 100 * FIRST_CALL_S / PROBE_STEPS / 2, est

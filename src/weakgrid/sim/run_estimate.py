@@ -2,9 +2,10 @@
 
 The mechanism of a sweep's estimate (:mod:`weakgrid.study.sweep_estimate`) for one run of a
 plain case: the time is measured, not assumed — a short probe (:data:`PROBE_STEPS` steps of
-the quiet grid at the operating point, on a separate :class:`~weakgrid.sim.integrate.Simulator`)
-gives the cost of a quiet step; a step from the first disturbance on costs
-:data:`TRANSIENT_FACTOR` times as much (more Newton iterations and Jacobians; the ratio the
+the quiet grid at the operating point, on a separate :class:`~weakgrid.sim.integrate.Simulator`,
+after :data:`WARM_STEPS` untimed steps: a process's first steps load or compile the
+simulator's kernels, :mod:`weakgrid.sim.kernels`) gives the cost of a quiet step; a step from
+the first disturbance on costs :data:`TRANSIENT_FACTOR` times as much (more Newton iterations and Jacobians; the ratio the
 sweep's probes measure). The memory is the recorded trajectories, steps × variables × 8 bytes,
 twice (while they grow and as the final array). The result is a
 :class:`weakgrid.game.estimate.Estimate`, refused beyond its limits (30 min, 4 GiB or half the
@@ -20,9 +21,10 @@ import time
 from ..game.estimate import Estimate
 from .results import RECORD_ALL_MAX
 
-__all__ = ["PROBE_STEPS", "TRANSIENT_FACTOR", "recorded_columns", "run_estimate"]
+__all__ = ["PROBE_STEPS", "TRANSIENT_FACTOR", "WARM_STEPS", "recorded_columns", "run_estimate"]
 
 PROBE_STEPS = 20
+WARM_STEPS = 2
 TRANSIENT_FACTOR = 3.0
 
 
@@ -69,7 +71,11 @@ def run_estimate(system, t_end: float, dt: float, first_event: float | None = No
     nbytes = 2.0 * 8.0 * (steps + 1) * cols
     seconds = 0.0
     if probe:
-        sim = Simulator(system, dt=dt, record=[system.state_names()[0]] if system.nx else None)
+        rec = [system.state_names()[0]] if system.nx else None
+        # untimed first steps: a process's first steps load (or compile) the simulator's
+        # kernels (weakgrid.sim.kernels), a cost paid once, not per step
+        Simulator(system, dt=dt, record=rec).run(WARM_STEPS * dt, on_failure="return")
+        sim = Simulator(system, dt=dt, record=rec)
         t0 = time.perf_counter()
         sim.run(PROBE_STEPS * dt, on_failure="return")
         per_step = (time.perf_counter() - t0) / PROBE_STEPS

@@ -2,26 +2,33 @@
 
 The time is measured, not assumed: a short probe of the study's own grid (the first run
 still to do, with its integration step and tolerance, the controller idle) is timed in this
-process — two simulations of 10 and 40 steps at the operating point (their difference gives
-the cost of a quiet step, the rest the fixed cost of a run: grid set-up, initialization),
-then one through the run's disturbances and 60 steps beyond (the cost of a step of the
-transient, ≈ 3× a quiet one: more Newton iterations and Jacobians). Every remaining run then
-costs ``fixed + quiet steps × quiet cost + steps from its first disturbance on × transient
-cost``. A batched sweep (the default: the runs of one grid advance together,
-:mod:`weakgrid.study.batches`) is costed by its batches, grouped as the sweep will group them:
-the probe also times the first 10 and 40 steps of its largest batch (up to
-:data:`PROBE_BATCH` copies of the probed run, :func:`weakgrid.sim.batch.simulate_batch`), and a
-batch of ``B`` runs costs each run's fixed cost plus its steps at the cost of a batched step,
-interpolated linearly in ``B`` between the probe's one run and its batch (a batched step of
-``B`` runs costs far less than ``B`` steps: case 1's quick sweep, 12 runs, is estimated at
-14 CPU-s one by one and 8 CPU-s in its batch of 12, which took 8.2 s; 2026-12-02); the HJI
-trainings (once per design point and worker process) come from
-:func:`weakgrid.game.estimate.training_estimate`. Rough (±2×): on the development machine a
-case-1 run estimated at 1.4 s took 1.7 s, a case-2 run estimated at 5.5 s took 3.1 s (the
-transient right after a fault is the costliest part of a run). Runs already in
-the cache cost nothing. The wall time divides the CPU time by the workers, at most one per
-core; other work on the machine slows it down (on the shared development machine, load ≈ 2
-on 2 cores, the quick maps' sweep of `reproduce`, 18 runs, estimated at 14 s took 30 s).
+process. First, untimed, what a process pays once (``per_process_s``): its first build of the
+grid (imports, caches) and its first steps (the compiled kernels loaded or compiled,
+:mod:`weakgrid.sim.kernels`: 0.5–1 s). Then, each the least of :data:`PROBE_REPEAT` timings
+(this machine's jitter is milliseconds), two simulations of 10 and 40 steps at the operating
+point (their difference gives the cost of a quiet step, the rest with the grid's second build
+the fixed cost of a run), and one through the run's disturbances, moved to start after
+:data:`LEAD_STEPS` quiet steps, and 60 steps beyond (the cost of a step of the transient:
+more Newton iterations and Jacobians). Every remaining run then costs ``fixed + quiet steps ×
+quiet cost + steps from its first disturbance on × transient cost``. A batched sweep (the
+default: the runs of one grid advance together, :mod:`weakgrid.study.batches`) is costed by
+its batches, grouped as the sweep will group them: the probe also times the quiet steps and
+the transient of its largest batch (up to :data:`PROBE_BATCH` copies of the probed run,
+:func:`weakgrid.sim.batch.simulate_batch`), and a batch of ``B`` runs costs each run's fixed
+cost plus its quiet steps and its transient at the costs of a batched step, each interpolated
+linearly in ``B`` between the probe's one run and its batch (a batched step of ``B`` runs
+costs far less than ``B`` steps); each worker process pays its ``per_process_s`` once; the
+HJI trainings (once per design point and worker process) come from
+:func:`weakgrid.game.estimate.training_estimate`. Rough (±2×, low: the probe's controller is
+idle, a trained policy's evaluation at every sample is not in it): on the development
+machine (2026-12-03) case 2's sweep, 96 runs serially, estimated at 69 CPU-s took 129 s;
+case 1's, 96 runs on 2 workers, estimated at 25 s (46 CPU-s) took 54 s (89 CPU-s). Before the
+untimed first steps and the repeated timings, the same case-2 sweep was estimated anywhere
+from 5 CPU-min to 7.1 CPU-h from one call to the next (and refused): a process's first call
+of a compiled kernel fell in the timed quiet steps, and a transient timed from 0 s drowned in
+the jitter of 3 000 quiet steps. Runs already in the cache cost nothing. The wall time
+divides the CPU time by the workers, at most one per core; other work on the machine slows
+it down.
 
 The memory: one worker process holds what this process holds after the probe (the
 package, the grid; its resident size is measured), plus the trajectories of its longest
@@ -55,6 +62,9 @@ PROBE_STEPS = (10, 40)
 TRANSIENT_STEPS = 60          # steps probed after the last disturbance
 CLUSTER_START_S = 2.0         # a local Dask cluster of 2 workers up and importing weakgrid
 PROBE_BATCH = 32              # the largest batch the probe times (larger ones: extrapolated)
+PROBE_REPEAT = 2              # each timing the least of this many (the machine's jitter)
+WARM_STEPS = 2                # untimed steps first (a process's first steps load its kernels)
+LEAD_STEPS = 5                # quiet steps before the probed disturbance
 MAX_LISTED = 20000            # runs listed (and looked up in the cache) one by one
 
 
@@ -236,11 +246,15 @@ def _training(pr: dict, key: str):
 def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
     """Time the study's grid of the run ``inputs`` (see the module's text).
 
-    Returns ``per_step_s``, ``per_run_s``, ``n_vars`` (variables recorded per step) and
-    ``train`` and ``train_bounded`` (the :class:`~weakgrid.game.estimate.Estimate` of one HJI
-    training, unbounded and rating-bounded: their bases differ); with ``batch`` > 1 also
-    ``batch`` (at most :data:`PROBE_BATCH`) and ``batch_step_s``, the cost of one quiet step
-    of that many copies of the run advanced together [s].
+    Returns ``per_step_s`` and ``transient_step_s`` (one run's quiet step and step of the
+    transient), ``per_run_s`` (a run's fixed cost: its grid built as a worker builds it again,
+    its start), ``per_process_s`` (what a process pays once: its first build of the grid, the
+    simulator's first steps — compiled kernels loaded or compiled, :mod:`weakgrid.sim.kernels`),
+    ``n_vars`` (variables recorded per step) and ``train`` and ``train_bounded`` (the
+    :class:`~weakgrid.game.estimate.Estimate` of one HJI training, unbounded and rating-bounded:
+    their bases differ); with ``batch`` > 1 also ``batch`` (at most :data:`PROBE_BATCH`),
+    ``batch_step_s`` and ``batch_transient_step_s``, the cost of one quiet step and of one step
+    of the transient of that many copies of the run advanced together [s].
     """
     from ..sim.batch import simulate_batch
     from ..sim.controllers import DigitalController, UPQCTarget
@@ -253,8 +267,11 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
     sc = next(s for s in st.scenarios() if s["id"] == inputs["scenario"])
     run = Run.of(st, sc, inputs["controller"])
     dt, tol = sim_settings(st, float(inputs.get("dt_factor") or 1.0))
+    t_once = time.perf_counter()
+    variant = controller_variant(st, run.controller)
+    build_setup(st, run.load, run.upqc, variant)      # a process's first build: imports, caches
     t0 = time.perf_counter()
-    setup = build_setup(st, run.load, run.upqc, controller_variant(st, run.controller))
+    setup = build_setup(st, run.load, run.upqc, variant)
     t_setup = time.perf_counter() - t0
 
     def idle(**kw):     # the run's digital controller, measuring and holding zero
@@ -262,62 +279,99 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
                                  target=UPQCTarget(setup.upqc_name) if setup.upqc_name
                                  else _MeasureOnly(), name="probe", **kw)
 
-    timed = []
-    for n in steps:    # at the operating point: the fixed cost and the cost of a quiet step
-        dc = idle()
-        t0 = time.perf_counter()
-        res = simulate(setup.system, n * dt, dt=dt, tol=tol, controllers=[dc],
-                       on_failure="return")
-        timed.append((time.perf_counter() - t0, int(res.stats.get("steps") or n),
-                      len(res.names)))
-    (t1, s1, _), (t2, s2, n_vars) = timed
-    per_step = (t2 - t1) / (s2 - s1) if s2 > s1 and t2 > t1 else t2 / max(s2, 1)
     batch = max(1, min(int(batch), PROBE_BATCH))
-    batch_step = per_step
-    if batch > 1:     # the same quiet steps, ``batch`` copies of the run together
-        tb = []
-        for n in steps:
-            scen = [{"controllers": [idle()]} for _ in range(batch)]
+
+    def timed(t_end, b=1, events=None, enable=None, repeat=PROBE_REPEAT):
+        """The least wall time of ``repeat`` simulations of ``b`` copies of the run [s] and
+        the steps and recorded variables of one."""
+        best = math.inf
+        for _ in range(repeat):
+            kw = {} if enable is None else {"enable": enable}
+            scen = [{"controllers": [idle(**kw)], "events": events() if events else []}
+                    for _ in range(b)]
             t0 = time.perf_counter()
-            simulate_batch(setup.system, scen, n * dt, batch_size=batch, dt=dt, tol=tol)
-            tb.append(time.perf_counter() - t0)
-        batch_step = max((tb[1] - tb[0]) / (s2 - s1) if s2 > s1 else tb[1] / max(s2, 1),
-                         per_step)
+            if b == 1:
+                res = simulate(setup.system, t_end, dt=dt, tol=tol, on_failure="return", **scen[0])
+            else:
+                res = simulate_batch(setup.system, scen, t_end, batch_size=b, dt=dt, tol=tol)[0]
+            best = min(best, time.perf_counter() - t0)
+        return best, int(res.stats.get("steps") or round(t_end / dt)), len(res.names)
+
+    # a process's first steps load (or compile) what the simulator caches: not a run's cost
+    timed(WARM_STEPS * dt, repeat=1)
+    if batch > 1:
+        timed(WARM_STEPS * dt, batch, repeat=1)
+    per_process = time.perf_counter() - t_once - t_setup
+    # at the operating point: the fixed cost of a run and the cost of a quiet step
+    (t1, s1, _), (t2, s2, n_vars) = (timed(n * dt) for n in steps)
+    per_step = (t2 - t1) / (s2 - s1) if s2 > s1 and t2 > t1 else t2 / max(s2, 1)
     fixed_sim = max(t1 - s1 * per_step, 0.0)
     per_run = t_setup + fixed_sim
-    # through the run's disturbances and TRANSIENT_STEPS beyond the last: the cost of a step
-    # of the transient (more Newton iterations and Jacobians), most of a run after a fault
-    transient = per_step
+    batch_step = per_step
+    if batch > 1:     # the same quiet steps, ``batch`` copies of the run together
+        (u1, _, _), (u2, _, _) = (timed(n * dt, batch) for n in steps)
+        batch_step = max((u2 - u1) / (s2 - s1) if s2 > s1 else u2 / max(s2, 1), per_step)
+    # through the run's disturbances and TRANSIENT_STEPS beyond the last, the disturbances
+    # moved to start after LEAD_STEPS quiet steps (the grid is at its operating point until
+    # then whenever they start): the cost of a step of the transient (more Newton iterations
+    # and Jacobians), most of a run after a fault
+    transient, batch_transient = per_step, batch_step
     first, last = _event_window(run.events)
     if first is not None:
-        t_probe = min(run.t_end, last + TRANSIENT_STEPS * dt)
-        dc = idle(enable=enable_windows(run.bypass, t_probe))
-        t0 = time.perf_counter()
-        res = simulate(setup.system, t_probe, dt=dt, tol=tol, controllers=[dc],
-                       events=make_events(setup, run), on_failure="return")
-        t3 = time.perf_counter() - t0
-        n_quiet = min(math.floor(first / dt), int(res.stats.get("steps") or 0))
-        n_after = int(res.stats.get("steps") or 0) - n_quiet
-        if n_after > 0:
-            transient = max((t3 - fixed_sim - n_quiet * per_step) / n_after, per_step)
+        shift = max(first - LEAD_STEPS * dt, 0.0)
+        moved = replace(run, events=tuple(_shifted(e, shift) for e in run.events),
+                        bypass=tuple((a - shift, b - shift) for a, b in run.bypass))
+        t_probe = min(run.t_end, last + TRANSIENT_STEPS * dt) - shift
+        n_quiet = math.floor((first - shift) / dt)
+        enable = enable_windows(moved.bypass, t_probe)
+
+        def events():
+            return make_events(setup, moved)
+
+        t3, s3, _ = timed(t_probe, 1, events, enable)
+        if s3 > n_quiet:
+            transient = max((t3 - fixed_sim - n_quiet * per_step) / (s3 - n_quiet), per_step)
+        if batch > 1:
+            u3, _, _ = timed(t_probe, batch, events, enable)
+            if s3 > n_quiet:
+                batch_transient = max((u3 - batch * fixed_sim - n_quiet * batch_step)
+                                      / (s3 - n_quiet), batch_step)
     prob = design_problem(st, setup.design)
     # a rating-bounded training (hji-bounded) fits its own basis (the problem's [basis] bounded)
     bounded = prob.with_rating(float(st.data["upqc"]["rating"]))
     train, train_bounded = (training_estimate(int(p.mesh.points.shape[0]), p.basis.size,
                                               p.system.n_states) for p in (prob, bounded))
     return {"per_step_s": per_step, "transient_step_s": transient, "per_run_s": per_run,
-            "n_vars": n_vars, "train": train, "train_bounded": train_bounded,
-            "batch": batch, "batch_step_s": batch_step}
+            "per_process_s": per_process, "n_vars": n_vars, "train": train,
+            "train_bounded": train_bounded, "batch": batch, "batch_step_s": batch_step,
+            "batch_transient_step_s": batch_transient}
+
+
+def _shifted(event: dict, shift: float) -> dict:
+    """A study event ``shift`` seconds earlier (its ``t_on``, ``t_off`` and ``t``)."""
+    return {k: (float(v) - shift if k in ("t_on", "t_off", "t") else v) for k, v in event.items()}
+
+
+def _linear(pr: dict, size: int, one: str, many: str) -> float:
+    """A cost linear in the batch's ``size`` through the probe's one run (``pr[one]``) and its
+    batch (``pr[many]`` for ``pr["batch"]`` runs), never below one run's."""
+    if size <= 1 or pr.get("batch", 1) <= 1:
+        return pr[one] * max(size, 1)
+    slope = (pr[many] - pr[one]) / (pr["batch"] - 1)
+    return pr[one] + max(slope, 0.0) * (size - 1)
 
 
 def batch_step_cost(pr: dict, size: int) -> float:
     """The cost of one quiet step of a batch of ``size`` runs [s]: linear in ``size`` through
     the probe's one run (``per_step_s``) and its batch (``batch_step_s`` of ``batch`` runs),
     never below one run's step."""
-    if size <= 1 or pr.get("batch", 1) <= 1:
-        return pr["per_step_s"] * max(size, 1)
-    slope = (pr["batch_step_s"] - pr["per_step_s"]) / (pr["batch"] - 1)
-    return pr["per_step_s"] + max(slope, 0.0) * (size - 1)
+    return _linear(pr, size, "per_step_s", "batch_step_s")
+
+
+def batch_transient_cost(pr: dict, size: int) -> float:
+    """The cost of one step of the transient of a batch of ``size`` runs [s], as
+    :func:`batch_step_cost` (``transient_step_s``, ``batch_transient_step_s``)."""
+    return _linear(pr, size, "transient_step_s", "batch_transient_step_s")
 
 
 def planned_runs(study, quick: bool = False) -> int:
@@ -405,13 +459,15 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
     quiet = {k: _quiet_steps(p.inputs) for k, p in todo.items()}
     # a batch: each run's fixed cost, then the members' steps together (in lockstep: the
     # longest member's, quiet until the first member's disturbance)
-    ratio = pr["transient_step_s"] / pr["per_step_s"] if pr["per_step_s"] > 0 else 1.0
     run_s = []
     for b in batches:
         n, q = max(steps[k] for k in b), min(quiet[k] for k in b)
-        step = batch_step_cost(pr, len(b))
-        run_s.append(len(b) * pr["per_run_s"] + (q + (n - q) * ratio) * step)
-    cpu = scale * sum(run_s) + train_s
+        run_s.append(len(b) * pr["per_run_s"] + q * batch_step_cost(pr, len(b))
+                     + (n - q) * batch_transient_cost(pr, len(b)))
+    # each worker process (or this one, serially: already paid by the probe) builds the grid
+    # and loads the simulator's kernels once
+    once = (pr.get("per_process_s", 0.0) * min(par, len(batches))) if n_par else 0.0
+    cpu = scale * sum(run_s) + train_s + once
     # workers beyond the cores share them; a local cluster starts in ≈ 2 s (measured: 1.6 s,
     # then 0.4 s for a worker's first import)
     cores = max(min(par, os.cpu_count() or 1), 1)
