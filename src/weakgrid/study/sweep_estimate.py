@@ -5,8 +5,8 @@ still to do, with its integration step and tolerance, the controller idle) is ti
 process. First, untimed, what a process pays once (``per_process_s``): its first build of the
 grid (imports, caches) and its first steps (the compiled kernels loaded or compiled,
 :mod:`weakgrid.sim.kernels`: 0.5–1 s). Then, each the least of :data:`PROBE_REPEAT` timings
-(this machine's jitter is milliseconds), two simulations of 10 and 40 steps at the operating
-point (their difference gives the cost of a quiet step, the rest with the grid's second build
+(this machine's jitter is milliseconds, as long as these), two simulations of 10 and 40 steps
+at the operating point (their difference gives the cost of a quiet step, the rest with the grid's second build
 the fixed cost of a run), and one through the run's disturbances, moved to start after
 :data:`LEAD_STEPS` quiet steps, and 60 steps beyond (the cost of a step of the transient:
 more Newton iterations and Jacobians). Every remaining run then costs ``fixed + quiet steps ×
@@ -328,11 +328,11 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
         def events():
             return make_events(setup, moved)
 
-        t3, s3, _ = timed(t_probe, 1, events, enable)
+        t3, s3, _ = timed(t_probe, 1, events, enable, repeat=1)   # long enough: once (1 % apart)
         if s3 > n_quiet:
             transient = max((t3 - fixed_sim - n_quiet * per_step) / (s3 - n_quiet), per_step)
         if batch > 1:
-            u3, _, _ = timed(t_probe, batch, events, enable)
+            u3, _, _ = timed(t_probe, batch, events, enable, repeat=1)
             if s3 > n_quiet:
                 batch_transient = max((u3 - batch * fixed_sim - n_quiet * batch_step)
                                       / (s3 - n_quiet), batch_step)
