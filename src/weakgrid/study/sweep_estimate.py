@@ -6,8 +6,8 @@ process. First, untimed, what a process pays once (``per_process_s``): its first
 grid (imports, caches) and its first steps (the compiled kernels loaded or compiled,
 :mod:`weakgrid.sim.kernels`: 0.5–1 s). Then, each the least of :data:`PROBE_REPEAT` timings
 (this machine's jitter is milliseconds, as long as these), two simulations of 10 and 40 steps
-at the operating point (their difference gives the cost of a quiet step, the rest with the grid's second build
-the fixed cost of a run), and one through the run's disturbances, moved to start after
+at the operating point (their difference gives the cost of a quiet step, the rest with the
+grid's second build the fixed cost of a run), and one through the run's disturbances, moved to start after
 :data:`LEAD_STEPS` quiet steps, and 60 steps beyond (the cost of a step of the transient:
 more Newton iterations and Jacobians). Every remaining run then costs ``fixed + quiet steps ×
 quiet cost + steps from its first disturbance on × transient cost``. A batched sweep (the
@@ -311,6 +311,7 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
     if batch > 1:     # the same quiet steps, ``batch`` copies of the run together
         (u1, _, _), (u2, _, _) = (timed(n * dt, batch) for n in steps)
         batch_step = max((u2 - u1) / (s2 - s1) if s2 > s1 else u2 / max(s2, 1), per_step)
+        batch_fixed = max(u1 - s1 * batch_step, 0.0)
     # through the run's disturbances and TRANSIENT_STEPS beyond the last, the disturbances
     # moved to start after LEAD_STEPS quiet steps (the grid is at its operating point until
     # then whenever they start): the cost of a step of the transient (more Newton iterations
@@ -334,7 +335,7 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
         if batch > 1:
             u3, _, _ = timed(t_probe, batch, events, enable, repeat=1)
             if s3 > n_quiet:
-                batch_transient = max((u3 - batch * fixed_sim - n_quiet * batch_step)
+                batch_transient = max((u3 - batch_fixed - n_quiet * batch_step)
                                       / (s3 - n_quiet), batch_step)
     prob = design_problem(st, setup.design)
     # a rating-bounded training (hji-bounded) fits its own basis (the problem's [basis] bounded)
