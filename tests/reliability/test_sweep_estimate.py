@@ -255,3 +255,63 @@ def test_a_plain_run_estimate_pays_a_first_call_before_timing(monkeypatch):
     dt = st.data["design"]["T"]
     est = run_estimate(setup.system, 100 * dt, dt)
     assert est.seconds < 100 * FIRST_CALL_S / PROBE_STEPS / 2, est
+
+
+def test_the_probe_times_the_transient_without_the_quiet_lead_in(monkeypatch):
+    """The transient is probed with the run's disturbances moved to start after LEAD_STEPS
+    quiet steps (the grid is at its operating point until then, whenever they start), alone
+    and in the batch: the probe never simulates case 1's 0.2 s before its fault (247 steps,
+    whose jitter drowned the transient's cost when it was the difference of two long
+    timings), and the moved fault keeps its duration."""
+    import weakgrid.sim.batch as batch
+    import weakgrid.sim.integrate as integrate
+    from weakgrid.sim.events import Fault
+    from weakgrid.study.studyfile import load_study
+    from weakgrid.study.sweep import sweep_points
+    from weakgrid.study.sweep_estimate import LEAD_STEPS, TRANSIENT_STEPS, probe
+
+    seen = []
+
+    def spy(fn, t_end_at, events_of):
+        def wrapped(system, *a, **k):
+            seen.append((a[t_end_at], events_of(a, k)))
+            return fn(system, *a, **k)
+        return wrapped
+
+    monkeypatch.setattr(integrate, "simulate", spy(integrate.simulate, 0,
+                                                   lambda a, k: list(k.get("events") or [])))
+    monkeypatch.setattr(batch, "simulate_batch", spy(batch.simulate_batch, 1, lambda a, k: [
+        e for sc in a[0] for e in sc.get("events") or []]))
+    st = load_study("case1-weak-grid")
+    dt = st.data["design"]["T"]
+    pts = sweep_points(st, quick=True)
+    pr = probe(pts[0].inputs, batch=3)
+    faults = [(t_end, e) for t_end, evs in seen for e in evs if isinstance(e, Fault)]
+    assert len(faults) == 1 + 3, seen          # once alone, once in the batch of 3
+    for t_end, f in faults:
+        assert f.t_on == pytest.approx(LEAD_STEPS * dt)
+        assert f.t_off - f.t_on == pytest.approx(0.05)
+        assert t_end == pytest.approx(f.t_off + TRANSIENT_STEPS * dt)
+    assert max(t for t, _ in seen) < 0.2
+    assert pr["batch_transient_step_s"] >= pr["batch_step_s"] > 0
+
+
+def test_the_transient_of_a_batch_is_costed_at_the_batch_s_transient_step(tmp_path, monkeypatch):
+    """A batch's steps from its first disturbance on cost the probe's batched transient step,
+    those before it the batched quiet step (each linear in the batch's size)."""
+    import weakgrid.study.sweep_estimate as se
+    from weakgrid.study.studyfile import load_study
+
+    def probe(inputs, steps=(10, 40), batch=1):
+        free = type("Free", (), {"seconds": 0.0, "bytes": 0.0})()
+        return {"per_step_s": 1e-3, "transient_step_s": 3e-3, "per_run_s": 0.0,
+                "per_process_s": 0.0, "n_vars": 10, "train": free, "train_bounded": free,
+                "batch": batch, "batch_step_s": 1e-3 + 1e-4 * (batch - 1),
+                "batch_transient_step_s": 3e-3 + 5e-4 * (batch - 1)}
+    monkeypatch.setattr(se, "probe", probe)
+    st = load_study("case1-weak-grid")
+    est = se.estimate_sweep(st, tmp_path / "c", quick=True, workers=0)
+    pts = se.sweep_points(st, quick=True)
+    n, q = se._steps(pts[0].inputs), se._quiet_steps(pts[0].inputs)
+    assert 0 < q < n and est.batch == 12
+    assert est.cpu_s == pytest.approx(q * (1e-3 + 1e-4 * 11) + (n - q) * (3e-3 + 5e-4 * 11))
