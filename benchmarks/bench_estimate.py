@@ -18,7 +18,7 @@ Measured 2026-12-03 on the idle 2-core machine, from the source tree:
   (3 calls; the first, which also builds the grid and loads the kernels, 4.7 s, the others
   1.4 s), 143.0 CPU-s measured (1.72–1.79×); case 1's quick sweep (the default) 6.4–6.9 CPU-s
   estimated, 8.1 CPU-s measured (1.18–1.27×). Case 1's full sweep on 2 workers (``weakgrid
-  sweep case1-weak-grid``): 46 CPU-s estimated, 89 CPU-s measured. Low, by up to 2×: the
+  sweep case1-weak-grid``): 49–61 CPU-s estimated (3 calls), 89 CPU-s measured. Low, by up to 2×: the
   probe's controller holds zero, so a trained policy's evaluation and the network's re-solve
   after each of its samples are not in it.
 
@@ -54,7 +54,8 @@ def main(study="case1-weak-grid", quick=True, repeat=3):
         used, wall = time.process_time() - c0, time.perf_counter() - t0
     print(f"  the sweep serially: {used:.1f} CPU-s, {wall:.1f} s; measured / estimated: "
           + ", ".join(f"{used / c:.2f}" for c in cpu)
-          + f"; estimates from {min(cpu):.1f} to {max(cpu):.1f} CPU-s, load {os.getloadavg()[0]:.2f}")
+          + f"; estimates from {min(cpu):.1f} to {max(cpu):.1f} CPU-s, "
+          f"load {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":

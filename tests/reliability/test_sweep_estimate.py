@@ -149,20 +149,21 @@ def test_bounded_trainings_are_estimated_with_their_own_basis():
         assert _training(pr, k) is want
 
 
-def _fake_probe(calls):
-    """A probe with round numbers: 1 ms a step (quiet or not), a batch of ``b`` runs
-    1 ms + 0.1 ms per run beyond the first, free set-up and trainings, 10⁵ variables (their
-    trajectories outweigh the process's own memory)."""
+def _fake_probe(calls, transient=(1e-3, 1e-4)):
+    """A probe with round numbers: a quiet step 1 ms, a batch of ``b`` runs 1 ms + 0.1 ms per
+    run beyond the first; a step of the transient ``transient[0]``, in a batch
+    ``transient[0] + transient[1]`` per run beyond the first; free set-up and trainings, 10⁵
+    variables (their trajectories outweigh the process's own memory)."""
     from types import SimpleNamespace
 
     free = SimpleNamespace(seconds=0.0, bytes=0.0)
 
     def probe(inputs, steps=(10, 40), batch=1):
         calls.append(batch)
-        return {"per_step_s": 1e-3, "transient_step_s": 1e-3, "per_run_s": 0.0, "n_vars": 10**5,
-                "per_process_s": 0.0, "train": free, "train_bounded": free, "batch": batch,
-                "batch_step_s": 1e-3 + 1e-4 * (batch - 1),
-                "batch_transient_step_s": 1e-3 + 1e-4 * (batch - 1)}
+        return {"per_step_s": 1e-3, "transient_step_s": transient[0], "per_run_s": 0.0,
+                "n_vars": 10**5, "per_process_s": 0.0, "train": free, "train_bounded": free,
+                "batch": batch, "batch_step_s": 1e-3 + 1e-4 * (batch - 1),
+                "batch_transient_step_s": transient[0] + transient[1] * (batch - 1)}
     return probe
 
 
@@ -302,13 +303,7 @@ def test_the_transient_of_a_batch_is_costed_at_the_batch_s_transient_step(tmp_pa
     import weakgrid.study.sweep_estimate as se
     from weakgrid.study.studyfile import load_study
 
-    def probe(inputs, steps=(10, 40), batch=1):
-        free = type("Free", (), {"seconds": 0.0, "bytes": 0.0})()
-        return {"per_step_s": 1e-3, "transient_step_s": 3e-3, "per_run_s": 0.0,
-                "per_process_s": 0.0, "n_vars": 10, "train": free, "train_bounded": free,
-                "batch": batch, "batch_step_s": 1e-3 + 1e-4 * (batch - 1),
-                "batch_transient_step_s": 3e-3 + 5e-4 * (batch - 1)}
-    monkeypatch.setattr(se, "probe", probe)
+    monkeypatch.setattr(se, "probe", _fake_probe([], transient=(3e-3, 5e-4)))
     st = load_study("case1-weak-grid")
     est = se.estimate_sweep(st, tmp_path / "c", quick=True, workers=0)
     pts = se.sweep_points(st, quick=True)

@@ -6,10 +6,10 @@ the quiet grid at the operating point, on a separate :class:`~weakgrid.sim.integ
 after :data:`WARM_STEPS` untimed steps: a process's first steps load or compile the
 simulator's kernels, :mod:`weakgrid.sim.kernels`) gives the cost of a quiet step; a step from
 the first disturbance on costs :data:`TRANSIENT_FACTOR` times as much (more Newton iterations
-and Jacobians; the ratio the sweep's probes measure). The memory is the recorded trajectories, steps × variables × 8 bytes,
-twice (while they grow and as the final array). The result is a
-:class:`weakgrid.game.estimate.Estimate`, refused beyond its limits (30 min, 4 GiB or half the
-available memory, ``WEAKGRID_MAX_GIB``) by :meth:`~weakgrid.game.estimate.Estimate.check`
+and Jacobians; the ratio the sweep's probes measure). The memory is the recorded
+trajectories, steps × variables × 8 bytes, twice (while they grow and as the final array).
+The result is a :class:`weakgrid.game.estimate.Estimate`, refused beyond its limits (30 min,
+4 GiB or half the available memory, ``WEAKGRID_MAX_GIB``) by :meth:`~weakgrid.game.estimate.Estimate.check`
 unless forced.
 """
 

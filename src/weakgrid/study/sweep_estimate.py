@@ -7,28 +7,28 @@ grid (imports, caches) and its first steps (the compiled kernels loaded or compi
 :mod:`weakgrid.sim.kernels`: 0.5–1 s). Then, each the least of :data:`PROBE_REPEAT` timings
 (this machine's jitter is milliseconds, as long as these), two simulations of 10 and 40 steps
 at the operating point (their difference gives the cost of a quiet step, the rest with the
-grid's second build the fixed cost of a run), and one through the run's disturbances, moved to start after
-:data:`LEAD_STEPS` quiet steps, and 60 steps beyond (the cost of a step of the transient:
-more Newton iterations and Jacobians). Every remaining run then costs ``fixed + quiet steps ×
-quiet cost + steps from its first disturbance on × transient cost``. A batched sweep (the
-default: the runs of one grid advance together, :mod:`weakgrid.study.batches`) is costed by
-its batches, grouped as the sweep will group them: the probe also times the quiet steps and
-the transient of its largest batch (up to :data:`PROBE_BATCH` copies of the probed run,
-:func:`weakgrid.sim.batch.simulate_batch`), and a batch of ``B`` runs costs each run's fixed
-cost plus its quiet steps and its transient at the costs of a batched step, each interpolated
-linearly in ``B`` between the probe's one run and its batch (a batched step of ``B`` runs
-costs far less than ``B`` steps); each worker process pays its ``per_process_s`` once; the
-HJI trainings (once per design point and worker process) come from
+grid's second build the fixed cost of a run), and one through the run's disturbances, moved
+to start after :data:`LEAD_STEPS` quiet steps, and 60 steps beyond (the cost of a step of the
+transient: more Newton iterations and Jacobians). Every remaining run then costs ``fixed +
+quiet steps × quiet cost + steps from its first disturbance on × transient cost``. A batched
+sweep (the default: the runs of one grid advance together, :mod:`weakgrid.study.batches`) is
+costed by its batches, grouped as the sweep will group them: the probe also times the quiet
+steps and the transient of its largest batch (up to :data:`PROBE_BATCH` copies of the probed
+run, :func:`weakgrid.sim.batch.simulate_batch`), and a batch of ``B`` runs costs each run's
+fixed cost plus its quiet steps and its transient at the costs of a batched step, each
+interpolated linearly in ``B`` between the probe's one run and its batch (a batched step of
+``B`` runs costs far less than ``B`` steps); each worker process pays its ``per_process_s``
+once; the HJI trainings (once per design point and worker process) come from
 :func:`weakgrid.game.estimate.training_estimate`. Rough (±2×, low: the probe's controller is
 idle, a trained policy's evaluation at every sample is not in it): on the development
-machine (2026-12-03) case 2's sweep, 96 runs serially, estimated at 69 CPU-s took 129 s;
-case 1's, 96 runs on 2 workers, estimated at 25 s (46 CPU-s) took 54 s (89 CPU-s). Before the
-untimed first steps and the repeated timings, the same case-2 sweep was estimated anywhere
-from 5 CPU-min to 7.1 CPU-h from one call to the next (and refused): a process's first call
-of a compiled kernel fell in the timed quiet steps, and a transient timed from 0 s drowned in
-the jitter of 3 000 quiet steps. Runs already in the cache cost nothing. The wall time
-divides the CPU time by the workers, at most one per core; other work on the machine slows
-it down.
+machine (2026-12-03, ``benchmarks/bench_estimate.py``) case 2's sweep, 96 runs serially,
+estimated at 80–83 CPU-s took 143 CPU-s; case 1's, 96 runs on 2 workers, estimated at 27–32 s
+(49–61 CPU-s) took 54 s (89 CPU-s). Before the untimed first steps and the repeated timings,
+the same case-2 sweep was estimated anywhere from 5 CPU-min to 7.1 CPU-h from one call to the
+next (and refused): a process's first call of a compiled kernel fell in the timed quiet
+steps, and a transient timed from 0 s drowned in the jitter of 3 000 quiet steps. Runs
+already in the cache cost nothing. The wall time divides the CPU time by the workers, at
+most one per core; other work on the machine slows it down.
 
 The memory: one worker process holds what this process holds after the probe (the
 package, the grid; its resident size is measured), plus the trajectories of its longest
@@ -326,14 +326,15 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
         n_quiet = math.floor((first - shift) / dt)
         enable = enable_windows(moved.bypass, t_probe)
 
-        def events():
+        def moved_events():
             return make_events(setup, moved)
 
-        t3, s3, _ = timed(t_probe, 1, events, enable, repeat=1)   # long enough: once (1 % apart)
+        # long enough to be timed once (repeated, they agreed to 1 %)
+        t3, s3, _ = timed(t_probe, 1, moved_events, enable, repeat=1)
         if s3 > n_quiet:
             transient = max((t3 - fixed_sim - n_quiet * per_step) / (s3 - n_quiet), per_step)
         if batch > 1:
-            u3, _, _ = timed(t_probe, batch, events, enable, repeat=1)
+            u3, _, _ = timed(t_probe, batch, moved_events, enable, repeat=1)
             if s3 > n_quiet:
                 batch_transient = max((u3 - batch_fixed - n_quiet * batch_step)
                                       / (s3 - n_quiet), batch_step)
