@@ -339,3 +339,66 @@ def test_the_policy_key_is_the_content_of_the_policy():
     assert policy_key(a) == policy_key(b) != policy_key(c)
     assert policy_key(None) == "idle"
     assert policy_key(lambda x: x) != policy_key(lambda x: x)     # closures: by identity
+
+
+def test_a_studys_scenario_runs_of_both_loads_share_a_batch():
+    """`weakgrid run`/`reproduce` batch a study's runs by UPQC structure and grid variant,
+    both load levels together (each member holds its own loads, as in a sweep's batches):
+    case 1's 20 runs in 4 batches, none of one run (8 batches, 4 of one run, when the load
+    level split them)."""
+    from weakgrid.study.controllers import controller_variant
+    from weakgrid.study.engine import _run_batches
+    from weakgrid.study.runner import Run
+
+    st = load_study("case1-weak-grid")
+    runs = [Run.of(st, sc, c) for sc, c in st.runs(False)]
+    assert len(runs) == 20
+    batches = _run_batches([(st, r, {}, None) for r in runs], 0)
+    assert sorted(len(b) for b in batches) == [2, 2, 4, 12]
+    for b in batches:
+        assert {runs[i].load for i in b} == {"high", "low"}
+        assert len({(runs[i].upqc, controller_variant(st, runs[i].controller)) for i in b}) == 1
+    # the costliest first (all runs of 6 s at one step: the largest first)
+    assert [len(b) for b in batches] == sorted((len(b) for b in batches), reverse=True)
+    # on 2 workers no batch holds more than half the runs' steps: the 12 runs split in two
+    two = _run_batches([(st, r, {}, None) for r in runs], 2)
+    assert sorted(len(b) for b in two) == [2, 2, 4, 6, 6]
+    assert sorted(i for b in two for i in b) == list(range(20))
+
+
+def test_a_sweep_point_without_run_files_records_only_what_its_metrics_read(tmp_path,
+                                                                           monkeypatch):
+    """A sweep that keeps no run file records only the signals its metrics read (the grid's
+    aliased signals): the table is the same as with every signal recorded, the recorded
+    columns are those signals alone."""
+    import dataclasses
+
+    import weakgrid.study.sweep as sweep
+    from weakgrid.study.runner import simulate_prepared
+
+    st = _two_ratings_two_loads(["nonlinear-29"])
+    pts = sweep_points(st, quick=True)
+    prep = sweep.prepare_point(pts[0].inputs)
+    assert prep.record == list(dict.fromkeys(prep.setup.signals.values()))
+    res, _ = simulate_prepared([prep], batched=False)[0]
+    assert sorted(res.names) == sorted(prep.record)
+    full = dataclasses.replace(sweep.prepare_point(pts[0].inputs), record=None)
+    res_full, _ = simulate_prepared([full], batched=False)[0]
+    assert len(res_full.names) > 5 * len(res.names)
+    for n in res.names:
+        assert (res[n] == res_full[n]).all(), n
+    lean = run_study_sweep(st, tmp_path / "lean", quick=True, workers=0, progress=False)
+    real = sweep.prepare_point
+    monkeypatch.setattr(sweep, "prepare_point",
+                        lambda inputs: dataclasses.replace(real(inputs), record=None))
+    every = run_study_sweep(st, tmp_path / "every", quick=True, workers=0, progress=False)
+    pd.testing.assert_frame_equal(lean.drop(columns=TIMES), every.drop(columns=TIMES))
+
+
+def test_a_run_file_sweep_point_records_every_signal():
+    """With ``signals = true`` (the run files kept) a sweep point records every signal."""
+    import weakgrid.study.sweep as sweep
+
+    st = _two_ratings_two_loads(["nonlinear-29"])
+    pt = sweep_points(st, quick=True)[0]
+    assert sweep.prepare_point(dict(pt.inputs, signals=True)).record is None

@@ -62,6 +62,29 @@ def test_group_keys_order_and_sizes():
     assert group([], key=str) == []
 
 
+def test_group_splits_a_group_costlier_than_max_weight_into_equal_parts():
+    items = [("a", 1.0)] * 5 + [("b", 4.0), ("a", 1.0), ("c", 0.5)]
+    bs = group(items, key=lambda it: it[0], weight=lambda it: it[1], max_weight=2.5)
+    # a: 6 runs of cost 1 -> 3 parts of 2; b: one run of 4 stays whole; c: under the limit
+    assert [(b.key, b.rows) for b in bs] == [("a", (0, 1)), ("a", (2, 3)), ("a", (4, 6)),
+                                             ("b", (5,)), ("c", (7,))]
+    # both limits: the count's parts where they are more
+    bs = group(items, key=lambda it: it[0], max_size=2, weight=lambda it: it[1],
+               max_weight=100.0)
+    assert [len(b) for b in bs if b.key == "a"] == [2, 2, 2]
+    # sizes differ by one at most: 7 runs of cost 1 over a limit of 3 -> 3 parts of 3, 2, 2
+    bs = group([1.0] * 7, key=lambda x: 0, weight=float, max_weight=3.0)
+    assert [len(b) for b in bs] == [3, 2, 2]
+
+
+@pytest.mark.parametrize("mw", [0, -1.0, float("inf"), float("nan"), True])
+def test_group_refuses_a_bad_max_weight(mw):
+    with pytest.raises(ParameterError, match="max_weight"):
+        group([1, 2], key=str, weight=float, max_weight=mw)
+    with pytest.raises(ParameterError, match="max_weight"):
+        group([1, 2], key=str, max_weight=1.0)      # a limit without a weight
+
+
 @pytest.mark.parametrize("size", [0, -1, 1.5, True])
 def test_group_refuses_a_bad_size(size):
     with pytest.raises(ParameterError, match="max_size"):

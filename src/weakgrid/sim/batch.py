@@ -122,6 +122,7 @@ class _BatchRecorder:
         self.sys = system
         self.blocks = []
         self._ocols = None      # the columns of the outputs, in the order of ``rec._outs``
+        self._pieces = None     # with ``record``: where each selected column comes from
 
     def add(self, t, members, Z, ctx, pos):
         """Record members ``members`` (their points ``Z``, one row each) whose rows in the
@@ -130,6 +131,11 @@ class _BatchRecorder:
         if not rec._layout_done:
             rec._layout(_RowCtx(ctx, pos[0], self.sys))
             rec._plan()
+            if rec.sel is not None:
+                self._pieces = self._selected_pieces()
+        if rec.sel is not None:
+            self.blocks.append((t, xp.asarray(members), self._selected(Z, ctx, pos)))
+            return
         nx, nb = self.sys.nx, self.sys.nb
         row = xp.empty((len(members), rec._ncol))
         row[:, :nx] = Z[:, :nx]
@@ -155,6 +161,55 @@ class _BatchRecorder:
         if rec.sel is not None:
             row = row[:, rec.sel]
         self.blocks.append((t, xp.asarray(members), row))
+
+    def _selected_pieces(self) -> list:
+        """Where each selected column of a row comes from (a recorder with ``record``): a
+        list of ``(source, columns of the row, indices in the source)``, the sources
+        ``"z"`` (the point: states, ``Vr``, ``Vi``), ``"v"``/``"a"`` (a bus's magnitude and
+        angle, by bus), ``("out", key)`` (a model's output, by instance), ``"tm"``, ``"vs"``
+        (by machine)."""
+        rec = self.rec
+        nx, nb = self.sys.nx, self.sys.nb
+        parts: dict = {}
+        for j, c in enumerate(rec.sel.tolist()):
+            if c < nx:
+                src, i = "z", c
+            elif c < rec._bus.stop:
+                b, q = divmod(c - nx, 4)
+                src, i = (("z", nx + b), ("z", nx + nb + b), ("v", b), ("a", b))[q]
+            elif c >= rec._vs.start:
+                src, i = "vs", c - rec._vs.start
+            elif c >= rec._tm.start:
+                src, i = "tm", c - rec._tm.start
+            else:
+                key, sl = next((k, sl) for k, sl in rec._outs if sl.start <= c < sl.stop)
+                src, i = ("out", key), c - sl.start
+            cols, idx = parts.setdefault(src, ([], []))
+            cols.append(j)
+            idx.append(i)
+        return [(src, fast_index(cols), fast_index(idx)) for src, (cols, idx) in parts.items()]
+
+    def _selected(self, Z, ctx, pos):
+        """The selected columns of the rows ``pos`` of ``ctx`` (points ``Z``): each computed
+        alone, the same floats as those of the whole row (elementwise operations)."""
+        n = ctx.x.shape[0]
+        every = len(pos) == n and list(pos) == list(range(n))
+        nx, nb = self.sys.nx, self.sys.nb
+        row = xp.empty((len(Z), len(self.rec.sel)))
+        for src, cols, idx in self._pieces:
+            if src == "z":
+                row[:, cols] = Z[:, idx]
+                continue
+            if src in ("v", "a"):
+                Vr, Vi = Z[:, nx:nx + nb][:, idx], Z[:, nx + nb:][:, idx]
+                row[:, cols] = xp.hypot(Vr, Vi) if src == "v" else xp.arctan2(Vi, Vr)
+                continue
+            v = ctx.out[src[1]] if isinstance(src, tuple) else ctx.sig[src]
+            if getattr(v, "ndim", 0) < 2:   # the same for every row
+                row[:, cols] = xp.asarray(v)[idx]
+            else:
+                row[:, cols] = (v if every else v[pos])[:, idx]
+        return row
 
     def finish(self, B, failures, stats):
         """One :class:`Results` per member ``0..B-1``."""

@@ -30,7 +30,7 @@ import os
 from ..dotted import get_path
 
 __all__ = ["batch_key", "event_breakpoints", "simulate_many", "batch_size_for",
-           "STUDY_BATCHES"]
+           "balance_for", "STUDY_BATCHES"]
 
 log = logging.getLogger(__name__)
 
@@ -116,6 +116,14 @@ def batch_size_for(n_runs: int, workers: int | None) -> int | None:
         return None
     w = workers or os.cpu_count() or 1
     return max(1, math.ceil(n_runs / w))
+
+
+def balance_for(workers: int | None) -> int | None:
+    """The workers a sweep's batches are balanced over by cost (:func:`weakgrid.sweep.run_sweep`'s
+    ``balance``; None: one per core; 0: serially, no balance)."""
+    if workers == 0:
+        return None
+    return workers or os.cpu_count() or 1
 
 
 #: ``batch`` argument of :func:`weakgrid.sweep.run_sweep` for a study's sweep.

@@ -31,7 +31,7 @@ from ..design import design_mode, machine_mode, mode_states, modes
 from ..fileio import write_json_atomic
 from ..manifest import Manifest
 from ..models import load_preset
-from .batches import STUDY_BATCHES, batch_size_for
+from .batches import STUDY_BATCHES, balance_for, batch_size_for
 from .build import build_setup
 from .cache import inputs_key, load_run, remove_stale, save_run
 from .claims import STABILITY_NOTE, judge_all
@@ -166,17 +166,35 @@ def _run_batch_task(study, runs, trained):
 
 def _run_batches(todo, workers):
     """``todo`` (study, run, trained, key) in batches of runs that can share a batched
-    simulation (one study, load level, UPQC structure, grid variant, final time and event
-    times off the step grid), at least one batch per worker (:func:`weakgrid.study.batches.batch_size_for`); lists of rows of ``todo``."""
+    simulation (one study, UPQC structure, grid variant, final time and event times off the
+    step grid; both load levels: each member holds its own loads, as in a sweep's batches),
+    at least one batch per worker (:func:`weakgrid.study.batches.batch_size_for`) and none
+    costing more than a worker's share of the runs' steps; lists of rows of ``todo``, the
+    costliest first (a cluster starts them first).
+
+    Grouped by load level as well, case 1's 20 runs made 8 batches (4 of one run) instead of
+    4 and took 129 s serially instead of 89 s (2026-12-03); the runs move by round-off, as
+    they do between a batch and a run alone (docs: performance)."""
     from ..sweep import group
-    from .batches import batch_size_for, event_breakpoints
+    from .batches import balance_for, batch_size_for, event_breakpoints
     from .runner import sim_settings
 
     def key(item):
         st, run, _, _ = item
-        return (id(st), run.load, run.upqc, controller_variant(st, run.controller), run.t_end,
+        return (id(st), run.upqc, controller_variant(st, run.controller), run.t_end,
                 event_breakpoints(run.events, sim_settings(st)[0]))
-    return [list(b.rows) for b in group(todo, key, batch_size_for(len(todo), workers))]
+
+    def steps(item):        # the run's steps: its cost, all runs of a study at one step
+        st, run, _, _ = item
+        return run.t_end / sim_settings(st)[0]
+
+    n_workers = balance_for(workers)
+    share = sum(steps(it) for it in todo) / n_workers if n_workers and todo else None
+    batches = group(todo, key, batch_size_for(len(todo), workers),
+                    weight=steps if share else None, max_weight=share or None)
+    cost = [sum(steps(todo[i]) for i in b.rows) for b in batches]
+    order = sorted(range(len(batches)), key=lambda j: -cost[j])   # stable: ties in order
+    return [list(batches[j].rows) for j in order]
 
 
 def planned_files(out: Path, plan, quick: bool, maps: bool) -> list[Path]:
@@ -229,10 +247,11 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
     Every run's events are built on its grid while planning (:func:`check_events`): a bad
     event stops the command before any training or write.
 
-    ``batched`` (default): the runs of one study, load level and UPQC structure are simulated
-    together (:func:`weakgrid.study.runner.run_scenarios`, a task per batch) and so are the
-    maps' sweep runs of one grid (:func:`weakgrid.study.batches.simulate_many`); ``False``: a
-    task per run, the scalar path (the same results but the wall times).
+    ``batched`` (default): the runs of one study and UPQC structure (both load levels) are
+    simulated together (:func:`weakgrid.study.runner.run_scenarios`, a task per batch) and so
+    are the maps' sweep runs of one grid (:func:`weakgrid.study.batches.simulate_many`);
+    ``False``: a task per run, the scalar path (the same results to round-off, but the wall
+    times).
 
     Returns a summary dict (claims, metrics, figures, report, designs, maps).
     """
@@ -352,13 +371,15 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
             from distributed import as_completed
 
             futs = {}
-            for rows in batches:
+            for rank, rows in enumerate(batches):   # the costliest first, by priority
                 st = todo[rows[0]][0]
                 runs = [todo[i][1] for i in rows]
                 tr = {k: v for i in rows for k, v in todo[i][2].items()
                       if k in {r.design_key for r in runs}}
-                fut = client.submit(_run_batch_task, st, runs, tr, pure=False) if batched \
-                    else client.submit(_run_task, st, runs[0], tr, pure=False)
+                prio = len(batches) - rank
+                fut = client.submit(_run_batch_task, st, runs, tr, pure=False,
+                                    priority=prio) if batched \
+                    else client.submit(_run_task, st, runs[0], tr, pure=False, priority=prio)
                 futs[fut] = rows
             for fut in as_completed(list(futs)):
                 recs = fut.result()
@@ -387,7 +408,9 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                                     table_path=out / _sweep_file(quick),
                                     desc="maps", batch=STUDY_BATCHES if batched else None,
                                     batch_size=batch_size_for(len(pts), 0 if serial else
-                                                              workers) if batched else None)
+                                                              workers) if batched else None,
+                                    balance=balance_for(0 if serial else workers)
+                                    if batched else None)
     map_list, sweeps, uncertainty = [], [], {}
     for st in swept:
         sub = sweep_table[sweep_table["scenario"].isin(st.data["sweep"]["scenarios"])]

@@ -29,6 +29,7 @@ process (cached on the design model and the design settings).
 from __future__ import annotations
 
 import copy
+import dataclasses
 from pathlib import Path
 
 import pandas as pd
@@ -315,7 +316,18 @@ def prepare_point(inputs: dict):
     if controller_kind(st, name) == "hji":
         trained[(dload, run.upqc)] = _trained(st, design, [dload, run.upqc])
     dt, tol = sim_settings(st, float(inputs.get("dt_factor") or 1.0))
-    return prepare_run(st, run, trained, dt=dt, tol=tol, design_load=dload, design=design)
+    prep = prepare_run(st, run, trained, dt=dt, tol=tol, design_load=dload, design=design)
+    if not inputs.get("signals"):   # only its metrics are kept: record what they read
+        prep = dataclasses.replace(prep, record=metric_signals(prep))
+    return prep
+
+
+def metric_signals(prep) -> list:
+    """The simulator signals a run's metrics read (:func:`weakgrid.study.runner.finish_run`:
+    the aliased signals of its grid, ``setup.signals``), for a sweep point that keeps no run
+    file: recorded alone, they cost a fraction of every signal's time and memory (case 2's
+    maps: 10 of 237 columns), and the metrics are the same floats."""
+    return list(dict.fromkeys(prep.setup.signals.values()))
 
 
 def finish_point(inputs: dict, prep, res, wall: float):
@@ -368,10 +380,11 @@ def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
     in the way stops the sweep before any run unless ``force``
     (:class:`weakgrid.manifest.Manifest`). ``batched`` (default): the runs of one grid go to
     :func:`weakgrid.study.batches.simulate_many` together, a task per batch (at least one
-    batch per worker: :func:`weakgrid.study.batches.batch_size_for`); ``False``: a task per
-    run, the scalar path (the same table).
+    batch per worker: :func:`weakgrid.study.batches.batch_size_for`, and none above a worker's
+    share of the sweep's cost: :func:`weakgrid.study.batches.balance_for`); ``False``: a task
+    per run, the scalar path (the same table to round-off).
     """
-    from .batches import STUDY_BATCHES, batch_size_for
+    from .batches import STUDY_BATCHES, balance_for, batch_size_for
     from .sweep_estimate import run_cost
 
     out = Path(output)
@@ -383,6 +396,7 @@ def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
                       scheduler=scheduler, workers=workers, progress=progress, log=log,
                       cost=run_cost, table_path=table_path, desc=f"sweep {study.name}",
                       batch=STUDY_BATCHES if batched else None,
-                      batch_size=batch_size_for(len(pts), workers) if batched else None)
+                      batch_size=batch_size_for(len(pts), workers) if batched else None,
+                      balance=balance_for(workers) if batched else None)
     Manifest(out).record([table_path])   # its content, as written
     return table

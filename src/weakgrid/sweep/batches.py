@@ -9,6 +9,7 @@ results back on the runs' rows.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from ..game.errors import ParameterError
@@ -35,7 +36,8 @@ class Batch:
         return len(self.rows)
 
 
-def group(items, key, max_size: int | None = None) -> list[Batch]:
+def group(items, key, max_size: int | None = None, weight=None,
+          max_weight: float | None = None) -> list[Batch]:
     """The batches of ``items`` by ``key(item)``.
 
     Parameters
@@ -45,25 +47,49 @@ def group(items, key, max_size: int | None = None) -> list[Batch]:
     key : callable
         ``key(item)`` → a hashable value; equal values share a batch.
     max_size : int, optional
-        Largest batch (a larger group is split into consecutive batches of at most this many,
-        so that batches can still be spread over workers). Default: no limit.
+        Largest batch (a larger group is split, so that batches can still be spread over
+        workers). Default: no limit.
+    weight : callable, optional
+        ``weight(item)`` → the item's cost (a finite number ≥ 0), with ``max_weight``.
+    max_weight : float, optional
+        Largest summed ``weight`` of a batch: a costlier group is split too (e.g. a worker's
+        share of the whole cost, so that one group does not run on one worker while the
+        others idle). Default: no limit.
 
     Returns
     -------
     list of Batch
-        In the order of each batch's first member; members in their order in ``items``.
+        In the order of each batch's first member; members in their order in ``items``. A
+        group that must be split is cut into the fewest consecutive parts that satisfy both
+        limits (by count; by weight, the parts' count assuming equal weights), of sizes that
+        differ by one at most.
     """
     if max_size is not None and (isinstance(max_size, bool) or not isinstance(max_size, int)
                                  or max_size < 1):
         raise ParameterError("max_size", max_size, "give a whole number ≥ 1, or None (no "
                              "limit)")
+    if max_weight is not None and (weight is None or isinstance(max_weight, bool)
+                                   or not isinstance(max_weight, (int, float))
+                                   or not max_weight > 0 or math.isinf(max_weight)):
+        raise ParameterError("max_weight", max_weight, "give a finite number > 0 with a "
+                             "weight function, or None (no limit)")
     rows: dict = {}
     for i, it in enumerate(items):
         rows.setdefault(key(it), []).append(i)
     out = []
     for k, r in rows.items():
-        step = max_size or len(r)
-        out += [Batch(k, tuple(r[j:j + step])) for j in range(0, len(r), step)]
+        parts = 1 if max_size is None else -(-len(r) // max_size)
+        if max_weight is not None:
+            w = sum(float(weight(items[i])) for i in r)
+            if math.isfinite(w):
+                parts = max(parts, math.ceil(w / max_weight - 1e-9))
+        parts = max(1, min(parts, len(r)))
+        q, extra = divmod(len(r), parts)
+        a = 0
+        for j in range(parts):
+            b = a + q + (1 if j < extra else 0)
+            out.append(Batch(k, tuple(r[a:b])))
+            a = b
     out.sort(key=lambda b: b.rows[0])
     return out
 
