@@ -206,6 +206,41 @@ def test_the_probe_times_a_batch_of_the_run():
     assert batch_step_cost(pr, 4) == pytest.approx(pr["batch_step_s"])
 
 
+def test_the_estimate_prices_the_batches_the_sweep_makes():
+    """Case 2's full sweep on 2 workers: its 90 runs of one grid are more than a worker's
+    share of the sweep's cost, so the sweep splits them in two batches of 45, and the
+    estimate prices those batches (one mechanism: :func:`weakgrid.sweep.batches.balanced`)."""
+    from weakgrid.study.batches import STUDY_BATCHES, balance_for, batch_size_for
+    from weakgrid.study.studyfile import load_study
+    from weakgrid.study.sweep import run_point, sweep_points
+    from weakgrid.study.sweep_estimate import _batches, run_cost
+    from weakgrid.sweep.engine import _tasks
+
+    pts = sweep_points(load_study("case2-lv-microgrid"), quick=False)
+    todo = {f"k{i}": p for i, p in enumerate(pts)}
+    est = _batches(todo, len(pts), 2)
+    tasks = _tasks([(p, k) for k, p in todo.items()], run_point, STUDY_BATCHES,
+                   batch_size_for(len(pts), 2), run_cost, balance_for(2))
+    assert est == [keys for _, _, (_, keys) in tasks]
+    assert sorted(len(b) for b in est) == [6, 45, 45]
+    assert sorted(len(b) for b in _batches(todo, len(pts), 0)) == [6, 90]   # serially: whole
+
+
+def test_the_probe_records_what_the_sweep_records():
+    """A sweep without run files records its metrics' signals alone, and the probe that
+    prices its memory records the same (every signal with ``signals``)."""
+    from weakgrid.study.build import build_setup
+    from weakgrid.study.studyfile import load_study
+    from weakgrid.study.sweep import sweep_points
+    from weakgrid.study.sweep_estimate import probe
+
+    st = load_study("case1-weak-grid")
+    pts = sweep_points(st, quick=True)
+    lean, every = probe(pts[0].inputs), probe(dict(pts[0].inputs, signals=True))
+    assert lean["n_vars"] == len(set(build_setup(st).signals.values()))
+    assert every["n_vars"] > 5 * lean["n_vars"]
+
+
 FIRST_CALL_S = 0.5     # an injected one-time cost (a process loading or compiling its kernels)
 
 

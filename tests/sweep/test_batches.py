@@ -77,6 +77,23 @@ def test_group_splits_a_group_costlier_than_max_weight_into_equal_parts():
     assert [len(b) for b in bs] == [3, 2, 2]
 
 
+def test_balanced_caps_a_batch_at_a_workers_share_of_the_cost():
+    from weakgrid.sweep.batches import balanced
+
+    items = [("a", 1.0)] * 6 + [("b", 2.0)] * 2      # cost 10: a worker's share of 2 is 5
+    bs = balanced(items, key=lambda it: it[0], cost=lambda it: it[1], balance=2)
+    assert [(b.key, len(b)) for b in bs] == [("a", 3), ("a", 3), ("b", 2)]
+    assert [len(b) for b in balanced(items, key=lambda it: it[0], cost=lambda it: it[1],
+                                     balance=1)] == [6, 2]
+    # no cost, or costs that are not finite numbers (counted 0): by count alone
+    assert len(balanced(items, key=lambda it: it[0], balance=2)) == 2
+    assert len(balanced(items, key=lambda it: it[0], cost=lambda it: float("nan"),
+                        balance=2)) == 2
+    for bad in (0, -2, 1.5, True):
+        with pytest.raises(ParameterError, match="balance"):
+            balanced(items, key=lambda it: it[0], cost=lambda it: it[1], balance=bad)
+
+
 @pytest.mark.parametrize("mw", [0, -1.0, float("inf"), float("nan"), True])
 def test_group_refuses_a_bad_max_weight(mw):
     with pytest.raises(ParameterError, match="max_weight"):

@@ -175,7 +175,7 @@ def _run_batches(todo, workers):
     Grouped by load level as well, case 1's 20 runs made 8 batches (4 of one run) instead of
     4 and took 129 s serially instead of 89 s (2026-12-03); the runs move by round-off, as
     they do between a batch and a run alone (docs: performance)."""
-    from ..sweep import group
+    from ..sweep.batches import balanced
     from .batches import balance_for, batch_size_for, event_breakpoints
     from .runner import sim_settings
 
@@ -188,10 +188,8 @@ def _run_batches(todo, workers):
         st, run, _, _ = item
         return run.t_end / sim_settings(st)[0]
 
-    n_workers = balance_for(workers)
-    share = sum(steps(it) for it in todo) / n_workers if n_workers and todo else None
-    batches = group(todo, key, batch_size_for(len(todo), workers),
-                    weight=steps if share else None, max_weight=share or None)
+    batches = balanced(todo, key, batch_size_for(len(todo), workers), steps,
+                       balance_for(workers))
     cost = [sum(steps(todo[i]) for i in b.rows) for b in batches]
     order = sorted(range(len(batches)), key=lambda j: -cost[j])   # stable: ties in order
     return [list(batches[j].rows) for j in order]

@@ -300,7 +300,7 @@ def prepare_point(inputs: dict):
     its study built from ``inputs``, its design model and trained controller (cached per
     worker process)."""
     from .controllers import controller_kind
-    from .runner import Run, prepare_run, sim_settings
+    from .runner import Run, metric_signals, prepare_run, sim_settings
 
     st = study_from_dict(inputs["study"], source=f"sweep:{inputs['study']['study']['name']}")
     sc = next((s for s in st.scenarios() if s["id"] == inputs["scenario"]), None)
@@ -318,16 +318,8 @@ def prepare_point(inputs: dict):
     dt, tol = sim_settings(st, float(inputs.get("dt_factor") or 1.0))
     prep = prepare_run(st, run, trained, dt=dt, tol=tol, design_load=dload, design=design)
     if not inputs.get("signals"):   # only its metrics are kept: record what they read
-        prep = dataclasses.replace(prep, record=metric_signals(prep))
+        prep = dataclasses.replace(prep, record=metric_signals(prep.setup))
     return prep
-
-
-def metric_signals(prep) -> list:
-    """The simulator signals a run's metrics read (:func:`weakgrid.study.runner.finish_run`:
-    the aliased signals of its grid, ``setup.signals``), for a sweep point that keeps no run
-    file: recorded alone, they cost a fraction of every signal's time and memory (case 2's
-    maps: 10 of 237 columns), and the metrics are the same floats."""
-    return list(dict.fromkeys(prep.setup.signals.values()))
 
 
 def finish_point(inputs: dict, prep, res, wall: float):

@@ -32,8 +32,9 @@ most one per core; other work on the machine slows it down.
 
 The memory: one worker process holds what this process holds after the probe (the
 package, the grid; its resident size is measured), plus the trajectories of its longest
-run (steps × variables × 8 bytes, twice: while they grow and as the final array) times the
-runs of its largest batch, plus a
+run (steps × recorded variables × 8 bytes, twice: while they grow and as the final array;
+the signals its metrics read, every signal with ``signals``) times the runs of its largest
+batch, plus a
 training's working memory; this process holds the table (a row per run) and, with
 ``signals``, one run's signals in transit.
 """
@@ -250,7 +251,7 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
     transient), ``per_run_s`` (a run's fixed cost: its grid built as a worker builds it again,
     its start), ``per_process_s`` (what a process pays once: its first build of the grid, the
     simulator's first steps — compiled kernels loaded or compiled, :mod:`weakgrid.sim.kernels`),
-    ``n_vars`` (variables recorded per step) and ``train`` and ``train_bounded`` (the
+    ``n_vars`` (variables recorded per step, as the sweep records them) and ``train`` and ``train_bounded`` (the
     :class:`~weakgrid.game.estimate.Estimate` of one HJI training, unbounded and rating-bounded:
     their bases differ); with ``batch`` > 1 also ``batch`` (at most :data:`PROBE_BATCH`),
     ``batch_step_s`` and ``batch_transient_step_s``, the cost of one quiet step and of one step
@@ -261,7 +262,8 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
     from ..sim.integrate import simulate
     from .build import build_setup
     from .controllers import controller_variant, design_problem
-    from .runner import Run, _MeasureOnly, enable_windows, make_events, sim_settings
+    from .runner import (Run, _MeasureOnly, enable_windows, make_events, metric_signals,
+                         sim_settings)
 
     st = study_from_dict(inputs["study"], source=f"sweep:{inputs['study']['study']['name']}")
     sc = next(s for s in st.scenarios() if s["id"] == inputs["scenario"])
@@ -273,6 +275,9 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
     t0 = time.perf_counter()
     setup = build_setup(st, run.load, run.upqc, variant)
     t_setup = time.perf_counter() - t0
+    # what the sweep records: every signal with ``signals`` (its run files), else what the
+    # metrics read (weakgrid.study.sweep.prepare_point)
+    record = None if inputs.get("signals") else metric_signals(setup)
 
     def idle(**kw):     # the run's digital controller, measuring and holding zero
         return DigitalController(lambda m: np.zeros(2), T=setup.design.T, measure=setup.measure,
@@ -291,9 +296,11 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
                     for _ in range(b)]
             t0 = time.perf_counter()
             if b == 1:
-                res = simulate(setup.system, t_end, dt=dt, tol=tol, on_failure="return", **scen[0])
+                res = simulate(setup.system, t_end, dt=dt, tol=tol, on_failure="return",
+                               record=record, **scen[0])
             else:
-                res = simulate_batch(setup.system, scen, t_end, batch_size=b, dt=dt, tol=tol)[0]
+                res = simulate_batch(setup.system, scen, t_end, batch_size=b, dt=dt, tol=tol,
+                                     record=record)[0]
             best = min(best, time.perf_counter() - t0)
         return best, int(res.stats.get("steps") or round(t_end / dt)), len(res.names)
 
@@ -496,13 +503,16 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
 def _batches(todo: dict, n_points: int, workers: int | None) -> list[list]:
     """The keys of ``todo`` in the batches the sweep makes of them
     (:func:`weakgrid.study.batches.batch_key`, at most
-    :func:`~weakgrid.study.batches.batch_size_for` of the sweep's ``n_points`` runs each)."""
-    from ..sweep.batches import group
-    from .batches import batch_key, batch_size_for
+    :func:`~weakgrid.study.batches.batch_size_for` of the sweep's ``n_points`` runs each, none
+    above a worker's share of their :func:`run_cost`: :func:`weakgrid.sweep.batches.balanced`,
+    as :func:`weakgrid.sweep.run_sweep` makes them)."""
+    from ..sweep.batches import balanced
+    from .batches import balance_for, batch_key, batch_size_for
 
     keys = list(todo)
     return [[keys[i] for i in b.rows] for b in
-            group([todo[k].inputs for k in keys], batch_key, batch_size_for(n_points, workers))]
+            balanced([todo[k].inputs for k in keys], batch_key, batch_size_for(n_points, workers),
+                     run_cost, balance_for(workers))]
 
 
 def check_sweep(est: SweepEstimate, study, quick: bool = False, force: bool = False,

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from ..game.errors import ParameterError
 
-__all__ = ["Batch", "group", "scatter"]
+__all__ = ["Batch", "group", "balanced", "finite_cost", "scatter"]
 
 
 @dataclass(frozen=True)
@@ -92,6 +92,29 @@ def group(items, key, max_size: int | None = None, weight=None,
             a = b
     out.sort(key=lambda b: b.rows[0])
     return out
+
+
+def finite_cost(cost, item) -> float:
+    """``cost(item)``, 0 where it is not a finite number ≥ 0."""
+    c = float(cost(item))
+    return c if math.isfinite(c) and c >= 0 else 0.0
+
+
+def balanced(items, key, max_size: int | None = None, cost=None,
+             balance: int | None = None) -> list[Batch]:
+    """:func:`group` with no batch above ``1/balance`` of the items' summed ``cost(item)``
+    (``balance``: the workers the batches are spread over; None, or no ``cost``: by count
+    alone), so that no worker is left with one long batch while the others idle."""
+    if balance is not None and (isinstance(balance, bool) or not isinstance(balance, int)
+                                or balance < 1):
+        raise ParameterError("balance", balance, "give a whole number ≥ 1 of workers, or "
+                             "None (no limit by cost)")
+    share = None
+    if balance is not None and cost is not None and len(items):
+        total = sum(finite_cost(cost, it) for it in items)
+        share = total / balance if total > 0 else None
+    return group(items, key, max_size, weight=(lambda it: finite_cost(cost, it)) if share
+                 else None, max_weight=share)
 
 
 def scatter(batches, results, n: int) -> list:

@@ -243,25 +243,17 @@ def results_table(points, records) -> pd.DataFrame:
     return df
 
 
-def _finite_cost(cost, inputs) -> float:
-    """``cost(inputs)``, 0 where it is not a finite number ≥ 0."""
-    c = float(cost(inputs))
-    return c if math.isfinite(c) and c >= 0 else 0.0
-
-
-def _tasks(todo, run, batch, batch_size, cost=None, share=None):
+def _tasks(todo, run, batch, batch_size, cost=None, balance=None):
     """``(function, arguments, (points, keys))`` of every task: one point each, or with
-    ``batch = (key, run_many)`` one batch each (:func:`weakgrid.sweep.batches.group`; a
-    batch costs at most ``share`` of ``cost`` when both are given)."""
+    ``batch = (key, run_many)`` one batch each (:func:`weakgrid.sweep.batches.balanced`)."""
     if batch is None:
         return [(execute, (run, p.inputs, k), ([p], [k])) for p, k in todo]
-    from .batches import group
+    from .batches import balanced
 
     key, run_many = batch
     out = []
-    weight = None if cost is None else (lambda pk: _finite_cost(cost, pk[0].inputs))
-    for b in group(todo, lambda pk: key(pk[0].inputs), batch_size, weight=weight,
-                   max_weight=share if cost is not None else None):
+    for b in balanced(todo, lambda pk: key(pk[0].inputs), batch_size,
+                      None if cost is None else (lambda pk: cost(pk[0].inputs)), balance):
         pts = [todo[i][0] for i in b.rows]
         keys = [todo[i][1] for i in b.rows]
         out.append((execute_batch, (run_many, [p.inputs for p in pts], keys), (pts, keys)))
@@ -349,10 +341,6 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
     """
     if workers is not None and (not isinstance(workers, int) or workers < 0):
         raise ParameterError("workers", workers, "give a whole number ≥ 0 (0 = serial)")
-    if balance is not None and (isinstance(balance, bool) or not isinstance(balance, int)
-                                or balance < 1):
-        raise ParameterError("balance", balance, "give a whole number ≥ 1 of workers, or "
-                             "None (no limit by cost)")
     log = log or _log.info
     cache = ResultCache(cache_dir)
     keys = [run_key(p.inputs, run) for p in points]
@@ -372,11 +360,7 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
                                          (" serially" if workers == 0 else
                                           f" on {scheduler or 'a local cluster'}")))
     bar = _progress(total, total - len(todo_unique), progress, desc)
-    share = None
-    if balance is not None and cost is not None and todo_unique:
-        total_cost = sum(_finite_cost(cost, p.inputs) for p, _ in todo_unique)
-        share = total_cost / balance if total_cost > 0 else None
-    tasks = _tasks(todo_unique, run, batch, batch_size, cost if share else None, share)
+    tasks = _tasks(todo_unique, run, batch, batch_size, cost, balance)
     try:
         with _sigterm_as_interrupt():
             if tasks and workers == 0 and client is None:
