@@ -119,8 +119,9 @@ def batch_size_for(n_runs: int, workers: int | None) -> int | None:
 
 
 def balance_for(workers: int | None) -> int | None:
-    """The workers a sweep's batches are balanced over by cost (:func:`weakgrid.sweep.run_sweep`'s
-    ``balance``; None: one per core; 0: serially, no balance)."""
+    """The workers a sweep's batches are balanced over by cost
+    (:func:`weakgrid.sweep.run_sweep`'s ``balance``) for ``workers`` (None: one per core; 0:
+    serially, no balance)."""
     if workers == 0:
         return None
     return workers or os.cpu_count() or 1

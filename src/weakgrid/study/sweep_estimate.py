@@ -251,9 +251,9 @@ def probe(inputs: dict, steps=PROBE_STEPS, batch: int = 1) -> dict:
     transient), ``per_run_s`` (a run's fixed cost: its grid built as a worker builds it again,
     its start), ``per_process_s`` (what a process pays once: its first build of the grid, the
     simulator's first steps — compiled kernels loaded or compiled, :mod:`weakgrid.sim.kernels`),
-    ``n_vars`` (variables recorded per step, as the sweep records them) and ``train`` and ``train_bounded`` (the
-    :class:`~weakgrid.game.estimate.Estimate` of one HJI training, unbounded and rating-bounded:
-    their bases differ); with ``batch`` > 1 also ``batch`` (at most :data:`PROBE_BATCH`),
+    ``n_vars`` (variables recorded per step, as the sweep records them) and ``train`` and
+    ``train_bounded`` (the :class:`~weakgrid.game.estimate.Estimate` of one HJI training,
+    unbounded and rating-bounded: their bases differ); with ``batch`` > 1 also ``batch`` (at most :data:`PROBE_BATCH`),
     ``batch_step_s`` and ``batch_transient_step_s``, the cost of one quiet step and of one step
     of the transient of that many copies of the run advanced together [s].
     """
