@@ -158,8 +158,6 @@ class _BatchRecorder:
         tm, vs = ctx.sig["tm"], ctx.sig["vs"]
         row[:, rec._tm] = tm if every else tm[pos]
         row[:, rec._vs] = vs if every else vs[pos]
-        if rec.sel is not None:
-            row = row[:, rec.sel]
         self.blocks.append((t, xp.asarray(members), row))
 
     def _selected_pieces(self) -> list:
