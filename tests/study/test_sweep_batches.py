@@ -402,3 +402,25 @@ def test_a_run_file_sweep_point_records_every_signal():
     st = _two_ratings_two_loads(["nonlinear-29"])
     pt = sweep_points(st, quick=True)[0]
     assert sweep.prepare_point(dict(pt.inputs, signals=True)).record is None
+
+
+@pytest.mark.slow
+def test_case1_runs_sharing_a_trained_law_equal_their_runs_alone_bit_for_bit():
+    """Case 1's 6-s HJI runs at both loads (one controller, designed at high load: one policy
+    call per sample for both) give the trajectories of their runs alone to the last bit. A
+    closed loop amplifies any difference: when the trained policy rounded its two-row call
+    otherwise than a one-row call, one ulp at 0.3 s became 1.8e-8 rad in the SG's angle."""
+    import numpy as np
+
+    from weakgrid.study.runner import Run, run_scenarios
+
+    st = load_study("case1-weak-grid")
+    runs = [Run.of(st, sc, c) for sc, c in st.runs(False)
+            if c == "hji" and sc["id"] in ("c1-high-conv", "c1-low-conv")]
+    assert len(runs) == 2 and runs[0].t_end >= 6.0
+    alone = run_scenarios(st, runs, batched=False)
+    together = run_scenarios(st, runs, batched=True)
+    for a, b in zip(alone, together):
+        assert a.results.names == b.results.names
+        assert np.array_equal(a.results.t, b.results.t)
+        assert np.array_equal(a.results.data, b.results.data)

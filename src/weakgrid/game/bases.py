@@ -18,6 +18,7 @@ from math import factorial
 import numpy as np
 
 from .errors import ParameterError, ShapeError
+from .rowwise import sum_in_order
 
 __all__ = [
     "PolynomialBasis",
@@ -177,6 +178,19 @@ class PolynomialBasis:
             return phi, grad
         hess = mono[self._hessian_planes]  # (n, n, L, p): plane of ∂²/∂x_j∂x_k at [j, k]
         return phi, grad, hess.transpose(3, 2, 0, 1).reshape(*batch, L, n, n)
+
+    def weighted_derivatives(self, x, weights):
+        """``∇J`` (..., n) and ``∇²J`` (..., n, n) of ``J = weights'σ`` at states ``x``
+        (..., n), the sum over the monomials term by term (:mod:`weakgrid.game.rowwise`):
+        a state's floats do not depend on the states evaluated with it."""
+        x2, batch = self._check_x(x)
+        n = self.n_states
+        w = np.asarray(weights, float)
+        mono = self.planes(x2.T, 2)[1:]     # (K − 1, L, p): first, then second derivatives
+        acc = sum_in_order(mono * w[:, None], 1)
+        grad = acc[:n].T.reshape(*batch, n)
+        hess = acc[self._hessian_planes - 1].transpose(2, 0, 1).reshape(*batch, n, n)
+        return grad, hess
 
     def second_derivative_pairs(self):
         """The (j, k), j ≤ k, of the second-derivative planes of :meth:`planes`."""

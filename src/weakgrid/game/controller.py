@@ -25,6 +25,7 @@ import numpy as np
 from .bases import PolynomialBasis
 from .cost import GameCost
 from .errors import ParameterError, ShapeError
+from .rowwise import matmul, matvec, vecmat
 from .system import ControlAffineSystem, system_from_dict
 from ..fileio import write_json_atomic
 
@@ -88,41 +89,47 @@ class GameController:
     # ------------------------------------------------------- saddle point
     def _terms(self, x):
         x = self.system.check_states(x)
-        _, dphi, d2phi = self.basis.evaluate(x)
-        gJ = np.einsum("...ln,l->...n", dphi, self.weights)
-        HJ = np.einsum("...lij,l->...ij", d2phi, self.weights)
+        gJ, HJ = self.basis.weighted_derivatives(x, self.weights)   # ∇J, ∇²J
         f = self.system.open_loop_dynamics(x)
         g = np.asarray(self.system.control_directions(x), float)
         h = np.asarray(self.system.disturbance_directions(x), float)
         return x, f, g, h, gJ, HJ
 
-    def saddle_point(self, x):
-        """Joint saddle point ``(u*, w*)`` at one state ``(n,)`` or a batch ``(..., n)``."""
+    def saddle_point(self, x, rowwise: bool = False):
+        """Joint saddle point ``(u*, w*)`` at one state ``(n,)`` or a batch ``(..., n)``.
+
+        The contractions are term by term (:mod:`weakgrid.game.rowwise`) and each matrix is
+        solved on its own, so the floats of a state do not depend on the batch it is in;
+        ``rowwise``: the input bound's minimization too (:meth:`rows`), point by point
+        whatever the count (:meth:`~weakgrid.game.input_bound.InputBound.minimize`'s
+        ``pointwise``; with at most 2 inputs).
+        """
         x, f, g, h, gJ, HJ = self._terms(x)
         m, q = g.shape[-1], h.shape[-1]
         B = np.concatenate([g, h], axis=-1)  # (..., n, m+q)
-        M = np.einsum("...ni,...nk,...kj->...ij", B, HJ, B)
+        M = matmul(np.swapaxes(B, -1, -2), matmul(HJ, B))    # B'∇²J B
         reg = np.zeros((m + q, m + q))
         reg[:m, :m] = 2 * self.cost.R
         reg[m:, m:] = -2 * self.cost.gamma**2 * self.cost.P
-        rhs = np.einsum("...ni,...n->...i", B, gJ + np.einsum("...ij,...j->...i", HJ, f - x))
+        rhs = vecmat(gJ + matvec(HJ, f - x), B)               # B'[∇J + ∇²J(f − x)]
         if self.cost.bound is not None:
-            return self._bounded_saddle_point(M, rhs, m)
+            return self._bounded_saddle_point(M, rhs, m, rowwise)
         M = M + reg
         z = -np.linalg.solve(M, rhs[..., None])[..., 0]
         return z[..., :m], z[..., m:]
 
-    def _bounded_saddle_point(self, M, rhs, m):
+    def _bounded_saddle_point(self, M, rhs, m, rowwise=False):
         """``u* = argmin_{bound} max_w`` of (22) with ``W(u)``; ``M = B'∇²J B``, ``rhs = B'r``."""
         c = self.cost
         Yw = M[..., m:, m:] - 2 * c.gamma**2 * c.P
         Ghg = M[..., m:, :m]
         Xs = np.linalg.solve(Yw, np.concatenate([Ghg, rhs[..., m:, None]], -1))
         Xg, Xr = Xs[..., :m], Xs[..., m]
-        Meff = M[..., :m, :m] - np.einsum("...iq,...qj->...ij", M[..., :m, m:], Xg)
-        beff = rhs[..., :m] - np.einsum("...iq,...q->...i", M[..., :m, m:], Xr)
-        u = c.bound.minimize(0.5 * (Meff + np.swapaxes(Meff, -1, -2)), beff, c.R)
-        w = -(Xr + np.einsum("...qj,...j->...q", Xg, u))
+        Meff = M[..., :m, :m] - matmul(M[..., :m, m:], Xg)
+        beff = rhs[..., :m] - matvec(M[..., :m, m:], Xr)
+        u = c.bound.minimize(0.5 * (Meff + np.swapaxes(Meff, -1, -2)), beff, c.R,
+                             pointwise=True if rowwise else None)
+        w = -(Xr + matvec(Xg, u))
         return u, w
 
     def unbounded_control(self, x) -> np.ndarray:
@@ -159,6 +166,12 @@ class GameController:
         return self.saddle_point(x)[1]
 
     __call__ = control
+
+    def rows(self, x) -> np.ndarray:
+        """``u*`` at each row of ``x`` (..., n), each row's floats those of :meth:`control` on
+        that row alone, however many rows (what a batched simulation calls for the members
+        that share this law; ``saddle_point(x, rowwise=True)``)."""
+        return self.saddle_point(x, rowwise=True)[0]
 
     def hamiltonian(self, x, u, w) -> np.ndarray:
         """The approximate Hamiltonian (22) ``∇J'Δx + ½Δx'∇²JΔx + Q(x) + u'Ru − γ²w'Pw``."""

@@ -276,7 +276,8 @@ class InputBound:
             return (r * val).sum(-1)
         return r[0] * val
 
-    def minimize(self, M, b, R, max_iter: int = 100, return_info: bool = False):
+    def minimize(self, M, b, R, max_iter: int = 100, return_info: bool = False,
+                 pointwise: bool | None = None):
         """``argmin_u ½u'Mu + b'u + W(u)`` at every point (see the module).
 
         Solved in the unbounded variable v of ``u = squash(v)`` (``ū·tanh(v/ū)``), in
@@ -294,6 +295,12 @@ class InputBound:
             Symmetric, with ``M + 2R ≻ 0`` (checked by the callers: Yu ≻ 0).
         b : (..., m)
         R : (m, m)
+        pointwise : bool, optional
+            With at most 2 inputs, iterate point by point on Python floats (each point's
+            floats then do not depend on the others: what the rows of a batched simulation
+            need) or on the arrays of all points at once (the same iteration, equal to
+            rounding, cheaper beyond about 16 points); default: point by point up to
+            :data:`POINTWISE_MAX` points. Ignored for more inputs (always the arrays).
 
         Returns
         -------
@@ -309,7 +316,7 @@ class InputBound:
         m = b.shape[-1]
         shape = b.shape[:-1]
         n_pts = b.size // m
-        if m <= 2 and n_pts <= POINTWISE_MAX:
+        if m <= 2 and (n_pts <= POINTWISE_MAX if pointwise is None else pointwise):
             # a few points (a controller sample, a small batch's rows): the same iteration on
             # Python floats, point by point — the vectorized form below costs ~0.3 ms of numpy
             # call overhead whatever the count, a point ~16 µs (measured, m = 2)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import ShapeError
+from .rowwise import matvec
 
 __all__ = ["LinearPolicy", "describe_policy"]
 
@@ -26,7 +27,9 @@ class LinearPolicy:
         self.name = name
 
     def __call__(self, x):
-        return -np.asarray(x, float) @ self.K.T
+        """``u = −K x`` at a state (n,) or each row of (..., n) (term by term: a row's floats
+        do not depend on the rows computed with it, :mod:`weakgrid.game.rowwise`)."""
+        return -matvec(self.K, x)
 
     def to_dict(self):
         return {"kind": "linear", "name": self.name, "K": self.K.tolist()}

@@ -50,7 +50,9 @@ class ControllerChoice:
     ----------
     name : str
     policy : callable or None
-        ``u = policy(x)`` for the design state x = [ϕ̂, υ] (None: UPQC idle).
+        ``u = policy(x)`` for the design state x = [ϕ̂, υ] (None: UPQC idle); a trained
+        controller is the :class:`~weakgrid.game.controller.GameController` itself (its call
+        is ``control``, its ``rows`` the batched form, :class:`weakgrid.study.law.StudyLaw`).
     info : dict
         Training record (weights, iterations, time) or parameters, for the report.
     """
@@ -113,7 +115,7 @@ def train_hji(study, design, progress=None):
 
 def _hji(ctx):
     ctl = ctx.trained if ctx.trained is not None else train_hji(ctx.study, ctx.design)[1]
-    return ControllerChoice(ctx.name, ctl.control, info={
+    return ControllerChoice(ctx.name, ctl, info={
         "weights": ctl.weights.tolist(), "iterations": ctl.iterations,
         "train_seconds": ctl.train_seconds})
 
@@ -129,7 +131,7 @@ def _hji_bounded(ctx):
     ctl = _BOUNDED.get(key)
     if ctl is None:   # every run of one operating point shares one training
         ctl = _BOUNDED[key] = design_problem(ctx.study, ctx.design).with_rating(ubar).train()
-    return ControllerChoice(ctx.name, ctl.control, info={
+    return ControllerChoice(ctx.name, ctl, info={
         "weights": ctl.weights.tolist(), "iterations": ctl.iterations,
         "train_seconds": ctl.train_seconds, "u_bound": ctl.cost.bound.to_dict()})
 
@@ -157,7 +159,7 @@ def _file(ctx):
     if not path:
         raise ParameterError(f"controllers.{ctx.name}.path", None, "give the controller file")
     ctl = load_controller(ctx.study.resolve(path))
-    return ControllerChoice(ctx.name, ctl.control, info={"file": str(path)})
+    return ControllerChoice(ctx.name, ctl, info={"file": str(path)})
 
 
 CONTROLLER_KINDS = {"hji": _hji, "hji-bounded": _hji_bounded, "nonlinear-29": _n29, "lqr": _lqr, "pq": _idle,

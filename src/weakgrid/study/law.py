@@ -12,9 +12,10 @@ content of the policy (:func:`policy_key`: a trained controller's weights, basis
 design model; a fixed law's parameters), never by a run's or a case's name — share one
 :meth:`StudyLaw.batch_key`, and the batch simulator evaluates them in one call
 (:meth:`StudyLaw.rows`: the state maps of all the rows in one array operation, the policy once
-on the stacked design states, each run's log appended). Each row equals the run's own call to
-rounding (the bounded saddle point's vectorized iteration,
-:meth:`weakgrid.game.input_bound.InputBound.minimize`, against its one-point form: ≤ 1e-12).
+on the stacked design states — its ``rows`` method if it has one — each run's log appended).
+Each row equals the run's own call bit for bit for the project's laws (a trained controller's
+:meth:`~weakgrid.game.controller.GameController.rows`, the linear and (29) laws: term-by-term
+arithmetic, :mod:`weakgrid.game.rowwise`): a closed loop would amplify a last-bit difference.
 """
 
 from __future__ import annotations
@@ -123,8 +124,8 @@ class StudyLaw:
             # one row: the run's own call (the same arithmetic as alone); a policy known only
             # by its identity (a function) is not assumed to take rows
             U = np.stack([np.asarray(pol(x), float).reshape(2) for x in X])
-        else:
-            U = np.asarray(pol(X), float).reshape(n, 2)
+        else:   # a policy's ``rows``: each row's floats those of its call on that row alone
+            U = np.asarray(getattr(pol, "rows", pol)(X), float).reshape(n, 2)
         for law, y, x in zip(laws, Y, X):
             law.ys.append(y.copy())
             law.xs.append(x.copy())
