@@ -79,12 +79,13 @@ class GameController:
         return self.basis(x) @ self.weights
 
     def gradient(self, x) -> np.ndarray:
-        """``∇J(x)``, shape (..., n)."""
-        return np.einsum("...ln,l->...n", self.basis.gradient(x), self.weights)
+        """``∇J(x)``, shape (..., n): the saddle point's
+        (:meth:`~weakgrid.game.bases.PolynomialBasis.weighted_derivatives`)."""
+        return self.basis.weighted_derivatives(x, self.weights)[0]
 
     def hessian(self, x) -> np.ndarray:
-        """``∇²J(x)``, shape (..., n, n)."""
-        return np.einsum("...lij,l->...ij", self.basis.hessian(x), self.weights)
+        """``∇²J(x)``, shape (..., n, n) (the saddle point's)."""
+        return self.basis.weighted_derivatives(x, self.weights)[1]
 
     # ------------------------------------------------------- saddle point
     def _terms(self, x):
