@@ -4,6 +4,7 @@ sweep appears in the report (a table of its runs; its maps when the study draws 
 from __future__ import annotations
 
 import copy
+import math
 import re
 
 import pandas as pd
@@ -56,3 +57,31 @@ def test_quick_run_announces_and_reports_its_sweep(tmp_path):
     peak = table.set_index(["upqc.rating", f"{EV}.duration"])["speed_peak_dev_pu"]
     assert peak[(0.1, 0.05)] > peak[(0.1, 0.02)]
     assert out["sweep"] is not None and len(out["sweep"]) == 4
+
+
+@pytest.mark.slow
+def test_maps_runs_fill_the_workers_while_the_scenario_runs_end(tmp_path):
+    """On a cluster, the maps' runs are submitted with the scenario runs (below them in
+    priority): a worker with no scenario run left goes on with the maps instead of idling
+    until the last scenario run ends (before, the maps started only then, after their
+    estimate's probe). Checked on Dask's task stream of 2 workers and one scenario run."""
+    from distributed import Client, LocalCluster, get_task_stream
+
+    st = tiny_case1({"scenarios": ["c1-high-conv"], "controllers": ["pss-only"], "t_end": 0.4,
+                     "axes": {"upqc.rating": [0.1, 0.2, 0.3, 0.4], f"{EV}.duration": [0.02]}})
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        with get_task_stream(client) as ts:
+            out = run_studies([st], tmp_path, log=lambda s: None, progress=False,
+                              scheduler=cluster.scheduler_address)
+    span = {}
+    for task in ts.data:
+        kind = "maps" if task["key"].startswith("weakgrid-run-") else "scenario"
+        for s in task["startstops"]:
+            if s["action"] == "compute":
+                lo, hi = span.get(kind, (math.inf, -math.inf))
+                span[kind] = (min(lo, s["start"]), max(hi, s["stop"]))
+    assert set(span) == {"maps", "scenario"}
+    assert span["maps"][0] < span["scenario"][1]     # a map run began before the scenario ended
+    assert len(out["sweep"]) == 4 and (out["sweep"]["status"] == "ok").all()
+    assert (tmp_path / "runs" / "c1-high-conv-pss-only.parquet").exists()

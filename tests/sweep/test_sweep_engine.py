@@ -223,3 +223,39 @@ def test_interrupted_sweep_resumes_without_rerunning(tmp_path, sig):
     table = pd.read_parquet(cache / "table.parquet")
     assert list(table["sq"]) == [i * i for i in range(16)]
     assert (table["status"] == "ok").all()
+
+
+def test_submitted_sweep_yields_to_the_callers_tasks_and_keeps_what_finished(tmp_path):
+    """``submit_sweep`` returns at once with the runs on the cluster at priorities below the
+    caller's own tasks (``weakgrid run``/``reproduce``: the scenario runs first, the maps'
+    runs filling the workers as they end); the runs finished before an interruption are kept
+    (``store_finished``), and the table is the one ``run_sweep`` gives."""
+    from distributed import wait
+
+    from weakgrid.sweep import ResultCache, open_client, submit_sweep
+
+    ratings = [0.3, 0.1, 0.5, 0.2]
+    pts = expand(BASE, {"upqc.rating": ratings})
+    serial = run_sweep(pts, stamped_run, cache_dir=tmp_path / "s", workers=0, progress=False)
+    said = []
+    with open_client(None, 1) as client:
+        first = client.submit(stamped_run, {}, pure=False, priority=0)   # the worker's first
+        pending = submit_sweep(pts, stamped_run, cache_dir=tmp_path / "c", client=client,
+                               progress=False, log=said.append,
+                               cost=lambda inp: inp["upqc"]["rating"])
+        mine = client.submit(stamped_run, {"x": 1}, pure=False, priority=0)
+        assert said == ["sweep: 4 runs, 0 already done, 4 to run on the cluster, beside other "
+                        "tasks"]
+        wait(pending.futures)
+        started = [first.result()["started"], mine.result()["started"]]
+        assert pending.store_finished() == 4         # kept without collect (an interrupt)
+        assert len(list(ResultCache(tmp_path / "c").folder.glob("*.json"))) == 4
+        table = pending.collect()
+    assert started[1] < table["started"].min()       # the caller's task before the sweep's
+    assert table.sort_values("started")["upqc.rating"].tolist() == sorted(ratings, reverse=True)
+    pd.testing.assert_frame_equal(_tab(table).drop(columns=["started", "cpu_busy"]),
+                                  _tab(serial).drop(columns=["started", "cpu_busy"]))
+    again = []
+    run_sweep(pts, stamped_run, cache_dir=tmp_path / "c", workers=0, progress=False,
+              log=again.append)
+    assert again[0] == "sweep: 4 runs, 4 already done, 0 to run"

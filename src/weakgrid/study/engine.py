@@ -39,7 +39,7 @@ from .controllers import controller_kind, controller_variant, train_hji
 from .figures import figure_specs, write_figures
 from .protocol import controller_name, protocol_of
 from .report import who_did_best, write_html, write_tables
-from ..sweep import open_client, run_sweep
+from ..sweep import open_client, run_sweep, submit_sweep
 from .runner import Run, RunRecord, check_engine, make_events, run_scenario, run_scenarios
 from .sweep import _axes, describe_sweep, run_point, sweep_points
 from .sweep_estimate import estimate_sweep, run_cost
@@ -238,6 +238,9 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
     The runs (and the sweeps of the studies that have a ``[sweep]`` table, drawn as maps
     when ``maps``) go to one Dask cluster: a local one with ``workers`` processes (default
     one per core), or the one at ``scheduler``; ``workers = 0`` runs everything serially here.
+    On a cluster the maps' runs are submitted with the scenario runs, at lower priorities
+    (:func:`weakgrid.sweep.submit_sweep`): a worker with no scenario run left goes on with the
+    maps while the last scenario runs end and this process draws their figures.
 
     weakgrid writes only into ``output`` and deletes there only files it wrote (its manifest,
     :class:`weakgrid.manifest.Manifest`): a file of another origin with the name of an output
@@ -352,6 +355,17 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
     n_tasks = len(todo) + sum(len(sweep_points(st, quick)) for st in swept)
     serial = workers == 0 or (scheduler is None and n_tasks <= 3)
     sweep_table = None
+    pts = [p for st in swept for p in sweep_points(st, quick)]
+    if swept:   # the shipped maps' sweep: its estimate is printed, never refused; its probe
+        # runs before the cluster starts (it times runs in this process, on idle cores)
+        log(estimate_sweep(None, out / "sweep-cache", quick, workers=0 if serial else
+                           workers, scheduler=scheduler, points=pts,
+                           batched=batched).line("maps"))
+    maps_kw = dict(cache_dir=out / "sweep-cache", progress=progress, log=log, cost=run_cost,
+                   desc="maps", batch=STUDY_BATCHES if batched else None,
+                   batch_size=batch_size_for(len(pts), 0 if serial else workers)
+                   if batched else None,
+                   balance=balance_for(0 if serial else workers) if batched else None)
     with contextlib.ExitStack() as stack:
         client = None if serial or not n_tasks else \
             stack.enter_context(open_client(scheduler, workers))
@@ -365,7 +379,8 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
 
         batches = _run_batches(todo, 0 if client is None else workers) if batched else \
             [[i] for i in range(len(todo))]
-        if client is not None and todo:
+        pending = None
+        if client is not None:
             from distributed import as_completed
 
             futs = {}
@@ -379,10 +394,19 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
                                     priority=prio) if batched \
                     else client.submit(_run_task, st, runs[0], tr, pure=False, priority=prio)
                 futs[fut] = rows
-            for fut in as_completed(list(futs)):
-                recs = fut.result()
-                for i, rec in zip(futs[fut], recs if batched else [recs]):
-                    keep(todo[i][1], todo[i][3], rec)
+            # the maps' runs are submitted too, after the scenario runs (priorities below
+            # theirs): a worker done with the scenario runs goes on with the maps while the
+            # last scenario runs end, the figures are drawn and the next study is read
+            pending = submit_sweep(pts, run_point, client=client, **maps_kw) if swept else None
+            try:
+                for fut in as_completed(list(futs)):
+                    recs = fut.result()
+                    for i, rec in zip(futs[fut], recs if batched else [recs]):
+                        keep(todo[i][1], todo[i][3], rec)
+            except BaseException:
+                if pending is not None:   # the maps' runs finished so far are kept
+                    pending.store_finished()
+                raise
         else:
             for rows in batches:
                 st, trained = todo[rows[0]][0], todo[rows[0]][2]
@@ -394,21 +418,14 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
         bar.close()
         if n_kept:
             log(f"kept {n_kept} finished result(s) of an earlier run with the same inputs")
-        if swept:
-            pts = [p for st in swept for p in sweep_points(st, quick)]
-            # the shipped maps' sweep: its estimate is printed, never refused
-            log(estimate_sweep(None, out / "sweep-cache", quick, workers=0 if serial else
-                               workers, scheduler=scheduler, points=pts,
-                               batched=batched).line("maps"))
-            sweep_table = run_sweep(pts, run_point, cache_dir=out / "sweep-cache",
-                                    workers=0 if serial else None, client=client,
-                                    progress=progress, log=log, cost=run_cost,
-                                    table_path=out / _sweep_file(quick),
-                                    desc="maps", batch=STUDY_BATCHES if batched else None,
-                                    batch_size=batch_size_for(len(pts), 0 if serial else
-                                                              workers) if batched else None,
-                                    balance=balance_for(0 if serial else workers)
-                                    if batched else None)
+        # the scenario runs' figures, drawn here while the maps' runs go on on the workers
+        figs = write_figures(records, out / "figures", fig_specs)
+        if pending is not None:
+            sweep_table = pending.collect(out / _sweep_file(quick))
+        elif swept:
+            sweep_table = run_sweep(pts, run_point, workers=0 if serial else None,
+                                    client=client, table_path=out / _sweep_file(quick),
+                                    **maps_kw)
     map_list, sweeps, uncertainty = [], [], {}
     for st in swept:
         sub = sweep_table[sweep_table["scenario"].isin(st.data["sweep"]["scenarios"])]
@@ -422,7 +439,6 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
         for k, u in metric_uncertainty(sub, _axes(st.data["sweep"], quick)).items():
             uncertainty[k] = max(uncertainty.get(k, 0.0), u)
     summaries = map_summaries(map_list)
-    figs = write_figures(records, out / "figures", fig_specs)
     run_title = title or ", ".join(st.data["study"].get("title", st.name) for st in studies)
     csv, md = write_tables(metrics, out, title=run_title)
     protocol = [p for st in studies for p in protocol_of(st, quick)

@@ -33,7 +33,8 @@ from .cache import ResultCache, run_key
 
 _log = logging.getLogger(__name__)
 
-__all__ = ["run_sweep", "execute", "execute_batch", "SweepInterrupted", "results_table",
+__all__ = ["run_sweep", "submit_sweep", "PendingSweep", "execute", "execute_batch",
+           "SweepInterrupted", "results_table",
            "open_client",
            "LOCAL_CLUSTER_CONFIG"]
 
@@ -342,63 +343,143 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
     if workers is not None and (not isinstance(workers, int) or workers < 0):
         raise ParameterError("workers", workers, "give a whole number ≥ 0 (0 = serial)")
     log = log or _log.info
-    cache = ResultCache(cache_dir)
-    keys = [run_key(p.inputs, run) for p in points]
-    if len(set(keys)) != len(keys):
-        dup = len(keys) - len(set(keys))
-        log(f"note: {dup} point(s) have the same input as another and run once")
-    records: dict[str, dict] = {}
-    for k in keys:
-        rec = cache.get(k)
-        if rec is not None:
-            records[k] = rec
-    todo = [(p, k) for p, k in zip(points, keys) if k not in records]
-    todo_unique = list({k: (p, k) for p, k in todo}.values())
+    cache, keys, records, todo = _plan(points, run, cache_dir, log)
     total = len(set(keys))
-    log(f"{desc}: {total} runs, {total - len(todo_unique)} already done, "
-        f"{len(todo_unique)} to run" + ("" if not todo_unique else
-                                         (" serially" if workers == 0 else
-                                          f" on {scheduler or 'a local cluster'}")))
-    bar = _progress(total, total - len(todo_unique), progress, desc)
-    tasks = _tasks(todo_unique, run, batch, batch_size, cost, balance)
+    log(f"{desc}: {total} runs, {total - len(todo)} already done, {len(todo)} to run"
+        + ("" if not todo else (" serially" if workers == 0 and client is None else
+                                f" on {scheduler or 'a local cluster'}")))
+    tasks = _tasks(todo, run, batch, batch_size, cost, balance)
+    if tasks and (workers != 0 or client is not None):
+        ctx = contextlib.nullcontext(client) if client is not None else \
+            open_client(scheduler, workers)
+        try:
+            with _sigterm_as_interrupt(), ctx as cl:
+                return _submit(cl, tasks, cost, points, keys, records, cache, desc, progress,
+                               log=log).collect(table_path)
+        except SweepInterrupted:
+            raise
+        except KeyboardInterrupt:   # before the runs were submitted (the cluster's start)
+            exc = SweepInterrupted(len(records), total, cache.folder)
+            log(str(exc))
+            raise exc from None
+    bar = _progress(total, total - len(todo), progress, desc)
     try:
         with _sigterm_as_interrupt():
-            if tasks and workers == 0 and client is None:
-                for fn, args, _ in tasks:
-                    for res in _results(fn(*args)):
-                        records[res["record"]["key"]] = _store(cache, res)
-                        bar.update(1)
-            elif tasks:
-                from distributed import as_completed
-
-                ctx = contextlib.nullcontext(client) if client is not None else \
-                    open_client(scheduler, workers)
-                with ctx as cl:
-                    # submitted costliest first, each with its priority (Dask starts a
-                    # task at once on an idle worker, and runs a queue by priority)
-                    prio = _priorities([(pts[0], keys_[0]) for _, _, (pts, keys_) in tasks],
-                                       cost, [pts for _, _, (pts, _) in tasks])
-                    futs = [cl.submit(fn, *args, key=f"weakgrid-run-{keys_[0]}"
-                                      + (f"-{len(keys_)}" if len(keys_) > 1 else ""),
-                                      pure=False, priority=pr)
-                            for pr, (fn, args, (_, keys_)) in sorted(zip(prio, tasks),
-                                                                     key=lambda x: -x[0])]
-                    try:
-                        for fut in as_completed(futs):
-                            for res in _results(fut.result()):
-                                records[res["record"]["key"]] = _store(cache, res)
-                                bar.update(1)
-                    finally:
-                        for f in futs:
-                            if not f.done():
-                                f.cancel()
+            for fn, args, _ in tasks:
+                for res in _results(fn(*args)):
+                    records[res["record"]["key"]] = _store(cache, res)
+                    bar.update(1)
     except KeyboardInterrupt:
         bar.close()
         exc = SweepInterrupted(len(records), total, cache.folder)
         log(str(exc))
         raise exc from None
     bar.close()
+    return _table(points, keys, records, table_path)
+
+
+def _plan(points, run, cache_dir, log):
+    """``(cache, keys, records, todo)``: the result cache, every point's key, the records
+    already cached and the ``(point, key)`` still to run (each key once)."""
+    cache = ResultCache(cache_dir)
+    keys = [run_key(p.inputs, run) for p in points]
+    if len(set(keys)) != len(keys):
+        log(f"note: {len(keys) - len(set(keys))} point(s) have the same input as another and "
+            "run once")
+    records = {k: rec for k in keys if (rec := cache.get(k)) is not None}
+    todo = list({k: (p, k) for p, k in zip(points, keys) if k not in records}.values())
+    return cache, keys, records, todo
+
+
+def _table(points, keys, records, table_path):
     table = results_table(points, [records[k] for k in keys])
     if table_path is not None:
         replace_atomic(table_path, lambda tmp: table.to_parquet(tmp, index=False))
     return table
+
+
+def submit_sweep(points, run, *, cache_dir, client, desc: str = "sweep", progress: bool = True,
+                 log=None, cost=None, batch=None, batch_size: int | None = None,
+                 balance: int | None = None) -> "PendingSweep":
+    """Submit the runs of a sweep to ``client``'s cluster and return at once: the
+    :class:`PendingSweep` collects them (:meth:`PendingSweep.collect`), so that the caller
+    can keep the workers busy with other tasks submitted beside it (``weakgrid run`` and
+    ``reproduce``: the maps' runs fill the workers as the scenario runs end). The arguments
+    are :func:`run_sweep`'s; the runs are submitted with Dask priorities below 0, so that
+    tasks the caller submits with priorities ≥ 0 start first."""
+    log = log or _log.info
+    cache, keys, records, todo = _plan(points, run, cache_dir, log)
+    total = len(set(keys))
+    log(f"{desc}: {total} runs, {total - len(todo)} already done, {len(todo)} to run"
+        + (" on the cluster, beside other tasks" if todo else ""))
+    tasks = _tasks(todo, run, batch, batch_size, cost, balance)
+    return _submit(client, tasks, cost, points, keys, records, cache, desc, progress,
+                   log=log, below=True)
+
+
+def _submit(cl, tasks, cost, points, keys, records, cache, desc, progress, log=None,
+            below=False):
+    """Submit ``tasks`` to the client ``cl``, costliest first, each with its priority (Dask
+    starts a task at once on an idle worker, and runs its queue by priority; ``below``:
+    priorities below 0)."""
+    prio = _priorities([(pts[0], keys_[0]) for _, _, (pts, keys_) in tasks],
+                       cost, [pts for _, _, (pts, _) in tasks])
+    shift = -(len(tasks) + 1) if below else 0
+    futs = [cl.submit(fn, *args, key=f"weakgrid-run-{keys_[0]}"
+                      + (f"-{len(keys_)}" if len(keys_) > 1 else ""),
+                      pure=False, priority=pr + shift)
+            for pr, (fn, args, (_, keys_)) in sorted(zip(prio, tasks), key=lambda x: -x[0])]
+    return PendingSweep(points, keys, records, cache, futs, desc, progress, log or _log.info)
+
+
+class PendingSweep:
+    """The runs of a sweep submitted to a cluster (:func:`submit_sweep`): the records
+    already cached and the futures of the others."""
+
+    def __init__(self, points, keys, records, cache, futures, desc, progress, log):
+        self.points, self.keys, self.records, self.cache = points, keys, records, cache
+        self.futures, self.desc, self.progress, self.log = futures, desc, progress, log
+
+    def store_finished(self) -> int:
+        """Store the runs already finished into the cache without waiting for the others
+        (a caller interrupted before :meth:`collect` loses no finished run); returns how
+        many were stored."""
+        n = 0
+        for fut in self.futures:
+            if fut.done() and fut.status == "finished":
+                for res in _results(fut.result()):
+                    if res["record"]["key"] not in self.records:
+                        self.records[res["record"]["key"]] = _store(self.cache, res)
+                        n += 1
+        return n
+
+    def cancel(self):
+        for f in self.futures:
+            if not f.done():
+                f.cancel()
+
+    def collect(self, table_path=None) -> pd.DataFrame:
+        """Wait for every run, store each in the cache as it arrives and return the
+        sweep's table (written to ``table_path`` as Parquet, atomically); raises
+        :class:`SweepInterrupted` on SIGINT/SIGTERM, after the finished runs are cached."""
+        from distributed import as_completed
+
+        total = len(set(self.keys))
+        bar = _progress(total, len(self.records), self.progress, self.desc)
+        try:
+            with _sigterm_as_interrupt():
+                try:
+                    for fut in as_completed(self.futures):
+                        for res in _results(fut.result()):
+                            if res["record"]["key"] not in self.records:
+                                self.records[res["record"]["key"]] = _store(self.cache, res)
+                                bar.update(1)
+                finally:
+                    self.cancel()
+        except KeyboardInterrupt:
+            bar.close()
+            exc = SweepInterrupted(len(self.records), total, self.cache.folder)
+            self.log(str(exc))
+            raise exc from None
+        bar.close()
+        return _table(self.points, self.keys, self.records, table_path)
