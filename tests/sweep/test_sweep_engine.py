@@ -226,36 +226,67 @@ def test_interrupted_sweep_resumes_without_rerunning(tmp_path, sig):
 
 
 def test_submitted_sweep_yields_to_the_callers_tasks_and_keeps_what_finished(tmp_path):
-    """``submit_sweep`` returns at once with the runs on the cluster at priorities below the
-    caller's own tasks (``weakgrid run``/``reproduce``: the scenario runs first, the maps'
-    runs filling the workers as they end); the runs finished before an interruption are kept
-    (``store_finished``), and the table is the one ``run_sweep`` gives."""
-    from distributed import wait
-
-    from weakgrid.sweep import ResultCache, open_client, submit_sweep
+    """``submit_sweep`` returns at once with the runs queued on the cluster's feed at
+    priorities below the caller's own tasks (``weakgrid run``/``reproduce``: the scenario
+    runs first, the maps' runs filling the workers as they end); the runs finished before an
+    interruption are kept (``store_finished``), and the table is the one ``run_sweep``
+    gives."""
+    from weakgrid.sweep import ResultCache, TaskFeed, open_client, submit_sweep
 
     ratings = [0.3, 0.1, 0.5, 0.2]
     pts = expand(BASE, {"upqc.rating": ratings})
     serial = run_sweep(pts, stamped_run, cache_dir=tmp_path / "s", workers=0, progress=False)
     said = []
     with open_client(None, 1) as client:
-        first = client.submit(stamped_run, {}, pure=False, priority=0)   # the worker's first
-        pending = submit_sweep(pts, stamped_run, cache_dir=tmp_path / "c", client=client,
+        feed = TaskFeed(client)
+        feed.add("mine", "first", stamped_run, {}, priority=0)     # the worker's first
+        pending = submit_sweep(pts, stamped_run, cache_dir=tmp_path / "c", feed=feed,
                                progress=False, log=said.append,
                                cost=lambda inp: inp["upqc"]["rating"])
-        mine = client.submit(stamped_run, {"x": 1}, pure=False, priority=0)
+        feed.add("mine", "mine", stamped_run, {"x": 1}, priority=0)
         assert said == ["sweep: 4 runs, 0 already done, 4 to run on the cluster, beside other "
                         "tasks"]
-        wait(pending.futures)
-        started = [first.result()["started"], mine.result()["started"]]
-        assert pending.store_finished() == 4         # kept without collect (an interrupt)
-        assert len(list(ResultCache(tmp_path / "c").folder.glob("*.json"))) == 4
+        mine = dict(feed.take("mine"))            # the sweep's first run starts after these
+        kept, t0 = 0, time.monotonic()
+        while kept == 0 and time.monotonic() - t0 < 30:
+            time.sleep(0.05)
+            kept = pending.store_finished()       # kept without collect (an interrupt)
+        assert kept == 1
+        assert len(list(ResultCache(tmp_path / "c").folder.glob("*.json"))) == 1
         table = pending.collect()
-    assert started[1] < table["started"].min()       # the caller's task before the sweep's
+    assert mine["mine"]["started"] < table["started"].min()   # the caller's task first
     assert table.sort_values("started")["upqc.rating"].tolist() == sorted(ratings, reverse=True)
+    assert len(list(ResultCache(tmp_path / "c").folder.glob("*.json"))) == 4
     pd.testing.assert_frame_equal(_tab(table).drop(columns=["started", "cpu_busy"]),
                                   _tab(serial).drop(columns=["started", "cpu_busy"]))
     again = []
     run_sweep(pts, stamped_run, cache_dir=tmp_path / "c", workers=0, progress=False,
               log=again.append)
     assert again[0] == "sweep: 4 runs, 4 already done, 0 to run"
+
+
+def slept(seconds):
+    """A task that sleeps ``seconds`` and says when it started."""
+    t = time.time()
+    time.sleep(seconds)
+    return t
+
+
+def test_free_workers_take_the_highest_priority_task_left(tmp_path):
+    """A cluster fed from the client (``TaskFeed``) starts its tasks in the order of their
+    priorities whatever their lengths: on 2 workers, a long first task and short others,
+    each short one starts before any of lower priority. Dask alone gives the first tasks
+    of a small group to a worker at submission, so a short task of high priority waited
+    there behind the long one while the other worker ran the rest."""
+    from weakgrid.sweep import TaskFeed, open_client
+
+    lengths = [1.5, 0.1, 0.1, 0.1, 0.1, 0.1]
+    with open_client(None, 2) as client:
+        client.run(lambda: None)
+        feed = TaskFeed(client)
+        for i, s in enumerate(lengths):
+            feed.add("g", i, slept, s, priority=len(lengths) - i, key=f"slept-{i}")
+        started = dict(feed.take("g"))
+    order = sorted(started, key=started.get)
+    assert order == list(range(len(lengths)))
+    assert started[5] < started[0] + 1.5          # the short ones ran beside the long one

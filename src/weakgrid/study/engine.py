@@ -39,7 +39,7 @@ from .controllers import controller_kind, controller_variant, train_hji
 from .figures import figure_specs, write_figures
 from .protocol import controller_name, protocol_of
 from .report import who_did_best, write_html, write_tables
-from ..sweep import open_client, run_sweep, submit_sweep
+from ..sweep import TaskFeed, open_client, run_sweep, submit_sweep
 from .runner import Run, RunRecord, check_engine, make_events, run_scenario, run_scenarios
 from .sweep import _axes, describe_sweep, run_point, sweep_points
 from .sweep_estimate import estimate_sweep, run_cost
@@ -238,9 +238,11 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
     The runs (and the sweeps of the studies that have a ``[sweep]`` table, drawn as maps
     when ``maps``) go to one Dask cluster: a local one with ``workers`` processes (default
     one per core), or the one at ``scheduler``; ``workers = 0`` runs everything serially here.
-    On a cluster the maps' runs are submitted with the scenario runs, at lower priorities
-    (:func:`weakgrid.sweep.submit_sweep`): a worker with no scenario run left goes on with the
-    maps while the last scenario runs end and this process draws their figures.
+    On a cluster the tasks are fed a free worker at a time, the highest priority first
+    (:class:`weakgrid.sweep.feed.TaskFeed`), and the maps' runs are queued with the scenario
+    runs, below them (:func:`weakgrid.sweep.submit_sweep`): a worker with no scenario run
+    left goes on with the maps while the last scenario runs end and this process draws their
+    figures.
 
     weakgrid writes only into ``output`` and deletes there only files it wrote (its manifest,
     :class:`weakgrid.manifest.Manifest`): a file of another origin with the name of an output
@@ -381,31 +383,27 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
             [[i] for i in range(len(todo))]
         pending = None
         if client is not None:
-            from distributed import as_completed
-
-            futs = {}
+            feed = TaskFeed(client)   # a task per free worker, the highest priority first
             for rank, rows in enumerate(batches):   # the costliest first, by priority
                 st = todo[rows[0]][0]
                 runs = [todo[i][1] for i in rows]
                 tr = {k: v for i in rows for k, v in todo[i][2].items()
                       if k in {r.design_key for r in runs}}
-                prio = len(batches) - rank
-                fut = client.submit(_run_batch_task, st, runs, tr, pure=False,
-                                    priority=prio) if batched \
-                    else client.submit(_run_task, st, runs[0], tr, pure=False, priority=prio)
-                futs[fut] = rows
-            # the maps' runs are submitted too, after the scenario runs (priorities below
+                task = (_run_batch_task, st, runs, tr) if batched else \
+                    (_run_task, st, runs[0], tr)
+                feed.add("runs", rows, *task, priority=len(batches) - rank)
+            # the maps' runs are queued too, after the scenario runs (priorities below
             # theirs): a worker done with the scenario runs goes on with the maps while the
-            # last scenario runs end, the figures are drawn and the next study is read
-            pending = submit_sweep(pts, run_point, client=client, **maps_kw) if swept else None
+            # last scenario runs end and their figures are drawn here
+            pending = submit_sweep(pts, run_point, feed=feed, **maps_kw) if swept else None
             try:
-                for fut in as_completed(list(futs)):
-                    recs = fut.result()
-                    for i, rec in zip(futs[fut], recs if batched else [recs]):
+                for rows, recs in feed.take("runs"):
+                    for i, rec in zip(rows, recs if batched else [recs]):
                         keep(todo[i][1], todo[i][3], rec)
             except BaseException:
                 if pending is not None:   # the maps' runs finished so far are kept
                     pending.store_finished()
+                feed.cancel()
                 raise
         else:
             for rows in batches:

@@ -7,16 +7,18 @@ by a hash of their full input and the code (:mod:`weakgrid.sweep.cache`).
 :func:`run_sweep` runs them on a local cluster (one worker process per core) or
 an existing one, with a progress bar, and returns one table, a row per run;
 :func:`submit_sweep` submits them to an open cluster beside the caller's own tasks and
-returns at once (its :class:`PendingSweep` collects the table).
+returns at once (its :class:`PendingSweep` collects the table); :class:`TaskFeed` feeds a
+cluster a task per free worker thread, the highest priority first.
 """
 
 from .axes import Axis, Point, expand, get_path, set_path
 from .cache import ResultCache, canonical_json, code_fingerprint, run_key
 from .batches import Batch, group, scatter
+from .feed import TaskFeed
 from .engine import (PendingSweep, SweepInterrupted, execute, execute_batch, open_client,
                      results_table, run_sweep, submit_sweep)
 
 __all__ = ["Axis", "Point", "expand", "get_path", "set_path", "ResultCache", "canonical_json",
            "code_fingerprint", "run_key", "SweepInterrupted", "execute", "execute_batch",
            "results_table", "Batch", "group", "scatter",
-           "run_sweep", "submit_sweep", "PendingSweep", "open_client"]
+           "run_sweep", "submit_sweep", "PendingSweep", "TaskFeed", "open_client"]

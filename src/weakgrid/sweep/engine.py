@@ -30,6 +30,7 @@ from .. import __version__
 from ..fileio import replace_atomic
 from ..game.errors import ParameterError, WeakgridError
 from .cache import ResultCache, run_key
+from .feed import TaskFeed
 
 _log = logging.getLogger(__name__)
 
@@ -354,8 +355,8 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
             open_client(scheduler, workers)
         try:
             with _sigterm_as_interrupt(), ctx as cl:
-                return _submit(cl, tasks, cost, points, keys, records, cache, desc, progress,
-                               log=log).collect(table_path)
+                return _submit(TaskFeed(cl), tasks, cost, points, keys, records, cache, desc,
+                               progress, log=log).collect(table_path)
         except SweepInterrupted:
             raise
         except KeyboardInterrupt:   # before the runs were submitted (the cluster's start)
@@ -398,84 +399,78 @@ def _table(points, keys, records, table_path):
     return table
 
 
-def submit_sweep(points, run, *, cache_dir, client, desc: str = "sweep", progress: bool = True,
+def submit_sweep(points, run, *, cache_dir, feed, desc: str = "sweep", progress: bool = True,
                  log=None, cost=None, batch=None, batch_size: int | None = None,
                  balance: int | None = None) -> "PendingSweep":
-    """Submit the runs of a sweep to ``client``'s cluster and return at once: the
-    :class:`PendingSweep` collects them (:meth:`PendingSweep.collect`), so that the caller
-    can keep the workers busy with other tasks submitted beside it (``weakgrid run`` and
-    ``reproduce``: the maps' runs fill the workers as the scenario runs end). The arguments
-    are :func:`run_sweep`'s; the runs are submitted with Dask priorities below 0, so that
-    tasks the caller submits with priorities ≥ 0 start first."""
+    """Queue the runs of a sweep on ``feed`` (a :class:`weakgrid.sweep.feed.TaskFeed` of the
+    caller's cluster) and return at once: the :class:`PendingSweep` collects them
+    (:meth:`PendingSweep.collect`), so that the caller can keep the workers busy with other
+    tasks beside it (``weakgrid run`` and ``reproduce``: the maps' runs fill the workers as
+    the scenario runs end). The other arguments are :func:`run_sweep`'s; the runs get
+    priorities below 0, so that tasks the caller queues with priorities ≥ 0 start first."""
     log = log or _log.info
     cache, keys, records, todo = _plan(points, run, cache_dir, log)
     total = len(set(keys))
     log(f"{desc}: {total} runs, {total - len(todo)} already done, {len(todo)} to run"
         + (" on the cluster, beside other tasks" if todo else ""))
     tasks = _tasks(todo, run, batch, batch_size, cost, balance)
-    return _submit(client, tasks, cost, points, keys, records, cache, desc, progress,
+    return _submit(feed, tasks, cost, points, keys, records, cache, desc, progress,
                    log=log, below=True)
 
 
-def _submit(cl, tasks, cost, points, keys, records, cache, desc, progress, log=None,
+def _submit(feed, tasks, cost, points, keys, records, cache, desc, progress, log=None,
             below=False):
-    """Submit ``tasks`` to the client ``cl``, costliest first, each with its priority (Dask
-    starts a task at once on an idle worker, and runs its queue by priority; ``below``:
-    priorities below 0)."""
+    """Queue ``tasks`` on ``feed``, each with its priority, the costliest highest
+    (``below``: priorities below 0)."""
     prio = _priorities([(pts[0], keys_[0]) for _, _, (pts, keys_) in tasks],
                        cost, [pts for _, _, (pts, _) in tasks])
     shift = -(len(tasks) + 1) if below else 0
-    futs = [cl.submit(fn, *args, key=f"weakgrid-run-{keys_[0]}"
-                      + (f"-{len(keys_)}" if len(keys_) > 1 else ""),
-                      pure=False, priority=pr + shift)
-            for pr, (fn, args, (_, keys_)) in sorted(zip(prio, tasks), key=lambda x: -x[0])]
-    return PendingSweep(points, keys, records, cache, futs, desc, progress, log or _log.info)
+    group = object()          # this sweep's tasks on the feed
+    for pr, (fn, args, (_, keys_)) in sorted(zip(prio, tasks), key=lambda x: -x[0]):
+        feed.add(group, None, fn, *args, priority=pr + shift,
+                 key=f"weakgrid-run-{keys_[0]}" + (f"-{len(keys_)}" if len(keys_) > 1 else ""))
+    return PendingSweep(points, keys, records, cache, feed, group, desc, progress,
+                        log or _log.info)
 
 
 class PendingSweep:
-    """The runs of a sweep submitted to a cluster (:func:`submit_sweep`): the records
-    already cached and the futures of the others."""
+    """The runs of a sweep queued on a cluster's :class:`~weakgrid.sweep.feed.TaskFeed`
+    (:func:`submit_sweep`): the records already cached, and the feed's group of the others."""
 
-    def __init__(self, points, keys, records, cache, futures, desc, progress, log):
+    def __init__(self, points, keys, records, cache, feed, group, desc, progress, log):
         self.points, self.keys, self.records, self.cache = points, keys, records, cache
-        self.futures, self.desc, self.progress, self.log = futures, desc, progress, log
+        self.feed, self.group, self.desc, self.progress, self.log = feed, group, desc, \
+            progress, log
+
+    def _keep(self, res) -> bool:
+        key = res["record"]["key"]
+        if key in self.records:
+            return False
+        self.records[key] = _store(self.cache, res)
+        return True
 
     def store_finished(self) -> int:
         """Store the runs already finished into the cache without waiting for the others
         (a caller interrupted before :meth:`collect` loses no finished run); returns how
         many were stored."""
-        n = 0
-        for fut in self.futures:
-            if fut.done() and fut.status == "finished":
-                for res in _results(fut.result()):
-                    if res["record"]["key"] not in self.records:
-                        self.records[res["record"]["key"]] = _store(self.cache, res)
-                        n += 1
-        return n
-
-    def cancel(self):
-        for f in self.futures:
-            if not f.done():
-                f.cancel()
+        return sum(self._keep(res) for _, out in self.feed.ended(self.group)
+                   for res in _results(out))
 
     def collect(self, table_path=None) -> pd.DataFrame:
         """Wait for every run, store each in the cache as it arrives and return the
         sweep's table (written to ``table_path`` as Parquet, atomically); raises
         :class:`SweepInterrupted` on SIGINT/SIGTERM, after the finished runs are cached."""
-        from distributed import as_completed
-
         total = len(set(self.keys))
         bar = _progress(total, len(self.records), self.progress, self.desc)
         try:
             with _sigterm_as_interrupt():
                 try:
-                    for fut in as_completed(self.futures):
-                        for res in _results(fut.result()):
-                            if res["record"]["key"] not in self.records:
-                                self.records[res["record"]["key"]] = _store(self.cache, res)
-                                bar.update(1)
-                finally:
-                    self.cancel()
+                    for _, out in self.feed.take(self.group):
+                        bar.update(sum(self._keep(res) for res in _results(out)))
+                except BaseException:
+                    self.store_finished()
+                    self.feed.cancel()
+                    raise
         except KeyboardInterrupt:
             bar.close()
             exc = SweepInterrupted(len(self.records), total, self.cache.folder)
