@@ -290,3 +290,17 @@ def test_free_workers_take_the_highest_priority_task_left(tmp_path):
     order = sorted(started, key=started.get)
     assert order == list(range(len(lengths)))
     assert started[5] < started[0] + 1.5          # the short ones ran beside the long one
+
+
+def test_sweep_on_a_client_that_is_not_the_default(tmp_path):
+    """A sweep runs on the client it is given, also when that client is not Dask's default
+    one (the feed waits on the given client's event loop)."""
+    from distributed import Client, LocalCluster
+
+    pts = expand(BASE, {"upqc.rating": [0.1, 0.2]})
+    serial = run_sweep(pts, toy_run, cache_dir=tmp_path / "s", workers=0, progress=False)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, \
+            Client(cluster, set_as_default=False) as client:
+        t = run_sweep(pts, toy_run, cache_dir=tmp_path / "c", client=client, progress=False)
+    pd.testing.assert_frame_equal(_tab(t), _tab(serial))

@@ -46,7 +46,7 @@ class TaskFeed:
         self._running = {}                   # future -> (group, tag)
         self._ended = defaultdict(deque)     # group -> (tag, future) ended, not yet taken
         self._left = defaultdict(int)        # group -> tasks queued or running
-        self._completed = as_completed()
+        self._completed = as_completed(loop=client.loop)   # (not the default client's)
 
     def slots(self) -> int:
         if self._slots is not None:
