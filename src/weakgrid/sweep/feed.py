@@ -49,6 +49,7 @@ class TaskFeed:
         self._completed = as_completed(loop=client.loop)   # (not the default client's)
 
     def slots(self) -> int:
+        """Tasks the feed keeps on the cluster at once (see ``slots`` above)."""
         if self._slots is not None:
             return max(1, int(self._slots))
         return max(1, sum(self.client.nthreads().values()))
