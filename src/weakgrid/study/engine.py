@@ -354,10 +354,10 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
             records[run.id] = rec
             n_kept += 1
             bar.update(1)
-    n_tasks = len(todo) + sum(len(sweep_points(st, quick)) for st in swept)
+    pts = [p for st in swept for p in sweep_points(st, quick)]
+    n_tasks = len(todo) + len(pts)
     serial = workers == 0 or (scheduler is None and n_tasks <= 3)
     sweep_table = None
-    pts = [p for st in swept for p in sweep_points(st, quick)]
     if swept:   # the shipped maps' sweep: its estimate is printed, never refused; its probe
         # runs before the cluster starts (it times runs in this process, on idle cores)
         log(estimate_sweep(None, out / "sweep-cache", quick, workers=0 if serial else
