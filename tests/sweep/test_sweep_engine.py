@@ -283,7 +283,7 @@ def test_free_workers_take_the_highest_priority_task_left(tmp_path):
 
     lengths = [1.5, 0.1, 0.1, 0.1, 0.1, 0.1]
     with open_client(None, 2) as client:
-        client.run(lambda: None)
+        client.run(slept, 0.0)      # each worker has the function before the timed tasks
         feed = TaskFeed(client)
         for i, s in enumerate(lengths):
             feed.add("g", i, slept, s, priority=len(lengths) - i, key=f"slept-{i}")
