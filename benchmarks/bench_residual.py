@@ -8,6 +8,10 @@ median of 5 rounds of 1000 calls after 200 warm-up calls, and each device's shar
 number of NumPy calls of its devices, nearly independent of ``B``; compare two versions of the
 code by running this file with each on ``PYTHONPATH``, back to back.
 
+Beside each grid's batches, the same grid's residual for one point as a run alone evaluates it
+(``alone``: ``System.residual`` on the ``(N,)`` vector), per call and by device: what the batch
+axis adds to each NumPy operation.
+
 The device kernels (:mod:`weakgrid.sim.kernels`) are timed both ways in the same run, rounds
 alternated: on NumPy (``WEAKGRID_KERNELS=numpy``) and compiled (numba, when installed).
 
@@ -50,6 +54,46 @@ def _device_times(bs, Z, rows, calls):
     return {k: 1e6 * v / calls for k, v in sorted(spent.items(), key=lambda kv: -kv[1])}
 
 
+class _Alone:
+    """A one-point system in the shape :func:`_device_times` times (``tmpl``, ``residual``)."""
+
+    def __init__(self, system, z):
+        self.tmpl, self._z = system, z
+
+    def residual(self, t, Z, rows):
+        return self.tmpl.residual(t, self._z)
+
+
+def alone(grid, modes, rounds, calls):
+    """The same grid's residual for one point, as a run alone evaluates it
+    (:meth:`weakgrid.sim.system.System.residual` on the ``(N,)`` vector): the reference of the
+    batched residual's cost, per call and by device."""
+    from sim_cases import build_gti_upqc_sg
+
+    from weakgrid.sim.integrate import Simulator
+
+    system = build_gti_upqc_sg(grid)
+    z = Simulator(system, dt=5e-3, tol=1e-6).z.copy()
+    per = {m: [] for m in modes}
+    for m in modes:
+        os.environ["WEAKGRID_KERNELS"] = m
+        for _ in range(200):
+            system.residual(0.0, z)
+    for _ in range(rounds):
+        for m in modes:
+            os.environ["WEAKGRID_KERNELS"] = m
+            c0 = time.process_time()
+            for _ in range(calls):
+                system.residual(0.0, z)
+            per[m].append((time.process_time() - c0) / calls)
+    print(f"{grid:12s} alone: residual µs CPU per call "
+          + ", ".join(f"{m} {1e6 * statistics.median(v):.0f}" for m, v in per.items()))
+    for m in modes:
+        os.environ["WEAKGRID_KERNELS"] = m
+        dev = _device_times(_Alone(system, z), None, None, calls)
+        print(f"    {m:5s} by device [µs]: " + ", ".join(f"{k} {v:.0f}" for k, v in dev.items()))
+
+
 def main(sizes=(6, 50), rounds=5, calls=1000):
     from bench_sim import _fault_scenarios
     from sim_cases import build_gti_upqc_sg
@@ -59,6 +103,7 @@ def main(sizes=(6, 50), rounds=5, calls=1000):
 
     modes = ["numpy"] + (["numba"] if kernels.compiled_available() else [])
     for grid in ("conventional", "reduced"):
+        alone(grid, modes, rounds, calls)
         for B in sizes:
             sc = [s for g, s in _fault_scenarios(2 * B) if g == grid][:B]
             bs = BatchSimulator(build_gti_upqc_sg(grid), sc, dt=5e-3, tol=1e-6)

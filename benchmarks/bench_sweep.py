@@ -68,7 +68,7 @@ ratios themselves are noisy: 0.75x-1.72x), the engine before (``--dask-defaults`
 
 Run:  PYTHONPATH=src python benchmarks/bench_sweep.py [n_ratings] [--dask-defaults]
       PYTHONPATH=src python benchmarks/bench_sweep.py --study [--repeats N] [--workers W]
-          [--only sweep|reproduce|breakdown]
+          [--only sweep|reproduce|breakdown|scaling]
 
 ``--study``: the commands users wait for, batched against the scalar path (issue #21), each
 pair measured in one run of this script, a fresh output folder and cache each time, each in a
@@ -79,7 +79,8 @@ alternated between repeats, medians of ``--repeats`` (default 1):
   workers (default 2; 0 = serially in this process);
 * ``weakgrid reproduce --quick`` (its runs, trainings, figures, report and the maps' sweeps);
 * ``--only breakdown``: where a batch's time goes, in this process (prepare, simulate one by
-  one and together, finish; the batched step's parts).
+  one and together, finish; the batched step's parts);
+* ``--only scaling``: how a map batch's cost grows with its size (:func:`batch_scaling`).
 
 The scalar path is one task per run (:func:`weakgrid.sweep.execute`); the batched path groups
 a sweep's runs by grid (:func:`weakgrid.study.batches.batch_key`) and hands each batch to
@@ -441,6 +442,80 @@ def batch_breakdown(repeats=3):
         f"{k} {v / repeats:.2f} s ({100 * v / tot:.0f} %)" for k, v in tim.items()))
 
 
+def batch_scaling(sizes=(6, 15, 30), repeats=1, n_alone=6):
+    """How a map batch's cost grows with its size, in this process: the first ``B`` runs of
+    one batch of the full case-1 sweep (one fault clearing time, 2-s runs at the controller's
+    period T; ratings, loads and the three controllers mixed as the sweep mixes them),
+    simulated together for each ``B`` (and the first ``n_alone`` one by one: the cost of a run
+    alone is their mean), after one warm-up batch
+    (trainings and design models built). Per batched step: the wall time, the time per
+    member, the timed parts (:attr:`weakgrid.sim.batch.BatchSimulator.timing`; ``events``
+    holds the controllers' samples, ``other`` is the rest: the members' bookkeeping between
+    the parts), and the residual evaluations per step, split into those of every member
+    still iterating and those of a few stragglers (at most a fifth of the batch): a
+    residual's cost hardly depends on how many members it evaluates. Medians of
+    ``repeats``."""
+    import collections
+
+    from weakgrid.sim import batch as batch_mod
+    from weakgrid.study.batches import batch_key, simulate_many
+
+    groups = collections.defaultdict(list)
+    for p in sweep_points(load_study("case1-weak-grid"), quick=False):
+        groups[batch_key(p.inputs)].append(p.inputs)
+    key = max(groups, key=lambda k: (k[4] == 1.0, len(groups[k])))
+    runs = groups[key]
+    seen = []
+    calls = collections.Counter()
+    run0, res0 = batch_mod.BatchSimulator.run, batch_mod.BatchSimulator.residual
+
+    def run(self, t_end):
+        t0 = time.perf_counter()
+        try:
+            return run0(self, t_end)
+        finally:
+            seen.append((self.B, self.steps, time.perf_counter() - t0, dict(self.timing)))
+
+    def residual(self, t, Z, rows):
+        calls["all" if 5 * len(rows) > self.B else "few"] += 1
+        return res0(self, t, Z, rows)
+
+    batch_mod.BatchSimulator.run, batch_mod.BatchSimulator.residual = run, residual
+    try:
+        simulate_many(runs[:2])                    # warm-up: trainings, design models
+        singles = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            for r in runs[:n_alone]:
+                simulate_many([r])
+            singles.append((time.perf_counter() - t0) / n_alone)
+        alone = statistics.median(singles)
+        ctl = collections.Counter(r["controller"] for r in runs[:n_alone])
+        print(f"== one map batch of the case-1 sweep ({len(runs)} runs, clearing at "
+              f"{key[5][-1]} s), the first B runs together, in this process ==")
+        print(f"a run alone: {alone:.2f} s (the mean of the first {n_alone}: "
+              + ", ".join(f"{n} {c}" for c, n in ctl.items()) + ")")
+        for B in sizes:
+            rows = []
+            for _ in range(repeats):
+                seen.clear()
+                calls.clear()
+                simulate_many(runs[:B])
+                (b, steps, wall, tim), = seen
+                rows.append((wall, steps, tim, dict(calls)))
+            wall, steps, tim, cnt = sorted(rows, key=lambda r: r[0])[len(rows) // 2]
+            ms = {k: 1e3 * v / steps for k, v in tim.items()}
+            ms["other"] = 1e3 * wall / steps - sum(ms.values())
+            print(f"B = {B:3d}: {wall:6.2f} s, {steps} steps: {1e3 * wall / steps:.2f} ms per "
+                  f"step, {1e3 * wall / steps / B:.3f} ms per member-step "
+                  f"({alone / (wall / B):.1f}x less than alone); per step: "
+                  + ", ".join(f"{k} {v:.2f}" for k, v in ms.items())
+                  + f" ms; residuals per step: {cnt.get('all', 0) / steps:.2f} of the members "
+                  f"iterating, {cnt.get('few', 0) / steps:.2f} of at most a fifth")
+    finally:
+        batch_mod.BatchSimulator.run, batch_mod.BatchSimulator.residual = run0, res0
+
+
 def _option(name, default):
     if name in sys.argv:
         return int(sys.argv[sys.argv.index(name) + 1])
@@ -452,6 +527,8 @@ if __name__ == "__main__":
         only = sys.argv[sys.argv.index("--only") + 1] if "--only" in sys.argv else None
         if only == "breakdown":
             batch_breakdown(_option("--repeats", 3))
+        elif only == "scaling":
+            batch_scaling(repeats=_option("--repeats", 1))
         else:
             study_commands(_option("--repeats", 1), _option("--workers", 2), only)
         sys.exit(0)
