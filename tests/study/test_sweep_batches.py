@@ -115,6 +115,31 @@ def test_a_batched_study_sweep_gives_the_scalar_table(tmp_path):
     pd.testing.assert_frame_equal(scalar.drop(columns=TIMES), batched.drop(columns=TIMES))
 
 
+def test_bounded_laws_of_two_ratings_share_a_call_and_give_the_scalar_table(tmp_path,
+                                                                            monkeypatch):
+    """The rating-bounded controllers trained at two ratings differ only in their weights and
+    bound (one family): the batch samples their members in one call of ``rows_of``, each row
+    with its own controller, and the table equals the one-by-one sweep's to the last bit."""
+    from weakgrid.game.controller import GameController
+
+    st = _two_ratings_two_loads(["hji-bounded"])
+    scalar = run_study_sweep(st, tmp_path / "scalar", quick=True, workers=0, progress=False,
+                             batched=False)
+    calls = []
+    real = GameController.rows_of
+
+    def counting(controllers, x):
+        calls.append(sorted({c.cost.bound.limit[0] for c in controllers}))
+        return real(controllers, x)
+
+    monkeypatch.setattr(GameController, "rows_of", staticmethod(counting))
+    batched = run_study_sweep(st, tmp_path / "batched", quick=True, workers=0, progress=False,
+                              batched=True)
+    assert len(scalar) == 4
+    assert calls and all(bounds == [0.15, 0.6] for bounds in calls)
+    pd.testing.assert_frame_equal(scalar.drop(columns=TIMES), batched.drop(columns=TIMES))
+
+
 def _failing_sweep():
     """Case 1, two controllers (the PQ baseline takes the UPQC out: another grid), points
     that run, one whose fault has no network solution (Newton) and one whose grid collapses

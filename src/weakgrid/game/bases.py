@@ -182,12 +182,19 @@ class PolynomialBasis:
     def weighted_derivatives(self, x, weights):
         """``∇J`` (..., n) and ``∇²J`` (..., n, n) of ``J = weights'σ`` at states ``x``
         (..., n), the sum over the monomials term by term (:mod:`weakgrid.game.rowwise`):
-        a state's floats do not depend on the states evaluated with it."""
+        a state's floats do not depend on the states evaluated with it. ``weights``: (L,), or
+        (..., L) with a row of weights per state (the same floats as each row's own call)."""
         x2, batch = self._check_x(x)
         n = self.n_states
         w = np.asarray(weights, float)
         mono = self.planes(x2.T, 2)[1:]     # (K − 1, L, p): first, then second derivatives
-        acc = sum_in_order(mono * w[:, None], 1)
+        if w.ndim > 1:                      # a row of weights per state: (L, p)
+            if w.shape[:-1] != tuple(batch) or w.shape[-1] != mono.shape[1]:
+                raise ShapeError("weights", w.shape, f"({mono.shape[1]},) or "
+                                 f"{tuple(batch) + (mono.shape[1],)}")
+            acc = sum_in_order(mono * w.reshape(-1, w.shape[-1]).T, 1)
+        else:
+            acc = sum_in_order(mono * w[:, None], 1)
         grad = acc[:n].T.reshape(*batch, n)
         hess = acc[self._hessian_planes - 1].transpose(2, 0, 1).reshape(*batch, n, n)
         return grad, hess

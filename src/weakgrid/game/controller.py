@@ -25,9 +25,11 @@ import numpy as np
 from .bases import PolynomialBasis
 from .cost import GameCost
 from .errors import ParameterError, ShapeError
+from .input_bound import minimize_points
 from .rowwise import matmul, matvec, vecmat
 from .system import ControlAffineSystem, system_from_dict
 from ..fileio import write_json_atomic
+from ..hashing import checksum
 
 __all__ = ["GameController", "load_controller", "FILE_FORMAT"]
 
@@ -88,9 +90,10 @@ class GameController:
         return self.basis.weighted_derivatives(x, self.weights)[1]
 
     # ------------------------------------------------------- saddle point
-    def _terms(self, x):
+    def _terms(self, x, weights=None):
         x = self.system.check_states(x)
-        gJ, HJ = self.basis.weighted_derivatives(x, self.weights)   # ∇J, ∇²J
+        w = self.weights if weights is None else weights
+        gJ, HJ = self.basis.weighted_derivatives(x, w)   # ∇J, ∇²J
         f = self.system.open_loop_dynamics(x)
         g = np.asarray(self.system.control_directions(x), float)
         h = np.asarray(self.system.disturbance_directions(x), float)
@@ -105,7 +108,14 @@ class GameController:
         whatever the count (:meth:`~weakgrid.game.input_bound.InputBound.minimize`'s
         ``pointwise``; with at most 2 inputs).
         """
-        x, f, g, h, gJ, HJ = self._terms(x)
+        return self._saddle_point(x, None, None, rowwise)
+
+    def _saddle_point(self, x, weights, bounds, rowwise):
+        """:meth:`saddle_point` with the weights ``weights`` (``(..., L)``, a row each; None:
+        this controller's) and the input bounds ``bounds`` (one per row; None: this
+        controller's) — each row's floats those of the controller with that row's weights and
+        bound (:meth:`rows_of`)."""
+        x, f, g, h, gJ, HJ = self._terms(x, weights)
         m, q = g.shape[-1], h.shape[-1]
         B = np.concatenate([g, h], axis=-1)  # (..., n, m+q)
         M = matmul(np.swapaxes(B, -1, -2), matmul(HJ, B))    # B'∇²J B
@@ -114,12 +124,12 @@ class GameController:
         reg[m:, m:] = -2 * self.cost.gamma**2 * self.cost.P
         rhs = vecmat(gJ + matvec(HJ, f - x), B)               # B'[∇J + ∇²J(f − x)]
         if self.cost.bound is not None:
-            return self._bounded_saddle_point(M, rhs, m, rowwise)
+            return self._bounded_saddle_point(M, rhs, m, rowwise, bounds)
         M = M + reg
         z = -np.linalg.solve(M, rhs[..., None])[..., 0]
         return z[..., :m], z[..., m:]
 
-    def _bounded_saddle_point(self, M, rhs, m, rowwise=False):
+    def _bounded_saddle_point(self, M, rhs, m, rowwise=False, bounds=None):
         """``u* = argmin_{bound} max_w`` of (22) with ``W(u)``; ``M = B'∇²J B``, ``rhs = B'r``."""
         c = self.cost
         Yw = M[..., m:, m:] - 2 * c.gamma**2 * c.P
@@ -128,8 +138,11 @@ class GameController:
         Xg, Xr = Xs[..., :m], Xs[..., m]
         Meff = M[..., :m, :m] - matmul(M[..., :m, m:], Xg)
         beff = rhs[..., :m] - matvec(M[..., :m, m:], Xr)
-        u = c.bound.minimize(0.5 * (Meff + np.swapaxes(Meff, -1, -2)), beff, c.R,
-                             pointwise=True if rowwise else None)
+        Msym = 0.5 * (Meff + np.swapaxes(Meff, -1, -2))
+        if bounds is None:
+            u = c.bound.minimize(Msym, beff, c.R, pointwise=True if rowwise else None)
+        else:       # a bound per row (rows_of), point by point as rowwise
+            u = minimize_points(bounds, Msym, beff, c.R)
         w = -(Xr + matvec(Xg, u))
         return u, w
 
@@ -173,6 +186,51 @@ class GameController:
         that row alone, however many rows (what a batched simulation calls for the members
         that share this law; ``saddle_point(x, rowwise=True)``)."""
         return self.saddle_point(x, rowwise=True)[0]
+
+    def family_key(self) -> str:
+        """Controllers with equal keys differ at most in their weights and in the limits and
+        shape of their input bound (the same design model, basis, Q, R, P, γ, and a bound or
+        none): :meth:`rows_of` evaluates them in one call. The SHA-256 of their canonical
+        description (a design model that cannot be written to a file: its identity).
+        Computed once (what it reads is not changed after training)."""
+        got = self.__dict__.get("_family_key")
+        if got is not None and got[0] is self.system and got[1] is self.cost:
+            return got[2]
+        try:
+            system = self.system.to_dict()
+        except NotImplementedError:
+            system = f"object:{id(self.system)}"
+        key = checksum({"class": f"{type(self).__module__}.{type(self).__qualname__}",
+                        "system": [type(self.system).__qualname__, system],
+                        "basis": self.basis.to_dict(),
+                        "cost": self.cost.with_bound(None).to_dict(),
+                        "bounded": self.cost.bound is not None})
+        self.__dict__["_family_key"] = (self.system, self.cost, key)
+        return key
+
+    @staticmethod
+    def rows_of(controllers, x) -> np.ndarray:
+        """``controllers[i].rows(x[i])`` for every row of ``x`` (n, n_states) in one call:
+        the controllers share :meth:`family_key` (they differ at most in their weights and
+        input bounds, e.g. one trained at each UPQC rating), and row ``i``'s floats are those
+        of ``controllers[i]`` on that row alone (its weights and bound, rowwise
+        arithmetic). Returns ``u*`` (n, m)."""
+        ctls = list(controllers)
+        x = np.asarray(x, float)
+        if x.ndim != 2 or x.shape[0] != len(ctls) or not ctls:
+            raise ShapeError("x", x.shape, f"({len(ctls)}, n_states): a row per controller")
+        first = ctls[0]
+        key = first.family_key()
+        for i, c in enumerate(ctls[1:], 1):
+            if c is not first and c.family_key() != key:
+                raise ParameterError(f"controllers[{i}]", type(c).__name__,
+                                     "differs from controllers[0] in more than its weights and "
+                                     "input bound: evaluate it with its own rows()")
+        if all(c is first for c in ctls):
+            return first.rows(x)
+        W = np.stack([c.weights for c in ctls])
+        bounds = [c.cost.bound for c in ctls] if first.cost.bound is not None else None
+        return first._saddle_point(x, W, bounds, True)[0]
 
     def hamiltonian(self, x, u, w) -> np.ndarray:
         """The approximate Hamiltonian (22) ``∇J'Δx + ½Δx'∇²JΔx + Q(x) + u'Ru − γ²w'Pw``."""

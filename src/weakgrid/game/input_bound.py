@@ -38,9 +38,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ParameterError
+from .errors import ParameterError, ShapeError
 
-__all__ = ["SHAPES", "InputBound"]
+__all__ = ["SHAPES", "InputBound", "minimize_points"]
 
 SHAPES = ("box", "disk")
 _SMALL = 0.1  # below this ρ the series are used (10 terms reach rounding)
@@ -320,10 +320,7 @@ class InputBound:
             # a few points (a controller sample, a small batch's rows): the same iteration on
             # Python floats, point by point — the vectorized form below costs ~0.3 ms of numpy
             # call overhead whatever the count, a point ~16 µs (measured, m = 2)
-            Ms = np.broadcast_to(M, shape + (m, m)).reshape(-1, m, m).tolist()
-            twoR = [2.0 * r for r in np.diag(R).tolist()]
-            out = [_minimize_point(self, Mk, bk, twoR, max_iter, return_info)
-                   for Mk, bk in zip(Ms, b.reshape(-1, m).tolist())]
+            out = _minimize_points([self] * n_pts, M, b, R, max_iter, return_info)
             u = np.asarray([o[0] for o in out], float).reshape(shape + (m,))
             if not return_info:
                 return u
@@ -500,6 +497,46 @@ def _pt_mm(A, S):
 
 def _pt_absmax(v):
     return max(abs(v[0]), abs(v[1])) if len(v) == 2 else abs(v[0])
+
+
+def minimize_points(bounds, M, b, R, max_iter: int = 100) -> np.ndarray:
+    """:meth:`InputBound.minimize` point by point with a bound of its own at each point:
+    ``u[i] = argmin ½u'M[i]u + b[i]'u + W_i(u)`` over ``bounds[i]`` (at most 2 inputs), each
+    point's floats those of ``bounds[i].minimize(M[i], b[i], R, pointwise=True)`` (what the
+    rows of controllers that differ only in their bound need:
+    :meth:`weakgrid.game.controller.GameController.rows_of`).
+
+    Parameters
+    ----------
+    bounds : sequence of InputBound
+        One per point.
+    M : (p, m, m)
+    b : (p, m)
+    R : (m, m)
+
+    Returns
+    -------
+    u : (p, m)
+    """
+    M = np.asarray(M, float)
+    b = np.asarray(b, float)
+    if b.ndim != 2 or b.shape[-1] > 2 or M.shape != b.shape + (b.shape[-1],) \
+            or len(bounds) != b.shape[0]:
+        raise ShapeError("M, b, bounds", (M.shape, b.shape, len(bounds)),
+                         "(p, m, m), (p, m) and p bounds, m <= 2")
+    out = _minimize_points(bounds, M, b, np.asarray(R, float), max_iter, False)
+    return np.asarray([o[0] for o in out], float).reshape(b.shape)
+
+
+def _minimize_points(bounds, M, b, R, max_iter, return_info):
+    """:func:`_minimize_point` at each point ``i`` with ``bounds[i]`` (``M`` broadcast to the
+    points of ``b``); a list of ``(u, info)``."""
+    m = b.shape[-1]
+    shape = b.shape[:-1]
+    Ms = np.broadcast_to(M, shape + (m, m)).reshape(-1, m, m).tolist()
+    twoR = [2.0 * r for r in np.diag(R).tolist()]
+    return [_minimize_point(bd, Mk, bk, twoR, max_iter, return_info)
+            for bd, Mk, bk in zip(bounds, Ms, b.reshape(-1, m).tolist())]
 
 
 def _minimize_point(bd, M, b, twoR, max_iter, return_info=True):

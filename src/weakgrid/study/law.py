@@ -13,6 +13,9 @@ design model; a fixed law's parameters), never by a run's or a case's name — s
 :meth:`StudyLaw.batch_key`, and the batch simulator evaluates them in one call
 (:meth:`StudyLaw.rows`: the state maps of all the rows in one array operation, the policy once
 on the stacked design states — its ``rows`` method if it has one — each run's log appended).
+Trained controllers that differ only in their weights and input bounds (one per UPQC rating in
+a sweep: :meth:`~weakgrid.game.controller.GameController.family_key`) share a call too, each row
+computed with its own (:meth:`~weakgrid.game.controller.GameController.rows_of`).
 Each row equals the run's own call bit for bit for the project's laws (a trained controller's
 :meth:`~weakgrid.game.controller.GameController.rows`, the linear and (29) laws: term-by-term
 arithmetic, :mod:`weakgrid.game.rowwise`): a closed loop would amplify a last-bit difference.
@@ -88,6 +91,10 @@ class StudyLaw:
     def __init__(self, policy, state_map, key=None):
         self.policy, self.state_map = policy, state_map
         self.key = policy_key(policy) if key is None else key
+        fam = getattr(policy, "family_key", None)
+        # policies of one family (e.g. one trained controller per UPQC rating) share a call
+        self.family = (("family", fam()) if callable(fam) and hasattr(type(policy), "rows_of")
+                       else None)
         self.xs, self.ys = [], []
 
     def __call__(self, y):
@@ -99,16 +106,21 @@ class StudyLaw:
         return u
 
     def batch_key(self):
-        """Laws with equal keys compute the same outputs for the same design state."""
-        return "study-law", self.key
+        """Laws with equal keys are evaluated in one call (:meth:`rows`): the same policy
+        (its content, :func:`policy_key`), or policies of one family — controllers that differ
+        only in their weights and input bounds
+        (:meth:`~weakgrid.game.controller.GameController.family_key`), each row computed with
+        its own."""
+        return "study-law", self.family or self.key
 
     @staticmethod
     def rows(laws, Y):
         """``laws[i](Y[i])`` for every row of the measured signals ``Y`` ``(n, p)`` (the laws
         share :meth:`batch_key`): the state maps in one array operation, the policy of
         ``laws[0]`` once on the ``(n, 2)`` design states (one row, or a policy known only by
-        its identity: called on each row, as alone); each law logs its row. Returns the
-        ``(n, 2)`` outputs."""
+        its identity: called on each row, as alone; the laws' policies of one family, not all
+        the same: their ``rows_of``, each row with its own policy); each law logs its row.
+        Returns the ``(n, 2)`` outputs."""
         Y = np.asarray(Y, float)
         maps = [law.state_map for law in laws]
         kind = type(maps[0])
@@ -124,6 +136,9 @@ class StudyLaw:
             # one row: the run's own call (the same arithmetic as alone); a policy known only
             # by its identity (a function) is not assumed to take rows
             U = np.stack([np.asarray(pol(x), float).reshape(2) for x in X])
+        elif any(law.key != laws[0].key for law in laws):   # one family: each row its own
+            U = np.asarray(type(pol).rows_of([law.policy for law in laws], X),
+                           float).reshape(n, 2)
         else:   # a policy's ``rows``: each row's floats those of its call on that row alone
             U = np.asarray(getattr(pol, "rows", pol)(X), float).reshape(n, 2)
         for law, y, x in zip(laws, Y, X):
