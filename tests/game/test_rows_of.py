@@ -94,3 +94,30 @@ def test_rows_of_refuses_controllers_of_another_family():
 def _system_scaled(s):
     return FunctionSystem(lambda x: 0.5 * s.open_loop_dynamics(x), s.control_directions,
                           s.disturbance_directions, 3, 2, 2)
+
+
+def test_rows_of_three_bounded_inputs_calls_each_controller_on_its_rows():
+    """Beyond 2 inputs the bound's minimization is vectorized (not point by point): each
+    controller of the family is then called on its own rows, as separate calls were."""
+    G = np.array([[0.1, 0.0, 0.02], [0.0, 0.2, 0.0], [0.05, 0.1, 0.1]])
+
+    def f(x):
+        return np.stack([0.9 * x[..., 0] + 0.1 * x[..., 1], 0.95 * x[..., 1],
+                         0.8 * x[..., 2] + 0.1 * x[..., 0] * x[..., 1]], axis=-1)
+
+    s = FunctionSystem(f, lambda x: np.broadcast_to(G, np.shape(x)[:-1] + G.shape),
+                       lambda x: np.broadcast_to(G[:, :1] * 0.2, np.shape(x)[:-1] + (3, 1)),
+                       3, 3, 1)
+    L = even_monomials(3, 4).size
+    ctls = []
+    for k, lim in enumerate(([0.02, 0.03, 0.04], [0.05, 0.01, 0.02])):
+        cost = GameCost.for_system(s, np.eye(3), np.eye(3), np.eye(1), 6.0, bound=lim,
+                                   bound_shape="box")
+        ctls.append(GameController(s, even_monomials(3, 4), _weights(L, k), cost))
+    assert ctls[0].family_key() == ctls[1].family_key()
+    X = np.random.default_rng(4).uniform(-1.5, 1.5, (6, 3))
+    ks = [ctls[i] for i in (0, 1, 1, 0, 1, 0)]
+    U = GameController.rows_of(ks, X)
+    for c in ctls:
+        idx = [i for i, k in enumerate(ks) if k is c]
+        np.testing.assert_array_equal(U[idx], c.rows(X[idx]))

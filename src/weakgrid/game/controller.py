@@ -214,7 +214,8 @@ class GameController:
         the controllers share :meth:`family_key` (they differ at most in their weights and
         input bounds, e.g. one trained at each UPQC rating), and row ``i``'s floats are those
         of ``controllers[i]`` on that row alone (its weights and bound, rowwise
-        arithmetic). Returns ``u*`` (n, m)."""
+        arithmetic). With an input bound and more than 2 inputs (whose minimization is not
+        point by point), each controller is called on its own rows. Returns ``u*`` (n, m)."""
         ctls = list(controllers)
         x = np.asarray(x, float)
         if x.ndim != 2 or x.shape[0] != len(ctls) or not ctls:
@@ -228,6 +229,16 @@ class GameController:
                                      "input bound: evaluate it with its own rows()")
         if all(c is first for c in ctls):
             return first.rows(x)
+        if first.cost.bound is not None and first.system.n_controls > 2:
+            # the bound's minimization goes point by point for at most 2 inputs only: each
+            # controller on its own rows, as separate calls would
+            U = np.empty((len(ctls), first.system.n_controls))
+            groups: dict = {}
+            for i, c in enumerate(ctls):
+                groups.setdefault(id(c), (c, []))[1].append(i)
+            for c, idx in groups.values():
+                U[idx] = c.rows(x[idx])
+            return U
         W = np.stack([c.weights for c in ctls])
         bounds = [c.cost.bound for c in ctls] if first.cost.bound is not None else None
         return first._saddle_point(x, W, bounds, True)[0]
