@@ -45,6 +45,19 @@ t_end = T_END
 """
 
 
+INTERRUPT_SWEEP = """
+[sweep]
+mode = "points"
+scenarios = ["c1-high-conv"]
+controllers = ["nonlinear-29"]
+t_end = 1.5
+[sweep.axes]
+"upqc.rating" = [0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3]
+"scenarios.c1-high-conv.events.0.bus" = [3, 3, 3, 3, 3, 3, 99, 99, 99, 99, 99, 99]
+"scenarios.c1-high-conv.events.0.t_off" = [0.25, 0.25, 0.25, 0.25, 0.25, 0.25, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3]
+"""
+
+
 def _small_study(tmp_path, ratings=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3), t_end=0.35) -> Path:
     """Case 1 with a small sweep: ratings × {bus 3, a bus that does not exist (fails)}."""
     src = resources.files("weakgrid") / "data" / "studies" / "case1-weak-grid.toml"
@@ -160,8 +173,13 @@ def test_sweep_against_a_scheduler_address_gives_the_default_table(tmp_path):
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_weakgrid_sweep_interrupted_and_restarted_completes_the_same_table(tmp_path, sig):
     # runs long enough (1.5 s simulated each) that the signal lands while some still run,
-    # however loaded the machine is; the 6 failing runs (bus 99) finish first
+    # however loaded the machine is. A batch's records are written when it ends, so the 6
+    # failing runs (bus 99) get another clearing time, hence a batch of their own, which
+    # ends first (their preparation fails); two batches of 3 and 3 ended within 40 ms of
+    # each other once, and the signal found nothing left to interrupt.
     study = _small_study(tmp_path, t_end=1.5)
+    text = study.read_text(encoding="utf-8")
+    study.write_text(text[: text.rindex("\n[sweep]\n")] + INTERRUPT_SWEEP, encoding="utf-8")
     out = tmp_path / "out"
     cache = out / "cache"
     cmd = [sys.executable, "-m", "weakgrid.cli.main", "sweep", str(study), "-o", str(out),
