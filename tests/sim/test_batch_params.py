@@ -9,7 +9,7 @@ is put in another batch (and refused by :class:`BatchSimulator` itself, naming t
 import numpy as np
 import pytest
 from sim_cases import build_gti_upqc_sg
-from test_batch import DT, EXACT, _alone, _K, _same
+from test_batch import DT, _alone, _K, _same
 
 from weakgrid.sim.batch import BatchSimulator, member_params, simulate_batch, system_fingerprint
 from weakgrid.sim.controllers import DigitalController, UPQCTarget, gti_design_states
@@ -17,36 +17,17 @@ from weakgrid.sim.errors import DataError
 from weakgrid.sim.events import Fault
 
 #: members with their own parameters equal their runs alone to round-off, amplified by the
-#: limiters: 0 with NumPy 2.x, up to 5.8e-9 pu with NumPy 1.26 (the lowest supported), whose
-#: ufuncs take other SIMD loops for a batch's rows than for a lone array (measured; 1.8e-10 on
-#: another member with AVX-512 disabled). A member run with another member's rating, the bug
-#: these tests guard against (they failed on the code before it), is off by far more. The
-#: recorded derivatives (``PV.dVc``) amplify it further: 4.1e-8 of their range with NumPy 1.26.
+#: limiters (measured: 0). A member run with another member's rating, the bug these tests guard
+#: against (they failed on the code before it), is off by far more: 0.23 pu during the clip and
+#: 0.018 pu at the end (a 0.02-pu rating run with its neighbour's 0.05 pu).
 ATOL_PARAMS, RTOL_PARAMS = 1e-8, 1e-6
-
-#: NumPy 1.26 on another CPU (CI's lowest-versions job, 2026-12-02) moved a limiter decision:
-#: the member with the 0.02-pu rating was 0.025 pu off its run alone during the clip, 8e-5 pu at
-#: the end. On NumPy 2 the members stay exact (above); on 1.26 each member is checked against
-#: what the bug these tests guard against does: a member run with its neighbour's rating (0.02
-#: against 0.05 pu) is 0.23 pu off during the clip and 0.018 pu at the end (measured), so a
-#: member must stay within 0.1 pu throughout and 1e-3 pu at the end, its clip at its own rating
-#: (checked below).
-LOWEST_MAX, LOWEST_END = 0.1, 1e-3
 
 T_END = 0.8
 
 
 def _same_member(a, b):
-    """A member's batched run ``b`` equals its run alone ``a`` (exact on NumPy 2, else
-    ``LOWEST_MAX``/``LOWEST_END``)."""
-    if EXACT:
-        _same(a, b, atol_states=ATOL_PARAMS, rtol_outputs=RTOL_PARAMS)
-        return
-    assert a.names == b.names and a.data.shape == b.data.shape
-    assert a.stats["steps"] == b.stats["steps"] and (a.failure is None) == (b.failure is None)
-    cols = [i for i, n in enumerate(a.names) if n.endswith((".Vr", ".Vi", ".delta", ".omega"))]
-    d = np.abs(a.data - b.data)[:, cols]
-    assert d.max() <= LOWEST_MAX and d[-1].max() <= LOWEST_END, (d.max(), d[-1].max())
+    """A member's batched run ``b`` equals its run alone ``a``."""
+    _same(a, b, atol_states=ATOL_PARAMS, rtol_outputs=RTOL_PARAMS)
 
 
 def _grid(structure="reduced", **upqc):

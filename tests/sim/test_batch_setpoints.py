@@ -158,7 +158,7 @@ def test_a_grid_at_several_loads_is_one_batch_equal_to_its_runs_alone(case):
     assert len({system_fingerprint(g) for g in grids}) == 1
     # the set-points do differ per member, beyond round-off: in these PSS/E cases the
     # governors' units are not the slack, so their pref0 moves by 1 ulp between load levels
-    # (NumPy 2) or not at all (NumPy 1.26); the *-swing cases put them on the slack
+    # (or not at all); the *-swing cases put them on the slack
     differ = {(grids[0].comps[j].type_name, name) for j, name, v in member_params(grids)
               if np.abs(v - v[0]).max() > 1e-9 * np.abs(v).max()}
     assert declared <= differ, differ

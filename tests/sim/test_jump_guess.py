@@ -13,8 +13,6 @@ from weakgrid.sim.controllers import DigitalController, UPQCTarget, gti_design_s
 from weakgrid.sim.integrate import jump_guess, simulate
 
 finite = st.floats(-1e3, 1e3, allow_nan=False)
-#: bit for bit on NumPy 2; NumPy 1.26's loops round differently in a batch (tests/sim/test_batch.py)
-EXACT = np.lib.NumpyVersion(np.__version__) >= "2.0.0"
 
 
 @given(st.floats(-50, 50, allow_nan=False).filter(lambda c: abs(c) > 1e-6),
@@ -77,9 +75,5 @@ def test_a_batch_member_takes_its_run_alones_guesses():
     sc = [{"controllers": [_sine_controller()]} for _ in range(3)]
     batch = simulate_batch(build_gti_upqc_sg("conventional"), sc, 0.2, dt=1e-3)
     for r in batch:
-        if EXACT:
-            assert r.stats["evals"] == alone.stats["evals"]
-            np.testing.assert_array_equal(r.data, alone.data)
-        else:   # NumPy 1.26: the batched residual differs from alone by round-off (test_batch)
-            assert r.stats["steps"] == alone.stats["steps"]
-            np.testing.assert_allclose(r.data, alone.data, rtol=1e-5, atol=1e-7)
+        assert r.stats["evals"] == alone.stats["evals"]
+        np.testing.assert_array_equal(r.data, alone.data)

@@ -26,12 +26,6 @@ from weakgrid.sim.machines.genrou import _KERNEL, GENROU, quad_sat, quad_sat_sca
 
 numba = pytest.importorskip("numba")
 
-#: NumPy 2 rounds its element-wise array arithmetic as the scalar code does, whatever the arrays'
-#: alignment; NumPy 1.26 (.ci/lowest.txt) does not always (tests/sim/test_batch.py: its SIMD
-#: loops), so whole runs there agree to round-off, not bit for bit (measured 0 to 1.1e-16 pu
-#: apart, depending on the run). The cores' own comparisons below held bit for bit on both.
-EXACT = np.lib.NumpyVersion(np.__version__) >= "2.0.0"
-
 
 @pytest.fixture(autouse=True, scope="module")
 def _auto_backend():
@@ -129,14 +123,9 @@ def _runs(system, scenarios, t_end, monkeypatch):
     for a, b in zip(out["numpy"], out["numba"]):
         assert a.failure is None and b.failure is None
         assert a.names == b.names
-        if EXACT:
-            assert np.array_equal(a.t, b.t)
-            assert np.array_equal(a.data, b.data)
-            assert a.stats == b.stats
-        else:   # NumPy 1.26: measured 0 to 1 ulp apart; through a Newton count that may move
-            # a step's result by up to the Newton tolerance (1e-6)
-            np.testing.assert_allclose(b.t, a.t, rtol=0, atol=1e-12)
-            np.testing.assert_allclose(b.data, a.data, rtol=0, atol=1e-6)
+        assert np.array_equal(a.t, b.t)
+        assert np.array_equal(a.data, b.data)
+        assert a.stats == b.stats
     return out
 
 

@@ -631,7 +631,7 @@ class BatchSimulator:
         ``J_yy``, each with the member's own factor (:meth:`Simulator._alg_lu_get`, LAPACK
         ``getrs``: the arithmetic of its run alone). A stacked ``numpy.linalg.solve`` was tried:
         bit-equal where NumPy and SciPy share one LAPACK (NumPy 2 with SciPy's OpenBLAS), 1e-8
-        off with another Newton count under NumPy 1.26's own OpenBLAS (.ci/lowest.txt), and it
+        off with another Newton count under NumPy 1.26's own OpenBLAS (then supported), and it
         saved little (the chord's time is its residual evaluations)."""
         return xp.stack([self.sims[k]._alg_lu_get().solve(r) for k, r in zip(ks, R)])
 

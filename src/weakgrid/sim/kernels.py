@@ -20,8 +20,7 @@ The two give the same floats: IEEE 754 rounds ``+ - * /`` and the square root ex
 compiles without fast-math (no re-association, no fused multiply-add), and the transcendental
 functions (``sin``, ``cos``, ...), whose last bit differs between libraries, stay outside the
 core, computed by NumPy and passed in as signals. ``tests/sim/test_kernels.py`` checks it bit
-for bit, model by model and on whole batched runs (those to round-off under NumPy 1.26, whose
-own array arithmetic depends on the arrays' alignment).
+for bit, model by model and on whole batched runs.
 
 ``WEAKGRID_KERNELS`` chooses: ``auto`` (default: compiled when numba imports, else NumPy),
 ``numpy`` (never compile: the reference path, e.g. to compare) or ``numba`` (compiled, an error

@@ -103,7 +103,7 @@ def itae(t, y, t_start=0.0, y_final=None, tail=0.5) -> float:
     yf = _final(t, y, tail) if y_final is None else float(y_final)
     sel = t >= t_start
     tt = t[sel] - t_start
-    # SciPy's trapezoid: NumPy's np.trapezoid is NumPy >= 2 only (the package allows 1.26)
+    # SciPy's trapezoid (the rule of NumPy's np.trapezoid)
     from scipy.integrate import trapezoid
 
     return float(trapezoid(tt * np.abs(y[sel] - yf), tt))
