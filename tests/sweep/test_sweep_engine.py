@@ -274,26 +274,29 @@ def slept(seconds):
 
 def test_free_workers_take_the_highest_priority_task_left(tmp_path):
     """A cluster fed from the client (``TaskFeed``) starts its tasks in the order of their
-    priorities whatever their lengths: on 2 workers, a long first task and short others,
-    each short one starts before any of lower priority (the two first together, on the
-    two free threads, in either order). Dask alone gives the first tasks
-    of a small group to a worker at submission, so a short task of high priority waited
-    there behind the long one while the other worker ran the rest."""
+    priorities whatever their lengths: on 2 workers, a long first task and short others, the
+    short ones start one after the other in the order of their priorities, all while the long
+    one runs. Dask alone gives the first tasks of a small group to a worker at submission, so
+    a short task of high priority waited there behind the long one while the other worker ran
+    the rest.
+
+    Only the order of the short ones is checked against each other: the long one and the first
+    short one start together on the two free threads, and a worker slow to start its task (CI
+    runs the suite beside this cluster) let the second short one start before the long one
+    (measured: the order 1, 2, 0, ...)."""
     from weakgrid.sweep import TaskFeed, open_client
 
-    lengths = [1.5, 0.1, 0.1, 0.1, 0.1, 0.1]
+    long = 2.0
+    lengths = [long, 0.1, 0.1, 0.1, 0.1, 0.1]
     with open_client(None, 2) as client:
         client.run(slept, 0.0)      # each worker has the function before the timed tasks
         feed = TaskFeed(client)
         for i, s in enumerate(lengths):
             feed.add("g", i, slept, s, priority=len(lengths) - i, key=f"slept-{i}")
         started = dict(feed.take("g"))
-    order = sorted(started, key=started.get)
-    # the two first start together on the two free threads (in either order); each later
-    # one starts when a thread frees, in the order of the priorities
-    assert set(order[:2]) == {0, 1}
-    assert order[2:] == list(range(2, len(lengths)))
-    assert started[5] < started[0] + 1.5          # the short ones ran beside the long one
+    shorts = sorted(range(1, len(lengths)), key=started.get)
+    assert shorts == list(range(1, len(lengths)))     # one after the other, by priority
+    assert max(started[i] for i in shorts) < started[0] + long   # beside the long one
 
 
 def test_sweep_on_a_client_that_is_not_the_default(tmp_path):
