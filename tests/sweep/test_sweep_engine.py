@@ -251,8 +251,9 @@ def test_submitted_sweep_yields_to_the_callers_tasks_and_keeps_what_finished(tmp
         while kept == 0 and time.monotonic() - t0 < 30:
             time.sleep(0.05)
             kept = pending.store_finished()       # kept without collect (an interrupt)
-        assert kept == 1
-        assert len(list(ResultCache(tmp_path / "c").folder.glob("*.json"))) == 1
+        # at least the first (two, if the poll came late: the suite runs beside this cluster)
+        assert kept >= 1
+        assert len(list(ResultCache(tmp_path / "c").folder.glob("*.json"))) == kept
         table = pending.collect()
     assert mine["mine"]["started"] < table["started"].min()   # the caller's task first
     assert table.sort_values("started")["upqc.rating"].tolist() == sorted(ratings, reverse=True)
