@@ -19,7 +19,10 @@ def small_study(n=4, t_end=0.4):
     for k in range(n):
         load = ("high", "low")[k % 2]
         ctl = ("pq", "nonlinear-29")[(k // 2) % 2]
-        scs.append({"id": f"s{k}", "load": load, "upqc": "conventional", "t_end": t_end,
+        # the (29) runs last twice as long: batched by controller, the two batches do not
+        # end together (the interrupt test stops the command between them)
+        scs.append({"id": f"s{k}", "load": load, "upqc": "conventional",
+                    "t_end": t_end * (1 + (k // 2) % 2),
                     "controllers": [ctl],
                     "events": [{"kind": "fault", "bus": 3, "t_on": 0.1,
                                 "t_off": 0.15 + 0.01 * k, "rf": 0.0, "xf": 0.1}]})
