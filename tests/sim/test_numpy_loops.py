@@ -12,7 +12,7 @@ and pass on 2.0.2 to 2.4.6.
 import numpy as np
 import pytest
 
-N = 44          # rows: a batch of 4 members' 11 Jacobian points, as in the failing run
+N = 44          # rows, as in the failing run: 2 members' Jacobian points (21 colours + base)
 
 
 def _strided_and_behind(values, stride):
