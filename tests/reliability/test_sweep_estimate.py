@@ -224,6 +224,15 @@ def test_the_estimate_prices_the_batches_the_sweep_makes():
     assert est == [keys for _, _, (_, keys) in tasks]
     assert sorted(len(b) for b in est) == [6, 45, 45]
     assert sorted(len(b) for b in _batches(todo, len(pts), 0)) == [6, 90]   # serially: whole
+    # beside other runs as costly as the sweep (reproduce's scenario runs, and case 1's maps:
+    # 192 points, at most 96 a batch), a worker's share holds the 90: one batch, in the
+    # estimate as on the cluster
+    other = sum(run_cost(p.inputs) for p in pts)
+    est = _batches(todo, 2 * len(pts), 2, other)
+    tasks = _tasks([(p, k) for k, p in todo.items()], run_point, STUDY_BATCHES,
+                   batch_size_for(2 * len(pts), 2), run_cost, balance_for(2), other)
+    assert est == [keys for _, _, (_, keys) in tasks]
+    assert sorted(len(b) for b in est) == [6, 90]
 
 
 def test_the_probe_records_what_the_sweep_records():

@@ -475,3 +475,39 @@ def test_a_single_member_evaluated_in_a_batch_gives_its_residual_alone():
         both, _ = bs.residual(0.0, np.stack([z, z]), [0, 1])
         assert np.array_equal(both[1], alone), trial
     assert up.n == 1
+
+
+def _zero(m):
+    """A policy that holds zero, on one point or a batch: its controller samples at every T
+    (the breakpoints the members meet at) and leaves the grid uncontrolled."""
+    return np.zeros(np.shape(m)[:-1] + (2,))
+
+
+def test_a_member_that_halved_a_step_catches_up_with_the_batch():
+    """Regression (2026-12-07): a sampled member that halves a step reaches its next sample
+    one iteration after the others. The others wait for it there, and the batch steps in one
+    group again: its steps are those of the member's run alone, not the two members' steps
+    taken apart from then on (before: it stayed a step behind to the end, the batch stepping
+    twice per step, each at a batched step's fixed cost)."""
+    s = build_gti_upqc_sg("reduced")
+    tf = 1.0
+
+    def scen(batched):
+        return [{"events": [Fault(b, 0.2, t_off, xf=x)],
+                 "controllers": [DigitalController(_zero, DT, gti_design_states("PV"),
+                                                   UPQCTarget("U"), batched=batched)]}
+                for b, t_off, x in ((3, 0.25, 0.05), (1, 0.35, 0.03))]   # the second halves
+    kw = dict(dt=DT, tol=1e-6)
+    alone = [_alone(s, sc, tf, **kw) for sc in scen(False)]
+    st = {}
+    got = simulate_batch(s, scen(True), tf, stats=st, **kw)
+    assert st["batches"] == 1 and st["rerun"] == 0 and st["halved"] >= 1
+    for a, b in zip(alone, got):
+        assert a.ok and b.ok
+        _same(a, b)
+    n0, n1 = (a.stats["steps"] for a in alone)
+    assert n1 > n0          # the halved steps
+    # the batch's steps: the halving member's own, and the 2 steps before the second fault's
+    # end (0.35 s) taken apart: there its step to the event and the other's to its sample
+    # differ in the last digit (measured: 203 = 201 + 2; before the fix 216)
+    assert st["steps"] <= n1 + 2, (st["steps"], n0, n1)

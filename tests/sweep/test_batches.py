@@ -94,6 +94,21 @@ def test_balanced_caps_a_batch_at_a_workers_share_of_the_cost():
             balanced(items, key=lambda it: it[0], cost=lambda it: it[1], balance=bad)
 
 
+def test_balanced_counts_the_workers_other_tasks_in_their_shares():
+    """Beside other tasks of cost 10 (the scenario runs beside the maps), the workers' shares
+    are (10 + 10) / 2 = 10: group 'a' (cost 6) stays one batch, which alone it is cut in two."""
+    from weakgrid.sweep.batches import balanced
+
+    items = [("a", 1.0)] * 6 + [("b", 2.0)] * 2
+    kw = dict(key=lambda it: it[0], cost=lambda it: it[1], balance=2)
+    assert [len(b) for b in balanced(items, **kw)] == [3, 3, 2]
+    assert [len(b) for b in balanced(items, other=10.0, **kw)] == [6, 2]
+    assert [len(b) for b in balanced(items, other=1.0, **kw)] == [3, 3, 2]   # 5.5: cut
+    for bad in (-1.0, float("nan"), float("inf"), True, "1"):
+        with pytest.raises(ParameterError, match="other"):
+            balanced(items, other=bad, **kw)
+
+
 @pytest.mark.parametrize("mw", [0, -1.0, float("inf"), float("nan"), True])
 def test_group_refuses_a_bad_max_weight(mw):
     with pytest.raises(ParameterError, match="max_weight"):

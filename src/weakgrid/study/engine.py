@@ -358,11 +358,15 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
     n_tasks = len(todo) + len(pts)
     serial = workers == 0 or (scheduler is None and n_tasks <= 3)
     sweep_table = None
+    # the scenario runs' cost in the maps' unit: the workers' shares that cap a map batch
+    # count them too (the maps' runs are queued beside them)
+    other = sum(run_cost({"study": st.data, "scenario": run.scenario, "t_end": run.t_end})
+                for st, run, _, _ in todo)
     if swept:   # the shipped maps' sweep: its estimate is printed, never refused; its probe
         # runs before the cluster starts (it times runs in this process, on idle cores)
         log(estimate_sweep(None, out / "sweep-cache", quick, workers=0 if serial else
-                           workers, scheduler=scheduler, points=pts,
-                           batched=batched).line("maps"))
+                           workers, scheduler=scheduler, points=pts, batched=batched,
+                           other_cost=other).line("maps"))
     maps_kw = dict(cache_dir=out / "sweep-cache", progress=progress, log=log, cost=run_cost,
                    desc="maps", batch=STUDY_BATCHES if batched else None,
                    batch_size=batch_size_for(len(pts), 0 if serial else workers)
@@ -395,7 +399,8 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
             # the maps' runs are queued too, after the scenario runs (priorities below
             # theirs): a worker done with the scenario runs goes on with the maps while the
             # last scenario runs end and their figures are drawn here
-            pending = submit_sweep(pts, run_point, feed=feed, **maps_kw) if swept else None
+            pending = submit_sweep(pts, run_point, feed=feed, other_cost=other,
+                                   **maps_kw) if swept else None
             try:
                 for rows, recs in feed.take("runs"):
                     for i, rec in zip(rows, recs if batched else [recs]):

@@ -409,13 +409,15 @@ def _first_values(study, quick):
 
 def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = None,
                    scheduler: str | None = None, points=None,
-                   batched: bool = True) -> SweepEstimate:
+                   batched: bool = True, other_cost: float = 0.0) -> SweepEstimate:
     """Estimate the remaining runs of ``study``'s sweep (cached in ``cache_dir``).
 
     Nothing is written (the cache folder is not created). ``workers``/``scheduler`` as for
     :func:`weakgrid.sweep.run_sweep` (None: one worker per core; 0: serially here);
     ``batched`` as for :func:`weakgrid.study.sweep.run_study_sweep` (the runs of one grid
-    together, in the batches the sweep will make; ``False``: one by one). A sweep
+    together, in the batches the sweep will make; ``False``: one by one; ``other_cost``:
+    the :func:`run_cost` of the other runs the same workers run beside the sweep, as
+    :func:`weakgrid.sweep.submit_sweep` takes it). A sweep
     of more than :data:`MAX_LISTED` runs is not listed (that alone would take minutes): its
     runs are counted from the axes, costed like those at the axes' first values, and the
     cache is not consulted.
@@ -447,7 +449,7 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
         return SweepEstimate(n_runs, n_cached, 0.0, 0.0, 0.0, 0, 0.0, n_par, 0.0,
                              base + table)
     steps = {k: _steps(p.inputs) for k, p in todo.items()}
-    batches = _batches(todo, len(pts), workers) if batched \
+    batches = _batches(todo, len(pts), workers, other_cost) if batched \
         else [[k] for k in todo]
     largest = max(len(b) for b in batches)
     try:
@@ -500,19 +502,21 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
                          batch_step_s=batch_step_cost(pr, largest))
 
 
-def _batches(todo: dict, n_points: int, workers: int | None) -> list[list]:
+def _batches(todo: dict, n_points: int, workers: int | None,
+             other: float = 0.0) -> list[list]:
     """The keys of ``todo`` in the batches the sweep makes of them
     (:func:`weakgrid.study.batches.batch_key`, at most
     :func:`~weakgrid.study.batches.batch_size_for` of the sweep's ``n_points`` runs each, none
-    above a worker's share of their :func:`run_cost`: :func:`weakgrid.sweep.batches.balanced`,
-    as :func:`weakgrid.sweep.run_sweep` makes them)."""
+    above a worker's share of their :func:`run_cost` and ``other``, the workers' other runs:
+    :func:`weakgrid.sweep.batches.balanced`, as :func:`weakgrid.sweep.run_sweep` and
+    :func:`weakgrid.sweep.submit_sweep` make them)."""
     from ..sweep.batches import balanced
     from .batches import balance_for, batch_key, batch_size_for
 
     keys = list(todo)
     return [[keys[i] for i in b.rows] for b in
             balanced([todo[k].inputs for k in keys], batch_key, batch_size_for(n_points, workers),
-                     run_cost, balance_for(workers))]
+                     run_cost, balance_for(workers), other)]
 
 
 def check_sweep(est: SweepEstimate, study, quick: bool = False, force: bool = False,

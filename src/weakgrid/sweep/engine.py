@@ -245,9 +245,10 @@ def results_table(points, records) -> pd.DataFrame:
     return df
 
 
-def _tasks(todo, run, batch, batch_size, cost=None, balance=None):
+def _tasks(todo, run, batch, batch_size, cost=None, balance=None, other=0.0):
     """``(function, arguments, (points, keys))`` of every task: one point each, or with
-    ``batch = (key, run_many)`` one batch each (:func:`weakgrid.sweep.batches.balanced`)."""
+    ``batch = (key, run_many)`` one batch each (:func:`weakgrid.sweep.batches.balanced`;
+    ``other``: the cost of the workers' other tasks)."""
     if batch is None:
         return [(execute, (run, p.inputs, k), ([p], [k])) for p, k in todo]
     from .batches import balanced
@@ -255,7 +256,8 @@ def _tasks(todo, run, batch, batch_size, cost=None, balance=None):
     key, run_many = batch
     out = []
     for b in balanced(todo, lambda pk: key(pk[0].inputs), batch_size,
-                      None if cost is None else (lambda pk: cost(pk[0].inputs)), balance):
+                      None if cost is None else (lambda pk: cost(pk[0].inputs)), balance,
+                      other):
         pts = [todo[i][0] for i in b.rows]
         keys = [todo[i][1] for i in b.rows]
         out.append((execute_batch, (run_many, [p.inputs for p in pts], keys), (pts, keys)))
@@ -401,19 +403,21 @@ def _table(points, keys, records, table_path):
 
 def submit_sweep(points, run, *, cache_dir, feed, desc: str = "sweep", progress: bool = True,
                  log=None, cost=None, batch=None, batch_size: int | None = None,
-                 balance: int | None = None) -> "PendingSweep":
+                 balance: int | None = None, other_cost: float = 0.0) -> "PendingSweep":
     """Queue the runs of a sweep on ``feed`` (a :class:`weakgrid.sweep.feed.TaskFeed` of the
     caller's cluster) and return at once: the :class:`PendingSweep` collects them
     (:meth:`PendingSweep.collect`), so that the caller can keep the workers busy with other
     tasks beside it (``weakgrid run`` and ``reproduce``: the maps' runs fill the workers as
     the scenario runs end). The other arguments are :func:`run_sweep`'s; the runs get
-    priorities below 0, so that tasks the caller queues with priorities ≥ 0 start first."""
+    priorities below 0, so that tasks the caller queues with priorities ≥ 0 start first.
+    ``other_cost``: the summed ``cost`` of those tasks of the caller, counted in the workers'
+    shares that ``balance`` caps a batch at (:func:`weakgrid.sweep.batches.balanced`)."""
     log = log or _log.info
     cache, keys, records, todo = _plan(points, run, cache_dir, log)
     total = len(set(keys))
     log(f"{desc}: {total} runs, {total - len(todo)} already done, {len(todo)} to run"
         + (" on the cluster, beside other tasks" if todo else ""))
-    tasks = _tasks(todo, run, batch, batch_size, cost, balance)
+    tasks = _tasks(todo, run, batch, batch_size, cost, balance, other_cost)
     return _submit(feed, tasks, cost, points, keys, records, cache, desc, progress,
                    log=log, below=True)
 
