@@ -354,3 +354,32 @@ def test_the_transient_of_a_batch_is_costed_at_the_batch_s_transient_step(tmp_pa
     n, q = se._steps(pts[0].inputs), se._quiet_steps(pts[0].inputs)
     assert 0 < q < n and est.batch == 12
     assert est.cpu_s == pytest.approx(q * (1e-3 + 1e-4 * 11) + (n - q) * (3e-3 + 5e-4 * 11))
+
+
+def test_a_batch_at_half_the_step_starts_before_the_batches_it_outlasts():
+    """``reproduce``'s maps on 2 workers: case 2's 6 runs at half the step (17.7 s measured)
+    start right after case 2's 90 runs, before case 1's batches of 30 (10–11 s each); ranked
+    by the sum of their runs' cost alone they started last, one worker on them while the
+    other idled (2026-12-07)."""
+    from weakgrid.study.batches import STUDY_BATCHES, balance_for, batch_size_for
+    from weakgrid.study.studyfile import load_study
+    from weakgrid.study.sweep import run_point, sweep_points
+    from weakgrid.study.sweep_estimate import batch_cost, run_cost
+    from weakgrid.sweep.engine import _priorities, _tasks
+
+    pts = [p for name in ("case1-weak-grid", "case2-lv-microgrid")
+           for p in sweep_points(load_study(name), quick=False)]
+    other = sum(run_cost(p.inputs) for p in pts) / 2        # reproduce's scenario runs
+    tasks = _tasks([(p, f"k{i}") for i, p in enumerate(pts)], run_point, STUDY_BATCHES,
+                   batch_size_for(len(pts), 2), run_cost, balance_for(2), other)
+    members = [m for _, _, (m, _) in tasks]
+
+    def order(bc):
+        prio = _priorities([(m[0], None) for m in members], run_cost, members, bc)
+        return [(members[i][0].inputs["study"]["study"]["name"][:5], len(members[i]),
+                 members[i][0].inputs["dt_factor"])
+                for i in sorted(range(len(members)), key=lambda i: -prio[i])]
+
+    assert order(batch_cost) == [("case2", 90, 1.0), ("case2", 6, 0.5)] + \
+        [("case1", 30, 1.0)] * 3 + [("case1", 6, 0.5)]
+    assert order(None).index(("case2", 6, 0.5)) > order(None).index(("case1", 30, 1.0))

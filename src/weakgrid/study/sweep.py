@@ -377,7 +377,7 @@ def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
     per run, the scalar path (the same table to round-off).
     """
     from .batches import STUDY_BATCHES, balance_for, batch_size_for
-    from .sweep_estimate import run_cost
+    from .sweep_estimate import batch_cost, run_cost
 
     out = Path(output)
     table_path = claim_sweep_outputs(study, out, quick, maps, force)
@@ -386,7 +386,8 @@ def run_study_sweep(study, output, *, quick=False, scheduler=None, workers=None,
 
     table = run_sweep(pts, run_point, cache_dir=cache_dir or out / "cache",
                       scheduler=scheduler, workers=workers, progress=progress, log=log,
-                      cost=run_cost, table_path=table_path, desc=f"sweep {study.name}",
+                      cost=run_cost, batch_cost=batch_cost, table_path=table_path,
+                      desc=f"sweep {study.name}",
                       batch=STUDY_BATCHES if batched else None,
                       batch_size=batch_size_for(len(pts), workers) if batched else None,
                       balance=balance_for(workers) if batched else None)

@@ -56,7 +56,8 @@ from ..sweep.cache import ResultCache
 from .studyfile import event_end, get_path, study_from_dict
 from .sweep import _NOT_DESIGN, _axes, run_point, sweep_points
 
-__all__ = ["SweepEstimate", "check_sweep", "estimate_sweep", "planned_runs", "probe", "run_cost"]
+__all__ = ["SweepEstimate", "batch_cost", "check_sweep", "estimate_sweep", "planned_runs",
+           "probe", "run_cost"]
 
 MAX_SECONDS = 1800.0          # the limits of a training (weakgrid.game.estimate.Estimate.check)
 PROBE_STEPS = (10, 40)
@@ -192,6 +193,7 @@ def _quiet_steps(inputs: dict) -> int:
 
 
 FAULT_STEP_WEIGHT = 10.0      # a step with a disturbance on, in quiet steps (see run_cost)
+BATCH_STEP_WEIGHT = 30.0      # a batched step's own cost, in quiet steps (see batch_cost)
 
 
 def run_cost(inputs: dict) -> float:
@@ -216,6 +218,24 @@ def run_cost(inputs: dict) -> float:
             t_on = float(e.get("t_on", e.get("t", 0.0)))
             on += max(min(event_end(e), t_end) - min(t_on, t_end), 0.0)
     return quiet + 3.0 * (n - quiet) + (FAULT_STEP_WEIGHT - 3.0) * on / dt
+
+
+def batch_cost(runs: list) -> float:
+    """A batch's cost before it runs, in :func:`run_cost`'s unit: to start a sweep's costliest
+    batches first (:func:`weakgrid.sweep.run_sweep`'s ``batch_cost``).
+
+    Its runs' :func:`run_cost`, and :data:`BATCH_STEP_WEIGHT` per step of the batch (its
+    longest run's): what a batched step costs whatever its members (the controllers'
+    sampling, the network's re-solve, the bookkeeping of the Newton iteration). Fitted on the
+    map batches of ``reproduce`` (2026-12-07, 2 workers): case 2's 90 runs of 6 s took 47.5 s
+    and its 6 at half the step 17.7 s, case 1's 30 runs of 2 s 10.3–11.0 s and its 6 at half
+    the step 8.9 s — about 0.036 s per 1 000 units, and 28–30 units per batched step. By the
+    sum of its runs alone, a batch of few runs at half the step ranked below batches of 30
+    and started last, one worker on it while the other idled.
+    """
+    runs = list(runs)
+    return sum(run_cost(r) for r in runs) + BATCH_STEP_WEIGHT * max(
+        (_steps(r) for r in runs), default=0)
 
 
 def _training_key(inputs: dict):

@@ -269,14 +269,19 @@ def _results(res):
     return res if isinstance(res, list) else [res]
 
 
-def _priorities(todo, cost, members=None):
-    """Dask priorities (higher runs first): by decreasing ``cost`` (of a batch: the sum over
-    its ``members``), ties in the given order."""
+def _priorities(todo, cost, members=None, batch_cost=None):
+    """Dask priorities (higher runs first): by decreasing ``cost`` (of a batch:
+    ``batch_cost`` of its ``members``' inputs, by default the sum of their ``cost``), ties in
+    the given order."""
     n = len(todo)
     if cost is None:
         return [n - i for i in range(n)]
-    est = [float(cost(p.inputs)) for p, _ in todo] if members is None else \
-        [sum(float(cost(p.inputs)) for p in m) for m in members]
+    if members is None:
+        est = [float(cost(p.inputs)) for p, _ in todo]
+    elif batch_cost is not None:
+        est = [float(batch_cost([p.inputs for p in m])) for m in members]
+    else:
+        est = [sum(float(cost(p.inputs)) for p in m) for m in members]
     order = sorted(range(n), key=lambda i: -est[i] if math.isfinite(est[i]) else 0.0)
     prio = [0] * n
     for rank, i in enumerate(order):
@@ -287,7 +292,8 @@ def _priorities(todo, cost, members=None):
 def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
               workers: int | None = None, progress: bool = True, table_path=None,
               desc: str = "sweep", log=None, client=None, cost=None, batch=None,
-              batch_size: int | None = None, balance: int | None = None) -> pd.DataFrame:
+              batch_size: int | None = None, balance: int | None = None,
+              batch_cost=None) -> pd.DataFrame:
     """Run every point (skipping those already cached) and return the result table.
 
     Parameters
@@ -332,6 +338,11 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
         split), so that no worker is left with one long batch while the others idle (the
         maps of ``weakgrid reproduce``: case 2's 90 runs of 6 s were one batch, half the
         sweep's cost, on one of 2 workers). Default: no limit by cost.
+    batch_cost : callable, optional
+        With ``batch`` and ``cost``: ``batch_cost(list of inputs) -> float``, a batch's cost
+        in ``cost``'s unit, for the order in which the batches start (a batch also costs per
+        step, whatever its size: :func:`weakgrid.study.sweep_estimate.batch_cost`). Default:
+        the sum of its runs' ``cost``.
 
     Returns
     -------
@@ -358,7 +369,7 @@ def run_sweep(points, run, *, cache_dir, scheduler: str | None = None,
         try:
             with _sigterm_as_interrupt(), ctx as cl:
                 return _submit(TaskFeed(cl), tasks, cost, points, keys, records, cache, desc,
-                               progress, log=log).collect(table_path)
+                               progress, log=log, batch_cost=batch_cost).collect(table_path)
         except SweepInterrupted:
             raise
         except KeyboardInterrupt:   # before the runs were submitted (the cluster's start)
@@ -403,7 +414,8 @@ def _table(points, keys, records, table_path):
 
 def submit_sweep(points, run, *, cache_dir, feed, desc: str = "sweep", progress: bool = True,
                  log=None, cost=None, batch=None, batch_size: int | None = None,
-                 balance: int | None = None, other_cost: float = 0.0) -> "PendingSweep":
+                 balance: int | None = None, other_cost: float = 0.0,
+                 batch_cost=None) -> "PendingSweep":
     """Queue the runs of a sweep on ``feed`` (a :class:`weakgrid.sweep.feed.TaskFeed` of the
     caller's cluster) and return at once: the :class:`PendingSweep` collects them
     (:meth:`PendingSweep.collect`), so that the caller can keep the workers busy with other
@@ -419,15 +431,15 @@ def submit_sweep(points, run, *, cache_dir, feed, desc: str = "sweep", progress:
         + (" on the cluster, beside other tasks" if todo else ""))
     tasks = _tasks(todo, run, batch, batch_size, cost, balance, other_cost)
     return _submit(feed, tasks, cost, points, keys, records, cache, desc, progress,
-                   log=log, below=True)
+                   log=log, below=True, batch_cost=batch_cost)
 
 
 def _submit(feed, tasks, cost, points, keys, records, cache, desc, progress, log=None,
-            below=False):
+            below=False, batch_cost=None):
     """Queue ``tasks`` on ``feed``, each with its priority, the costliest highest
     (``below``: priorities below 0)."""
     prio = _priorities([(pts[0], keys_[0]) for _, _, (pts, keys_) in tasks],
-                       cost, [pts for _, _, (pts, _) in tasks])
+                       cost, [pts for _, _, (pts, _) in tasks], batch_cost)
     shift = -(len(tasks) + 1) if below else 0
     group = object()          # this sweep's tasks on the feed
     for pr, (fn, args, (_, keys_)) in sorted(zip(prio, tasks), key=lambda x: -x[0]):
