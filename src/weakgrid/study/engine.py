@@ -373,7 +373,7 @@ def run_studies(studies, output, quick=False, log=None, title=None, progress=Tru
     # the scenario runs' cost in the maps' unit: the workers' shares that cap a map batch
     # count them too (the maps' runs are queued beside them)
     other = sum(run_cost({"study": st.data, "scenario": run.scenario, "t_end": run.t_end})
-                for st, run, _, _ in todo)
+                for st, run, _, _ in todo) if swept else 0.0
     if swept:   # the shipped maps' sweep: its estimate is printed, never refused; its probe
         # runs before the cluster starts (it times runs in this process, on idle cores)
         log(estimate_sweep(None, out / "sweep-cache", quick, workers=0 if serial else
