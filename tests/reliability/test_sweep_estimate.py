@@ -369,7 +369,9 @@ def test_a_batch_at_half_the_step_starts_before_the_batches_it_outlasts():
 
     pts = [p for name in ("case1-weak-grid", "case2-lv-microgrid")
            for p in sweep_points(load_study(name), quick=False)]
-    other = sum(run_cost(p.inputs) for p in pts) / 2        # reproduce's scenario runs
+    # the scenario runs beside them: about 0.4 of the maps' cost in reproduce (any amount that
+    # keeps case 2's 90 one batch gives this order)
+    other = 0.4 * sum(run_cost(p.inputs) for p in pts)
     tasks = _tasks([(p, f"k{i}") for i, p in enumerate(pts)], run_point, STUDY_BATCHES,
                    batch_size_for(len(pts), 2), run_cost, balance_for(2), other)
     members = [m for _, _, (m, _) in tasks]

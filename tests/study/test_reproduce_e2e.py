@@ -89,3 +89,27 @@ def test_report_is_self_contained_and_has_the_maps(output):
     for st in paper_studies():
         for m in st.data["sweep"]["maps"]:
             assert (output / "maps" / f"map-{st.name}-{m.get('id', m['claim'])}.png").stat().st_size > 1000
+
+
+def test_the_maps_drawn_on_the_cluster_are_those_drawn_here(output, tmp_path):
+    """`reproduce` draws each study's maps on a worker of its local cluster
+    (`weakgrid.study.engine._draw_maps_of`): the same images as drawn in this process, and the
+    results come back in the studies' order."""
+    from weakgrid.study.engine import _draw_maps_of
+    from weakgrid.sweep import open_client
+
+    studies = paper_studies()
+    table = pd.read_parquet(output / "sweep-quick.parquet")
+    tables = [table[table["scenario"].isin(st.data["sweep"]["scenarios"])]
+              .dropna(axis=1, how="all") for st in studies]
+    here = _draw_maps_of(studies, tables, tmp_path / "here", True)
+    with open_client(None, 2) as client:
+        there = _draw_maps_of(studies, tables, tmp_path / "there", True, client)
+    assert len(here) == len(there) == 2
+    for st, a, b in zip(studies, here, there):
+        assert [m["spec"] for m in a] == [m["spec"] for m in b] == st.data["sweep"]["maps"]
+        for ma, mb in zip(a, b):
+            assert ma["path"].name == mb["path"].name and st.name in mb["path"].name
+            assert ma["path"].read_bytes() == mb["path"].read_bytes()
+            assert (output / "maps" / mb["path"].name).read_bytes() == mb["path"].read_bytes()
+            pd.testing.assert_frame_equal(ma["cells"], mb["cells"])

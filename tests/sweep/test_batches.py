@@ -102,11 +102,11 @@ def test_balanced_counts_the_workers_other_tasks_in_their_shares():
     items = [("a", 1.0)] * 6 + [("b", 2.0)] * 2
     kw = dict(key=lambda it: it[0], cost=lambda it: it[1], balance=2)
     assert [len(b) for b in balanced(items, **kw)] == [3, 3, 2]
-    assert [len(b) for b in balanced(items, other=10.0, **kw)] == [6, 2]
-    assert [len(b) for b in balanced(items, other=1.0, **kw)] == [3, 3, 2]   # 5.5: cut
+    assert [len(b) for b in balanced(items, other_cost=10.0, **kw)] == [6, 2]
+    assert [len(b) for b in balanced(items, other_cost=1.0, **kw)] == [3, 3, 2]   # 5.5: cut
     for bad in (-1.0, float("nan"), float("inf"), True, "1"):
-        with pytest.raises(ParameterError, match="other"):
-            balanced(items, other=bad, **kw)
+        with pytest.raises(ParameterError, match="other_cost"):
+            balanced(items, other_cost=bad, **kw)
 
 
 @pytest.mark.parametrize("mw", [0, -1.0, float("inf"), float("nan"), True])

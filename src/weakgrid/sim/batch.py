@@ -892,7 +892,7 @@ class BatchSimulator:
             live = [k for k in act if self.sims[k].t < t_end - eps]
             if not live:
                 break
-            tb, hk = {}, {}
+            tb, hk, ends = {}, {}, {}
             for k in live:     # each member's next breakpoint and step, as in its run alone
                 t = self.sims[k].t
                 b = t_end
@@ -904,7 +904,8 @@ class BatchSimulator:
                 if b - (t + h) < 1e-3 * dt:
                     h = b - t
                 tb[k], hk[k] = b, h
-            live = self._catching_up(live, hk, 10 * eps)
+                ends.setdefault(t, set()).add(t + h)
+            live = self._catching_up(live, ends, 10 * eps)
             groups = {}
             for k in live:
                 groups.setdefault(hk[k], []).append(k)
@@ -945,9 +946,10 @@ class BatchSimulator:
             results[k] = None
         return results, rerun
 
-    def _catching_up(self, live, hk, tol):
-        """Members ``live`` that take their step ``hk`` now: those a member behind them reaches
-        with this step wait for it.
+    def _catching_up(self, live, ends, tol):
+        """Members ``live`` that take their step now (``ends``: the times the members at each
+        time reach with their steps): those a member behind them reaches with this step wait
+        for it.
 
         A member that halved its step (:meth:`_advance`) reaches its breakpoint one iteration
         after the others; stepping on, it would stay a step behind them to its end, the batch
@@ -955,9 +957,6 @@ class BatchSimulator:
         map batch with 0.3-s faults, 2026-12-07: 4 944 breakpoints in 4 groups after t = 1 s,
         21.5 s instead of 10). Members behind that do not land on the others' time (no
         controller sample to meet at: their own step grid) step beside them, as before."""
-        ends = {}
-        for k in live:
-            ends.setdefault(self.sims[k].t, set()).add(self.sims[k].t + hk[k])
         if len(ends) == 1:
             return live
         wait = {t for t in ends if any(

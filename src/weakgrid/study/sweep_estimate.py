@@ -523,11 +523,11 @@ def estimate_sweep(study, cache_dir, quick: bool = False, workers: int | None = 
 
 
 def _batches(todo: dict, n_points: int, workers: int | None,
-             other: float = 0.0) -> list[list]:
+             other_cost: float = 0.0) -> list[list]:
     """The keys of ``todo`` in the batches the sweep makes of them
     (:func:`weakgrid.study.batches.batch_key`, at most
     :func:`~weakgrid.study.batches.batch_size_for` of the sweep's ``n_points`` runs each, none
-    above a worker's share of their :func:`run_cost` and ``other``, the workers' other runs:
+    above a worker's share of their :func:`run_cost` and ``other_cost``, the workers' other runs:
     :func:`weakgrid.sweep.batches.balanced`, as :func:`weakgrid.sweep.run_sweep` and
     :func:`weakgrid.sweep.submit_sweep` make them)."""
     from ..sweep.batches import balanced
@@ -536,7 +536,7 @@ def _batches(todo: dict, n_points: int, workers: int | None,
     keys = list(todo)
     return [[keys[i] for i in b.rows] for b in
             balanced([todo[k].inputs for k in keys], batch_key, batch_size_for(n_points, workers),
-                     run_cost, balance_for(workers), other)]
+                     run_cost, balance_for(workers), other_cost)]
 
 
 def check_sweep(est: SweepEstimate, study, quick: bool = False, force: bool = False,

@@ -101,12 +101,12 @@ def finite_cost(cost, item) -> float:
 
 
 def balanced(items, key, max_size: int | None = None, cost=None,
-             balance: int | None = None, other: float = 0.0) -> list[Batch]:
+             balance: int | None = None, other_cost: float = 0.0) -> list[Batch]:
     """:func:`group` with no batch above ``1/balance`` of the items' summed ``cost(item)``
     (``balance``: the workers the batches are spread over; None, or no ``cost``: by count
     alone), so that no worker is left with one long batch while the others idle.
 
-    ``other`` (in ``cost``'s unit, ≥ 0): what the same workers run besides these items (the
+    ``other_cost`` (in ``cost``'s unit, ≥ 0): what the same workers run besides these items (the
     scenario runs beside the maps of ``weakgrid reproduce``); it counts in the workers'
     shares. A batch cut in two costs its fixed part twice (case 2's 90 map runs: 47 s as
     one batch, 57 s as two of 45, 64 s as three of 30, serially, 2026-12-07), so a group is
@@ -115,13 +115,13 @@ def balanced(items, key, max_size: int | None = None, cost=None,
                                 or balance < 1):
         raise ParameterError("balance", balance, "give a whole number ≥ 1 of workers, or "
                              "None (no limit by cost)")
-    if isinstance(other, bool) or not isinstance(other, (int, float)) \
-            or not (math.isfinite(other) and other >= 0):
-        raise ParameterError("other", other, "give the cost of the workers' other tasks as a "
+    if isinstance(other_cost, bool) or not isinstance(other_cost, (int, float)) \
+            or not (math.isfinite(other_cost) and other_cost >= 0):
+        raise ParameterError("other_cost", other_cost, "give the cost of the workers' other tasks as a "
                              "finite number ≥ 0 (0: none)")
     share = None
     if balance is not None and cost is not None and len(items):
-        total = sum(finite_cost(cost, it) for it in items) + float(other)
+        total = sum(finite_cost(cost, it) for it in items) + float(other_cost)
         share = total / balance if total > 0 else None
     return group(items, key, max_size, weight=(lambda it: finite_cost(cost, it)) if share
                  else None, max_weight=share)

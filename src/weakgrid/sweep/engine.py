@@ -245,10 +245,10 @@ def results_table(points, records) -> pd.DataFrame:
     return df
 
 
-def _tasks(todo, run, batch, batch_size, cost=None, balance=None, other=0.0):
+def _tasks(todo, run, batch, batch_size, cost=None, balance=None, other_cost=0.0):
     """``(function, arguments, (points, keys))`` of every task: one point each, or with
     ``batch = (key, run_many)`` one batch each (:func:`weakgrid.sweep.batches.balanced`;
-    ``other``: the cost of the workers' other tasks)."""
+    ``other_cost``: the cost of the workers' other tasks)."""
     if batch is None:
         return [(execute, (run, p.inputs, k), ([p], [k])) for p, k in todo]
     from .batches import balanced
@@ -257,7 +257,7 @@ def _tasks(todo, run, batch, batch_size, cost=None, balance=None, other=0.0):
     out = []
     for b in balanced(todo, lambda pk: key(pk[0].inputs), batch_size,
                       None if cost is None else (lambda pk: cost(pk[0].inputs)), balance,
-                      other):
+                      other_cost):
         pts = [todo[i][0] for i in b.rows]
         keys = [todo[i][1] for i in b.rows]
         out.append((execute_batch, (run_many, [p.inputs for p in pts], keys), (pts, keys)))
