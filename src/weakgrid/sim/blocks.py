@@ -20,13 +20,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from .namespace import NUMPY
+
+
+class Block:
+    """Base of the blocks: their arrays' namespace (:mod:`weakgrid.sim.namespace`; NumPy unless
+    the grid is evaluated on another, then in every block whose evaluation says so)."""
+
+    xp = NUMPY
+
 
 def _safe(T):
     T = np.asarray(T, dtype=float)
     return np.where(T > 0, T, 1.0)
 
 
-class Lag:
+class Lag(Block):
     r"""First-order lag :math:`K/(1+sT)`.
 
     Parameters
@@ -52,12 +61,12 @@ class Lag:
     def output(self, x, u):
         if self._all:
             return x
-        return np.where(self._on, x, self.K * u)
+        return self.xp.where(self._on, x, self.K * u)
 
     def deriv(self, x, u):
         if self._all:
             return (self.K * u - x) / self._Ts
-        return np.where(self._on, (self.K * u - x) / self._Ts, 0.0)
+        return self.xp.where(self._on, (self.K * u - x) / self._Ts, 0.0)
 
 
 class LagNonWindup(Lag):
@@ -80,10 +89,10 @@ class LagNonWindup(Lag):
     def output(self, x, u):
         if self._all:
             return x
-        return np.where(self._on, x, np.clip(self.K * u, self.lower, self.upper))
+        return self.xp.where(self._on, x, self.xp.clip(self.K * u, self.lower, self.upper))
 
 
-class LeadLag:
+class LeadLag(Block):
     r"""Lead-lag :math:`K(1+sT_1)/(1+sT_2)`.
 
     State ``x`` obeys :math:`T_2\dot x = u - x` and the output is
@@ -116,12 +125,12 @@ class LeadLag:
         if self._all:
             y = self._r * (u - x) + x
             return y if self._unit else self.K * y
-        return self.K * np.where(self._on, self._r * (u - x) + x, u)
+        return self.K * self.xp.where(self._on, self._r * (u - x) + x, u)
 
     def deriv(self, x, u):
         if self._all:
             return (u - x) / self._T2s
-        return np.where(self._on, (u - x) / self._T2s, 0.0)
+        return self.xp.where(self._on, (u - x) / self._T2s, 0.0)
 
     def output_deriv(self, x, u):
         """``(output(x, u), deriv(x, u))``, the same values with ``u - x`` formed once."""
@@ -132,7 +141,7 @@ class LeadLag:
         return self.output(x, u), self.deriv(x, u)
 
 
-class Washout:
+class Washout(Block):
     r"""Washout (high-pass) :math:`sK/(1+sT)`.
 
     State ``x`` obeys :math:`T\dot x = u - x`, output :math:`y = (K/T)(u - x)`.
@@ -163,12 +172,12 @@ class Washout:
     def output(self, x, u):
         if self._all:
             return self._g * (u - x)
-        return np.where(self._on, self._g * (u - x), 0.0)
+        return self.xp.where(self._on, self._g * (u - x), 0.0)
 
     def deriv(self, x, u):
         if self._all:
             return (u - x) / self._Ts
-        return np.where(self._on, (u - x) / self._Ts, 0.0)
+        return self.xp.where(self._on, (u - x) / self._Ts, 0.0)
 
     def output_deriv(self, x, u):
         """``(output(x, u), deriv(x, u))``, the same values with ``u - x`` formed once."""
@@ -197,7 +206,7 @@ class WashoutBypass(Washout):
     def output(self, x, u):
         if self._all:
             return u - x
-        return np.where(self._on, u - x, u)
+        return self.xp.where(self._on, u - x, u)
 
     def output_deriv(self, x, u):
         """``(output(x, u), deriv(x, u))``, the same values with ``u - x`` formed once."""
@@ -207,7 +216,7 @@ class WashoutBypass(Washout):
         return self.output(x, u), self.deriv(x, u)
 
 
-class Integrator:
+class Integrator(Block):
     r"""Integrator :math:`K/s`, output = state.
 
     Parameters
@@ -228,7 +237,7 @@ class Integrator:
         return self.K * u
 
 
-class PINonWindup:
+class PINonWindup(Block):
     r"""PI controller :math:`K_p + K_i/s` with non-windup output limits.
 
     The integrator state is held in ``[lower, upper]`` by the integrator
@@ -256,13 +265,13 @@ class PINonWindup:
         return np.asarray(y0, dtype=float) - self.Kp * u0
 
     def output(self, x, u):
-        return np.clip(self.Kp * u + x, self.lower, self.upper)
+        return self.xp.clip(self.Kp * u + x, self.lower, self.upper)
 
     def deriv(self, x, u):
         return self.Ki * u
 
 
-class PID:
+class PID(Block):
     r"""PID controller :math:`K_p + K_i/s + K_d s/(1+sT_d)` (no limits).
 
     States: integrator ``xi`` and derivative-filter state ``xd``
@@ -321,9 +330,10 @@ def quad_saturation_coeffs(E1, SE1, E2, SE2):
     return A, B
 
 
-def quad_saturation(x, A, B):
-    r"""Quadratic saturation product :math:`x\,S(x) = B(x-A)^2` for ``x >= A`` else 0."""
-    return np.where(x >= A, B * (x - A) ** 2, 0.0)
+def quad_saturation(x, A, B, xp=np):
+    r"""Quadratic saturation product :math:`x\,S(x) = B(x-A)^2` for ``x >= A`` else 0 (``xp``:
+    the arrays' namespace)."""
+    return xp.where(x >= A, B * (x - A) ** 2, 0.0)
 
 
 def exp_saturation_coeffs(E1, SE1, E2, SE2):
@@ -355,13 +365,14 @@ def exp_saturation_coeffs(E1, SE1, E2, SE2):
 
 
 def exp_saturation(x, A, B):
-    r"""Exponential saturation factor :math:`S(x) = B\,x^A` for ``x > 0`` else 0."""
-    x = np.asarray(x, dtype=float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(x > 0, B * np.abs(x) ** A, 0.0)
+    r"""Exponential saturation factor :math:`S(x) = B\,x^A` for ``x > 0`` else 0 (arrays of
+    any namespace: the name ``np`` is rebound where a kernel runs it on another, and ``x``
+    is kept off 0 where it is not used)."""
+    x = np.asarray(x, dtype=np.float64)
+    return np.where(x > 0, B * np.abs(np.where(x > 0, x, 1.0)) ** A, 0.0)
 
 
-class LagRate:
+class LagRate(Block):
     r"""First-order lag :math:`K/(1+sT)` with a rate limit, ANDES 2.0 convention.
 
     :math:`T\dot x = \mathrm{clip}(Ku - x,\ r_{lo},\ r_{hi})`: the limits bound
@@ -389,23 +400,23 @@ class LagRate:
         return self.K * np.asarray(u0, dtype=float)
 
     def deriv(self, x, u):
-        return np.clip(self.K * u - x, self.r_lo, self.r_hi) / self.T
+        return self.xp.clip(self.K * u - x, self.r_lo, self.r_hi) / self.T
 
 
-def piecewise_linear(u, points, values):
+def piecewise_linear(u, points, values, xp=NUMPY):
     """Continuous piecewise-linear characteristic through ``(points[k], values[k])``, flat outside.
 
     ``points`` and ``values`` are sequences of arrays (one entry per device); points must
-    be non-decreasing.
+    be non-decreasing. ``xp``: the arrays' namespace.
     """
-    u = np.asarray(u, dtype=float)
-    y = np.broadcast_to(np.asarray(values[0], float), u.shape).copy()
+    u = xp.asarray(u, dtype=xp.float64)
+    y = xp.asarray(xp.broadcast_to(xp.asarray(values[0], dtype=xp.float64), u.shape), copy=True)
     for k in range(1, len(points)):
         x0, x1 = points[k - 1], points[k]
         y0, y1 = values[k - 1], values[k]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            seg = y0 + (u - x0) * (y1 - y0) / (x1 - x0)
-        y = np.where(u > x0, np.where(u <= x1, seg, y1), y)
+        dx = x1 - x0      # a vertical step (dx = 0) is never on a segment: divided by 1 there
+        seg = y0 + (u - x0) * (y1 - y0) / xp.where(dx == 0, 1.0, dx)
+        y = xp.where(u > x0, xp.where(u <= x1, seg, y1), y)
     return y
 
 
@@ -432,7 +443,8 @@ class WashoutOrLag(Washout):
     def output(self, x, u):
         if self._all:
             return self._g * (u - x)
-        return np.where(self._lag, x, np.where(self._on, self._g * (u - x), 0.0))
+        xp = self.xp
+        return xp.where(self._lag, x, xp.where(self._on, self._g * (u - x), 0.0))
 
 
 class IntegratorNonWindup(Integrator):
@@ -452,24 +464,26 @@ class IntegratorNonWindup(Integrator):
         self.upper = np.asarray(upper, dtype=float)
 
 
-def hard_limit(u, lower, upper):
-    """Static (windup) limiter: ``u`` clipped to ``[lower, upper]`` (no state involved)."""
-    return np.minimum(np.maximum(u, lower), upper)
+def hard_limit(u, lower, upper, xp=NUMPY):
+    """Static (windup) limiter: ``u`` clipped to ``[lower, upper]`` (no state involved;
+    ``xp``: the arrays' namespace)."""
+    return xp.minimum(xp.maximum(u, lower), upper)
 
 
-def rectifier_fex(IN):
+def rectifier_fex(IN, xp=NUMPY):
     r"""Rectifier regulation factor :math:`F_{EX}(I_N)` of IEEE 421.5 AC/ST exciters.
 
     :math:`F_{EX} = 1` for :math:`I_N \le 0`; :math:`1 - 0.577 I_N` up to 0.433;
     :math:`\sqrt{0.75 - I_N^2}` up to 0.75; :math:`1.732(1 - I_N)` up to 1; 0 beyond.
-    ``IN = KC * XadIfd / VE`` is the normalized field current (load of the rectifier).
+    ``IN = KC * XadIfd / VE`` is the normalized field current (load of the rectifier);
+    ``xp``: the arrays' namespace.
     """
-    IN = np.asarray(IN, dtype=float)
-    return np.select([IN <= 0, IN <= 0.433, IN <= 0.75, IN <= 1.0],
-                     [np.ones_like(IN), 1 - 0.577 * IN, np.sqrt(np.abs(0.75 - IN * IN)), 1.732 * (1 - IN)], 0.0)
+    IN = xp.asarray(IN, dtype=xp.float64)
+    return xp.where(IN <= 0, 1.0, xp.where(IN <= 0.433, 1 - 0.577 * IN, xp.where(
+        IN <= 0.75, xp.sqrt(xp.abs(0.75 - IN * IN)), xp.where(IN <= 1.0, 1.732 * (1 - IN), 0.0))))
 
 
-class PITrackAW:
+class PITrackAW(Block):
     r"""PI controller :math:`K_p + K_i/s` with a tracking anti-windup (back-calculation).
 
     The unlimited output :math:`y_s = K_p u + x` is clipped to ``[lower, upper]``; the
@@ -496,19 +510,20 @@ class PITrackAW:
         return self.Kp * u + x
 
     def output(self, x, u, lower, upper):
-        return np.clip(self.Kp * u + x, lower, upper)
+        return self.xp.clip(self.Kp * u + x, lower, upper)
 
     def deriv(self, x, u, lower, upper):
         ys = self.Kp * u + x
-        return self.Ki * (u - self.Ks * (ys - np.clip(ys, lower, upper)))
+        return self.Ki * (u - self.Ks * (ys - self.xp.clip(ys, lower, upper)))
 
 
-def deadband(u, lower, upper):
-    """Dead band without offset: 0 inside ``[lower, upper]``, ``u - upper`` above, ``u - lower`` below."""
-    return np.where(u > upper, u - upper, np.where(u < lower, u - lower, 0.0))
+def deadband(u, lower, upper, xp=NUMPY):
+    """Dead band without offset: 0 inside ``[lower, upper]``, ``u - upper`` above, ``u - lower``
+    below (``xp``: the arrays' namespace)."""
+    return xp.where(u > upper, u - upper, xp.where(u < lower, u - lower, 0.0))
 
 
-class LeadLag2:
+class LeadLag2(Block):
     r"""Second-order lead-lag :math:`(1 + sA)/(1 + sB + s^2 C)` (unit gain).
 
     Realized in controllable canonical form, states ``x1`` (the lagged input) and
@@ -552,16 +567,18 @@ class LeadLag2:
         return u0 * 1.0, np.zeros_like(u0)
 
     def output(self, x1, x2, u):
-        return np.where(self._two, x1 + self.A * x2,
-                        np.where(self._one, self._r * (u - x1) + x1, u))
+        xp = self.xp
+        return xp.where(self._two, x1 + self.A * x2,
+                        xp.where(self._one, self._r * (u - x1) + x1, u))
 
     def deriv(self, x1, x2, u):
-        d1 = np.where(self._two, x2, np.where(self._one, (u - x1) / self._Bs, 0.0))
-        d2 = np.where(self._two, (u - x1 - self.B * x2) / self._Cs, 0.0)
+        xp = self.xp
+        d1 = xp.where(self._two, x2, xp.where(self._one, (u - x1) / self._Bs, 0.0))
+        d2 = xp.where(self._two, (u - x1 - self.B * x2) / self._Cs, 0.0)
         return d1, d2
 
 
-class TransportDelay:
+class TransportDelay(Block):
     r"""Pure transport delay :math:`e^{-sT_D}` from a stored history of the delayed signal.
 
     The phasor simulator integrates with a fixed-step implicit method; a delay is represented

@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import DataError
+from .namespace import NUMPY
 from .params import Param, validate
 
 
@@ -56,14 +57,19 @@ class Context:
         self.t = t
         self.x = x
         self.V = V
-        self.f = np.zeros(x.shape)
-        self.I = np.zeros(V.shape, dtype=complex)
+        xp = system.xp
+        self.f = xp.zeros(x.shape, dtype=xp.float64)
+        self.I = xp.zeros(V.shape, dtype=xp.complex128)
         # one copy of the stacked defaults; the dict holds row views of it
         S = system._sig_stack
         if x.ndim > 1 and S.ndim == 2:   # a batch of points (leading axis): one row block per
             # point (a batch simulator may bind its members' own, (n_sig, B, n): weakgrid.sim.batch)
-            S = np.broadcast_to(S[:, None, :], (S.shape[0],) + x.shape[:-1] + (S.shape[1],))
-        self.sig = dict(zip(system._sig_keys, S.copy()))
+            S = xp.broadcast_to(S[:, None, :], (S.shape[0],) + x.shape[:-1] + (S.shape[1],))
+        if xp is NUMPY:
+            self.sig = dict(zip(system._sig_keys, S.copy()))
+        else:
+            S = xp.asarray(S, copy=True)
+            self.sig = {k: S[i, ...] for i, k in enumerate(system._sig_keys)}
         self.out = {}
 
 
@@ -74,14 +80,6 @@ def fast_index(idx):
     if len(idx) and np.array_equal(idx, np.arange(idx[0], idx[0] + len(idx))):
         return slice(int(idx[0]), int(idx[0]) + len(idx))
     return idx
-
-
-def scatter_add(a, idx, v, unique):
-    """``a[..., idx] += v`` along the last axis, also for repeated indices (``unique=False``)."""
-    if unique:
-        a[..., idx] += v
-    else:   # unbuffered: every repeated index receives its share (two devices on one bus)
-        np.add.at(a, (Ellipsis, idx), v)
 
 
 class Component:
@@ -103,6 +101,12 @@ class Component:
 
     kind = "device"
     order = 0
+    #: the array namespace its evaluation calls (:mod:`weakgrid.sim.namespace`)
+    xp = NUMPY
+    #: its evaluation (``compute``, ``finish``) is written for any array-API namespace
+    #: (:func:`weakgrid.sim.namespace.on_namespace`), not NumPy's alone; said by each model
+    #: class itself (a subclass does not inherit it)
+    array_api = False
     params: tuple[Param, ...] = ()
     states: tuple[str, ...] = ()
     outputs: tuple[str, ...] = ()

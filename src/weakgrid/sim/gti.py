@@ -32,13 +32,16 @@ from __future__ import annotations
 import numpy as np
 
 from .blocks import PID
-from .component import Component, fast_index, scatter_add
+from .component import Component, fast_index
 from .errors import DataError
+from .namespace import add_at, take
 from .params import Param
 
 
 class GTI(Component):
     """Vectorized grid-tie inverters; add instances with :meth:`add_gti`."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "device"
     #: set-points computed at init (from the operating point): per batch member
@@ -136,13 +139,11 @@ class GTI(Component):
         x[self.sl(3)] = self.Q0
 
     def compute(self, ctx):
-        p = self.p
-        x = ctx.x
-        sl = self._sls
+        xp, p, x, sl = self.xp, self.p, ctx.x, self._sls
         Vc, ph = x[..., sl[0]], x[..., sl[1]]
-        V = ctx.V[..., self._bi]
-        Vref = ctx.V[..., self._refi]
-        th_r = np.arctan2(Vref.imag, Vref.real)     # np.angle's arithmetic
+        V = take(xp, ctx.V, self._bi)
+        Vref = take(xp, ctx.V, self._refi)
+        th_r = xp.atan2(xp.imag(Vref), xp.real(Vref))     # np.angle's arithmetic
         phi_s = self.phi0 + ph
         Vs_ref = self.Vs0
         if self._any_pq:
@@ -152,25 +153,22 @@ class GTI(Component):
             eQ = self.Q0 - x[..., sl[3]]
             uP = self.pidP.output(x[..., sl[4]], x[..., sl[5]], eP)
             uQ = self.pidQ.output(x[..., sl[6]], x[..., sl[7]], eQ)
-            phi_s = np.where(self.pq, self.phi0 + uP, phi_s)
-            Vs_ref = np.where(self.pq, self.Vs0 + uQ, Vs_ref)
+            phi_s = xp.where(self.pq, self.phi0 + uP, phi_s)
+            Vs_ref = xp.where(self.pq, self.Vs0 + uQ, Vs_ref)
             self._eP, self._eQ = eP, eQ
-        Vcs = np.where(Vc > 1e-6, Vc, 1e-6) if not (Vc > 1e-6).all() else Vc
-        ks = np.minimum(Vs_ref / Vcs, p["ks_max"])
+        Vcs = Vc if xp.all(Vc > 1e-6) else xp.where(Vc > 1e-6, Vc, 1e-6)
+        ks = xp.minimum(Vs_ref / Vcs, p["ks_max"])
         Vs = ks * Vc
-        Es = Vs * np.exp(1j * (th_r + phi_s))
+        Es = Vs * xp.exp(1j * (th_r + phi_s))
         I = -1j * p["B"] * (Es - V)
-        scatter_add(ctx.I, self._bi, I, self._uniq)
-        self._Pac = (Es * np.conj(I)).real
-        self._Q = (V * np.conj(I)).imag
+        add_at(self.xp, ctx.I, self._bi, I, self._uniq)
+        self._Pac = xp.real(Es * xp.conj(I))
+        self._Q = xp.imag(V * xp.conj(I))
         self._Vs, self._ks, self._phis = Vs, ks, phi_s
-        ctx.sig["gti_p_series"] = np.zeros(x.shape[:-1] + (self.n,))
+        ctx.sig["gti_p_series"] = xp.zeros(x.shape[:-1] + (self.n,), dtype=xp.float64)
 
     def finish(self, ctx):
-        p = self.p
-        x = ctx.x
-        f = ctx.f
-        sl = self._sls
+        xp, p, x, f, sl = self.xp, self.p, ctx.x, ctx.f, self._sls
         Vc = x[..., sl[0]]
         ps = ctx.sig["gti_p_series"]
         Pe = (1 + p["chi"]) * self._Pac
@@ -179,14 +177,14 @@ class GTI(Component):
         f[..., sl[0]] = dVc
         if self._any_pq:
             q = self.pq
-            f[..., sl[1]] = np.where(q, 0.0, ups)
-            f[..., sl[2]] = np.where(q, (self._Pac - x[..., sl[2]]) / p["Td"], 0.0)
-            f[..., sl[3]] = np.where(q, (self._Q - x[..., sl[3]]) / p["Td"], 0.0)
+            f[..., sl[1]] = xp.where(q, 0.0, ups)
+            f[..., sl[2]] = xp.where(q, (self._Pac - x[..., sl[2]]) / p["Td"], 0.0)
+            f[..., sl[3]] = xp.where(q, (self._Q - x[..., sl[3]]) / p["Td"], 0.0)
             dip, ddp = self.pidP.deriv(x[..., sl[4]], x[..., sl[5]], self._eP)
             diq, ddq = self.pidQ.deriv(x[..., sl[6]], x[..., sl[7]], self._eQ)
-            f[..., sl[4]], f[..., sl[5]] = np.where(q, dip, 0.0), np.where(q, ddp, 0.0)
-            f[..., sl[6]], f[..., sl[7]] = np.where(q, diq, 0.0), np.where(q, ddq, 0.0)
-            f[..., sl[8]] = np.where(q, p["ki_v"] * (Vc - p["Vc0"]), 0.0)
+            f[..., sl[4]], f[..., sl[5]] = xp.where(q, dip, 0.0), xp.where(q, ddp, 0.0)
+            f[..., sl[6]], f[..., sl[7]] = xp.where(q, diq, 0.0), xp.where(q, ddq, 0.0)
+            f[..., sl[8]] = xp.where(q, p["ki_v"] * (Vc - p["Vc0"]), 0.0)
         else:   # all energy mode: the pq states are constant (their f stays 0)
             f[..., sl[1]] = ups
         o = ctx.out

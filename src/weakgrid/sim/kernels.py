@@ -16,6 +16,11 @@ tuple of values, that uses only ``+ - * /``, comparisons and :func:`numpy.sqrt` 
   members of a batch and the model's instances: one call for the whole model instead of one
   per operation.
 
+``core`` runs with the name ``np`` in it (and in the array functions it calls) bound to the
+arrays' namespace (:mod:`weakgrid.sim.namespace`): :data:`~weakgrid.sim.namespace.NUMPY`,
+NumPy with the standard's ``all`` at the speed of the method, or another namespace when the
+constants ``p`` are its arrays. The functions above are the array API standard's too.
+
 The two give the same floats: IEEE 754 rounds ``+ - * /`` and the square root exactly, numba
 compiles without fast-math (no re-association, no fused multiply-add), and the transcendental
 functions (``sin``, ``cos``, ...), whose last bit differs between libraries, stay outside the
@@ -43,6 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import DataError
+from .namespace import NUMPY
 
 __all__ = ["Kernel", "backend", "cache_dir", "choice", "compiled_available", "constants"]
 
@@ -236,6 +242,20 @@ class Kernel:
         self.scalar_forms = tuple(scalar_forms)
         self._loops: dict = {}
         self._ready: set = set()
+        self._on: dict = {}     # the core on another namespace, by namespace
+
+    def on_namespace(self, xp):
+        """``core`` with ``np`` bound to the namespace ``xp`` in it and in the array functions
+        of :attr:`scalar_forms` it calls (the same code, another namespace's arrays)."""
+        fn = self._on.get(xp)
+        if fn is None:
+            def rebound(f, names):
+                return types.FunctionType(f.__code__, dict(f.__globals__, np=xp, **names),
+                                          f.__name__, f.__defaults__, f.__closure__)
+
+            helpers = {a.__name__: rebound(a, {}) for a, _ in self.scalar_forms}
+            fn = self._on[xp] = rebound(self.core, helpers)
+        return fn
 
     def _compiled(self, nsig, flags):
         """The compiled loop for ``nsig`` signals and these flags (constants of the compiled
@@ -258,11 +278,14 @@ class Kernel:
         ``flags`` go to the core; ``compiled_flags`` (the same flags, or None: run on NumPy)
         say whether these flags may be compiled: a model passes None where its branch calls
         an array function whose scalar form does not round as it does."""
+        if type(P) is not np.ndarray:      # another namespace's arrays (rows: p[k] per constant)
+            rows = tuple(P[k, ...] for k in range(P.shape[0]))
+            return self.on_namespace(P.__array_namespace__())(signals, rows, *flags)
         if compiled_flags is None or backend() == "numpy":
-            return self.core(signals, P, *flags)
+            return self.on_namespace(NUMPY)(signals, P, *flags)
         loop = self._compiled(len(signals), compiled_flags)
         if loop is None:
-            return self.core(signals, P, *flags)
+            return self.on_namespace(NUMPY)(signals, P, *flags)
         shape = signals[0].shape
         sig = signals
         if any(a.shape != shape for a in signals):   # e.g. a signal held the same for all members
@@ -278,7 +301,7 @@ class Kernel:
                 log.warning("could not compile %s.%s (%s); it runs on NumPy", *_ref(self.core),
                             str(exc).splitlines()[0])
                 self._loops[key] = None
-                return self.core(signals, P, *flags)
+                return self.on_namespace(NUMPY)(signals, P, *flags)
             self._ready.add(key)
         else:
             loop(P, out, *sig)

@@ -23,6 +23,7 @@ import numpy as np
 
 from .component import Component, Context
 from .errors import DataError
+from .namespace import NUMPY
 from .network import Network
 
 SIGNALS = ("omega", "delta", "Pe", "Qe", "Vt", "theta", "XadIfd", "vf", "tm", "vs",
@@ -125,6 +126,9 @@ class System:
     ...                   exciter=("EXDC2", {...}), governor=("TGOV1", {...}))
     >>> sys.setup()
     """
+
+    #: the array namespace of its evaluation (:func:`weakgrid.sim.namespace.on_namespace`)
+    xp = NUMPY
 
     def __init__(self, network):
         self.network = network if isinstance(network, Network) else Network(network)
@@ -568,7 +572,7 @@ class System:
         the last axis), as used by the finite-difference Jacobian.
         """
         nx, nb = self.nx, self.nb
-        V = z[..., nx:nx + nb] + 1j * z[..., nx + nb:]
+        V = z[..., nx:nx + nb] + 1j * z[..., nx + nb:]   # complex128 on every namespace
         ctx = Context(self, t, z[..., :nx], V)
         for c in self.comps:
             c.compute(ctx)
@@ -593,10 +597,11 @@ class System:
         ctx = self.evaluate(t, z)
         I = ctx.I
         nx, nb = self.nx, self.nb
-        F = np.empty(z.shape)
+        xp = self.xp
+        F = xp.empty(z.shape, dtype=xp.float64)
         F[..., :nx] = ctx.f
-        np.negative(I.real, out=F[..., nx:nx + nb])
-        np.negative(I.imag, out=F[..., nx + nb:])
+        F[..., nx:nx + nb] = -xp.real(I)
+        F[..., nx + nb:] = -xp.imag(I)
         return F, ctx
 
     def residual(self, t, z):

@@ -44,10 +44,13 @@ The inputs ``Vup``, ``Vuq`` [pu] are held values set by a digital controller
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from .component import Component, fast_index, scatter_add
+from .component import Component, fast_index
 from .errors import DataError
+from .namespace import add_at, take
 from .network import BR_B, BR_R, BR_X, F_BUS, SHIFT, T_BUS, TAP
 from .params import Param
 
@@ -64,20 +67,20 @@ def rating_clip(u, Vmax):
     return u * np.minimum(1.0, Vmax / np.where(mag > 0, mag, 1.0))[..., None]
 
 
-def series_dc_power(P, chi):
+def series_dc_power(P, chi, xp=np):
     """The series converter's dc-side power [pu on Sb] for its ac power ``P`` (to the line):
     ``P + chi*|P|`` — the paper's ``(1 + chi)*P`` while it delivers power (15), and a loss
     (never a gain) while it absorbs power."""
-    return P + chi * np.abs(P)
+    return P + chi * xp.abs(P)
 
 
-def link_vmax(Vmax, Vdc, Vdc0):
+def link_vmax(Vmax, Vdc, Vdc0, xp=np):
     """The series voltage [pu] the dc link at ``Vdc`` [pu] can carry (the converter's
     modulation limit): ``Vmax*min(1, max(Vdc, 0)/Vdc0)`` (conventional structure)."""
-    return np.where(Vdc < Vdc0, Vmax * np.maximum(Vdc, 0.0) / Vdc0, Vmax)
+    return xp.where(Vdc < Vdc0, Vmax * xp.maximum(Vdc, 0.0) / Vdc0, Vmax)
 
 
-def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p):
+def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p, xp=np):
     """The conventional UPQC's shunt converter and dc link (the module docstring's equations),
     the one law every engine evaluates.
 
@@ -93,6 +96,8 @@ def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p):
     p : mapping
         ``Vdc0``, ``kp_dc``, ``ki_dc``, ``Imax`` (0: no limit), ``Rsh``, ``Cdc``
         (:attr:`UPQC.params`).
+    xp : module
+        The arrays' namespace (:mod:`weakgrid.sim.namespace`).
 
     Returns
     -------
@@ -103,24 +108,26 @@ def shunt_dc_law(Pdc, Vdc, xi_dc, vr_abs, vr_safe, p):
     """
     err = p["Vdc0"] - Vdc
     Id = (Pdc + p["kp_dc"] * err + xi_dc) / vr_safe
-    imax = np.where(p["Imax"] > 0, p["Imax"], np.inf)   # 0: no limit
-    over = np.abs(Id) > imax
-    limited = over.any()
+    imax = xp.where(p["Imax"] > 0, p["Imax"], math.inf)   # 0: no limit
+    over = xp.abs(Id) > imax
+    limited = xp.any(over)
     if limited:
-        Id = np.clip(Id, -imax, imax)
+        Id = xp.clip(Id, -imax, imax)
     Psh = Id * vr_abs
     Ploss = p["Rsh"] * Id ** 2
-    Vdcs = Vdc if np.all(Vdc > 1e-6) else np.maximum(Vdc, 1e-6)   # Vdc: an array or a float (EMT)
+    Vdcs = Vdc if xp.all(Vdc > 1e-6) else xp.maximum(Vdc, 1e-6)   # Vdc: an array or a float (EMT)
     dVdc = (Psh - Ploss - Pdc) / (p["Cdc"] * Vdcs)
     dxi = p["ki_dc"] * err
     if limited:
-        dxi = np.where(over, 0.0, dxi)
+        dxi = xp.where(over, 0.0, dxi)
     return Id, over, Psh, Ploss, dVdc, dxi
 
 
 class UPQC(Component):
     """Vectorized UPQCs (series converter, and the shunt converter with its dc link in the
     conventional structure); add instances with :meth:`add_upqc`."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     #: the series-voltage commands [pu] a controller holds: per member in a batch
     batch_inputs = ("u_p", "u_q")
@@ -214,6 +221,9 @@ class UPQC(Component):
         # the buses as slices where they can be (basic indexing: no gather per evaluation)
         self._ri, self._b1i = (fast_index(self.r), fast_index(self.b1)) if self._uniq else (self.r, self.b1)
         self._r_conv = fast_index(self.r[self._conv]) if self._uniq else self.r[self._conv]
+        self._conv_i = np.nonzero(self._conv)[0]     # the conventional instances, the reduced
+        self._red_i = np.nonzero(self.reduced)[0]    # ones and the GTIs feeding them
+        self._gti_red = self.gti_i[self.reduced]
 
     def set_input(self, name, Vup, Vuq):
         """Hold series-voltage commands ``Vup`` (quadrature) and ``Vuq`` (in phase) [pu] for UPQC ``name``."""
@@ -238,67 +248,68 @@ class UPQC(Component):
         return groups
 
     def compute(self, ctx):
-        on = ctx.system.branch_status[self.branch]
-        p = self.p
-        Vr = ctx.V[..., self._ri]
-        V1 = ctx.V[..., self._b1i]
-        vr_abs = np.abs(Vr)
-        if (vr_abs > 1e-6).all():      # fast path (same values as the guarded expressions)
+        xp, p = self.xp, self.p
+        on = take(xp, ctx.system.branch_status, self.branch)
+        Vr = take(xp, ctx.V, self._ri)
+        V1 = take(xp, ctx.V, self._b1i)
+        vr_abs = xp.abs(Vr)
+        if xp.all(vr_abs > 1e-6):      # fast path (same values as the guarded expressions)
             ur = Vr / vr_abs
             vr_safe = vr_abs
         else:
-            ur = np.where(vr_abs > 1e-9, Vr / np.where(vr_abs > 1e-9, vr_abs, 1.0), 1.0)
-            vr_safe = np.maximum(vr_abs, 1e-6)
+            ur = xp.where(vr_abs > 1e-9, Vr / xp.where(vr_abs > 1e-9, vr_abs, 1.0), 1.0 + 0j)
+            vr_safe = xp.maximum(vr_abs, 1e-6)
         Vu = (self.u_q + 1j * self.u_p) * ur
-        mag = np.abs(Vu)
+        mag = xp.abs(Vu)
         Vmax = p["Vmax"]
         conv = self._conv
         if self._any_conv:   # the series voltage the dc link can carry: Vmax at Vdc >= Vdc0
             Vdc = ctx.x[..., self.sl(0)]
-            if (Vdc < p["Vdc0"]).any():
-                lv = link_vmax(Vmax, Vdc, p["Vdc0"])
-                Vmax = lv if self._all_conv else np.where(conv, lv, Vmax)
-        if (mag > Vmax).any():
-            Vu = Vu * np.where(mag > Vmax, Vmax / np.where(mag > 0, mag, 1.0), 1.0)
-            mag = np.abs(Vu)
-        if not on.all():
-            Vu = np.where(on, Vu, 0.0)
-            mag = np.abs(Vu)
+            if xp.any(Vdc < p["Vdc0"]):
+                lv = link_vmax(Vmax, Vdc, p["Vdc0"], xp)
+                Vmax = lv if self._all_conv else xp.where(conv, lv, Vmax)
+        if xp.any(mag > Vmax):
+            Vu = Vu * xp.where(mag > Vmax, Vmax / xp.where(mag > 0, mag, 1.0), 1.0)
+            mag = xp.abs(Vu)
+        if not xp.all(on):
+            Vu = xp.where(on, Vu, 0.0 + 0j)
+            mag = xp.abs(Vu)
         Isrc = self.yu * Vu
-        scatter_add(ctx.I, self._b1i, Isrc, self._uniq)
-        scatter_add(ctx.I, self._ri, -Isrc, self._uniq)
-        I = self.yu * (Vr + Vu - V1) * on
-        S = Vu * np.conj(I)
-        P = S.real
-        Pdc = series_dc_power(P, p["chi"]) if self._any_chi else P
+        add_at(xp, ctx.I, self._b1i, Isrc, self._uniq)
+        add_at(xp, ctx.I, self._ri, -Isrc, self._uniq)
+        I = self.yu * (Vr + Vu - V1) * xp.astype(on, xp.complex128)   # NumPy's bool * complex
+        S = Vu * xp.conj(I)
+        P = xp.real(S)
+        Pdc = series_dc_power(P, p["chi"], xp) if self._any_chi else P
         o = ctx.out
         if self._any_conv:
             Id, over, Psh, Ploss, dVdc, dxi = shunt_dc_law(Pdc, Vdc, ctx.x[..., self.sl(1)],
-                                                          vr_abs, vr_safe, p)
+                                                          vr_abs, vr_safe, p, xp)
             if self._all_conv:
-                scatter_add(ctx.I, self._r_conv, -(Id * ur), self._uniq)
+                add_at(xp, ctx.I, self._r_conv, -(Id * ur), self._uniq)
             else:
-                Id, Psh, Ploss, dVdc, dxi = (np.where(conv, a, 0.0)
+                Id, Psh, Ploss, dVdc, dxi = (xp.where(conv, a, 0.0)
                                              for a in (Id, Psh, Ploss, dVdc, dxi))
                 over = over & conv
-                scatter_add(ctx.I, self._r_conv, -(Id * ur)[..., conv], self._uniq)
+                add_at(xp, ctx.I, self._r_conv, take(xp, -(Id * ur), self._conv_i), self._uniq)
             self._f = (dVdc, dxi)
-            o["UPQC.P_shunt"], o["UPQC.S_shunt"] = Psh, np.abs(Psh)
-            o["UPQC.I_shunt"], o["UPQC.P_loss"], o["UPQC.limited"] = Id, Ploss, over * 1.0
+            o["UPQC.P_shunt"], o["UPQC.S_shunt"] = Psh, xp.abs(Psh)
+            o["UPQC.I_shunt"], o["UPQC.P_loss"] = Id, Ploss
+            o["UPQC.limited"] = xp.astype(over, xp.float64)
         else:
-            zero = np.zeros_like(P)
+            zero = xp.zeros_like(P)
             self._f = (zero, zero)
             o["UPQC.P_shunt"] = o["UPQC.S_shunt"] = o["UPQC.I_shunt"] = zero
             o["UPQC.P_loss"] = o["UPQC.limited"] = zero
         if self._any_red:
-            red = self.reduced
-            scatter_add(ctx.sig["gti_p_series"], self.gti_i[red], Pdc[..., red], self._uniq_g)
-        rot = Vu * np.conj(ur)
-        Iabs = np.abs(I)
-        o["UPQC.Vuq"], o["UPQC.Vup"], o["UPQC.Vu"] = rot.real, rot.imag, mag
-        o["UPQC.I"], o["UPQC.P_series"], o["UPQC.Q_series"] = Iabs, P, S.imag
+            add_at(xp, ctx.sig["gti_p_series"], self._gti_red, take(xp, Pdc, self._red_i),
+                   self._uniq_g)
+        rot = Vu * xp.conj(ur)
+        Iabs = xp.abs(I)
+        o["UPQC.Vuq"], o["UPQC.Vup"], o["UPQC.Vu"] = xp.real(rot), xp.imag(rot), mag
+        o["UPQC.I"], o["UPQC.P_series"], o["UPQC.Q_series"] = Iabs, P, xp.imag(S)
         o["UPQC.S_series"], o["UPQC.P_dc"] = mag * Iabs, Pdc
-        o["UPQC.P_line"] = ((Vr + Vu) * np.conj(I)).real
+        o["UPQC.P_line"] = xp.real((Vr + Vu) * xp.conj(I))
 
     def finish(self, ctx):
         dVdc, dxi = self._f

@@ -21,12 +21,15 @@ import numpy as np
 
 from ..blocks import Lag, LagNonWindup, LeadLag, Washout, quad_saturation, quad_saturation_coeffs
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 
 
 class EXDC2(MachineControl):
     """IEEE DC2 exciter. Parameters: TR, TA, TC, TB, TE, TF1 [s]; KA, KE, KF1 [pu];
     VRMAX, VRMIN [pu]; E1, SE1, E2, SE2 (saturation) [pu]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -101,25 +104,23 @@ class EXDC2(MachineControl):
         x[self.sl(4)] = self.W.init(vf0)
 
     def compute(self, ctx):
-        p = self.p
-        x = ctx.x
-        m = self._mi
-        sls = self._sls
+        xp, p, x, m, sls = self.xp, self.p, ctx.x, self._mi, self._sls
         ls, ll, vr, vp, w = x[..., sls[0]], x[..., sls[1]], x[..., sls[2]], x[..., sls[3]], x[..., sls[4]]
-        v = ctx.sig["Ecomp"][..., m]
-        omega = ctx.sig["omega"][..., m]
+        v = take(xp, ctx.sig["Ecomp"], m)
+        omega = take(xp, ctx.sig["omega"], m)
         W, dw = self.W.output_deriv(w, vp)
-        vi = self.vref0 - self.LS.output(ls, v) - W + ctx.sig["vs"][..., m]
+        vi = self.vref0 - self.LS.output(ls, v) - W + take(xp, ctx.sig["vs"], m)
         vll, dll = self.LL.output_deriv(ll, vi)
         vout = omega * vp if self.speed_times_vp else vp
-        sat = 0.0 if self._nosat else np.where(vout >= self.SA, quad_saturation(vp, self.SA, self.SB), 0.0)
+        sat = 0.0 if self._nosat else xp.where(vout >= self.SA, quad_saturation(vp, self.SA, self.SB, xp),
+                                               0.0)
         f = ctx.f
         f[..., self._sls[0]] = self.LS.deriv(ls, v)
         f[..., self._sls[1]] = dll
         f[..., self._sls[2]] = self.LA.deriv(vr, vll)
         f[..., self._sls[3]] = (vr - p["KE"] * vp - sat) / p["TE"]
         f[..., self._sls[4]] = dw
-        ctx.sig["vf"][..., m] = vout
+        put(xp, ctx.sig["vf"], m, vout)
         o = ctx.out
         k = self._keys
         o[k[0]], o[k[1]], o[k[2]] = vi, self.vref0 + 0 * vi, vout

@@ -34,6 +34,8 @@ class IEEEX1(EXDC2):
     """IEEE type 1 DC exciter; parameters as EXDC2 (VRMAX, VRMIN are multiplied by Vt
     unless ``VR_Vt = 0``)."""
 
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
+
     params = EXDC2.params + (
         Param("VR_Vt", 1.0, "-", "1: regulator limits VRMAX*Vt, VRMIN*Vt (IEEE); "
               "0: constant VRMAX, VRMIN (ANDES 2.0)", "flag"),

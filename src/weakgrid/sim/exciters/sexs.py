@@ -11,15 +11,16 @@ Block diagram::
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..blocks import Lag, LeadLag
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 
 
 class SEXS(MachineControl):
     """Simplified exciter. Parameters: TATB [-], TB, TE [s], K [pu], EMIN, EMAX [pu]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -59,12 +60,12 @@ class SEXS(MachineControl):
         x[self.sl(1)] = vf0
 
     def compute(self, ctx):
-        m = self._mi    # a slice when the machines are contiguous (a view, no gather)
+        xp, m = self.xp, self._mi    # a slice when the machines are contiguous (a view, no gather)
         ll, law = ctx.x[..., self._sls[0]], ctx.x[..., self._sls[1]]
-        vi = self.vref0 - ctx.sig["Ecomp"][..., m] + ctx.sig["vs"][..., m]
+        vi = self.vref0 - take(xp, ctx.sig["Ecomp"], m) + take(xp, ctx.sig["vs"], m)
         y = self.LL.output(ll, vi)
         ctx.f[..., self._sls[0]] = self.LL.deriv(ll, vi)
         ctx.f[..., self._sls[1]] = self.LAW.deriv(law, y)
-        vf = np.minimum(np.maximum(self.LAW.output(law, y), self.p["EMIN"]), self.p["EMAX"])
-        ctx.sig["vf"][..., m] = vf
+        vf = xp.minimum(xp.maximum(self.LAW.output(law, y), self.p["EMIN"]), self.p["EMAX"])
+        put(xp, ctx.sig["vf"], m, vf)
         ctx.out["SEXS.vi"] = vi

@@ -50,12 +50,15 @@ import numpy as np
 
 from ..blocks import Lag
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 
 
 class HYGOV(MachineControl):
     """Hydro governor. Parameters: R, r [pu]; Tf, Tr, Tg, Tw [s]; VELM [pu/s]; GMAX, GMIN, At, Dt, qNL [pu];
     flags Tr_used, Tw_sysbase, Dt_sysbase, VELM_offset (module docstring)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "governor"
     #: the power reference computed at init (from the operating point): per batch member
@@ -117,19 +120,19 @@ class HYGOV(MachineControl):
         x[self.sl(3)] = c0
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi    # a slice when the machines are contiguous (a view, no gather)
         x1, xi, g, q = (ctx.x[..., self._sls[k]] for k in range(4))
-        wd = ctx.sig["omega"][..., m] - p["wref0"]
+        wd = take(xp, ctx.sig["omega"], m) - p["wref0"]
         c = xi + x1 / p["r"]
         e = self.pref0 - wd - p["R"] * c
         h = (q / g) ** 2
         f = ctx.f
         f[..., self._sls[0]] = self.LF.deriv(x1, e)
         off = self.v_off * x1
-        f[..., self._sls[1]] = np.minimum(np.maximum(self.Ki * x1, -p["VELM"] - off), p["VELM"] - off)
+        f[..., self._sls[1]] = xp.minimum(xp.maximum(self.Ki * x1, -p["VELM"] - off), p["VELM"] - off)
         f[..., self._sls[2]] = self.LG.deriv(g, c)
         f[..., self._sls[3]] = (1.0 - h) / self.Tw_eff
         tm = (p["At"] * h * (q - p["qNL"]) - self.Dt_eff * wd * g) * self.Sbase
-        ctx.sig["tm"][..., m] = tm
+        put(xp, ctx.sig["tm"], m, tm)
         ctx.out["HYGOV.gate"], ctx.out["HYGOV.head"] = g, h

@@ -19,11 +19,14 @@ import numpy as np
 
 from ..blocks import LagNonWindup, LeadLag
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 
 
 class TGOV1(MachineControl):
     """Steam turbine-governor TGOV1. Parameters: R, VMAX, VMIN, Dt [pu, turbine base]; T1, T2, T3 [s]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "governor"
     #: the power reference computed at init (from the operating point): per batch member
@@ -70,13 +73,12 @@ class TGOV1(MachineControl):
         return self.pref0 + (self.paux - wd) / self.p["R"]
 
     def compute(self, ctx):
-        p = self.p
-        m = self._mi
+        xp, p, m = self.xp, self.p, self._mi
         lag, ll = ctx.x[..., self._sls[0]], ctx.x[..., self._sls[1]]
-        wd = ctx.sig["omega"][..., m] - p["wref0"]
+        wd = take(xp, ctx.sig["omega"], m) - p["wref0"]
         pd = self._pd(wd)
         ctx.f[..., self._sls[0]] = self.LAG.deriv(lag, pd)
         y, ctx.f[..., self._sls[1]] = self.LL.output_deriv(ll, lag)
         pout = y - p["Dt"] * wd
-        ctx.sig["tm"][..., m] = pout
+        put(xp, ctx.sig["tm"], m, pout)
         ctx.out[self._key] = pout

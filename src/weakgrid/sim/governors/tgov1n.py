@@ -16,6 +16,8 @@ from .tgov1 import TGOV1
 class TGOV1N(TGOV1):
     """TGOV1 with ``pref``/``paux`` summed after the droop gain; parameters as TGOV1."""
 
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
+
     psse_record = None   # an ANDES variant: PSS/E has no TGOV1N
 
     def _pd(self, wd):

@@ -16,8 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..component import Component, scatter_add
+from ..component import Component
 from ..errors import DataError
+from ..namespace import add_at
 from ..network import PD, QD
 from ..params import Param
 
@@ -99,5 +100,5 @@ class ZIP(Component):
         Q = self.cq[0] + self.cq[1] * r + self.cq[2] * r * r
         Vs = np.where(np.abs(V) > 1e-6, V, 1e-6)
         I = -np.conj((P + 1j * Q) / Vs) + self.y0 * V
-        scatter_add(ctx.I, self.bus, I, self._uniq)
+        add_at(self.xp, ctx.I, self.bus, I, self._uniq)
         ctx.out["ZIP.P"], ctx.out["ZIP.Q"] = P, Q

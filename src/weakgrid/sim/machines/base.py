@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..component import Component, fast_index, scatter_add
+from ..component import Component, fast_index
+from ..namespace import add_at, put
 from ..params import Param
 
 BASE_PARAMS = (
@@ -76,7 +77,7 @@ class SyncMachine(Component):
         self.wb = 2 * np.pi * self.p["fn"]
         self.m = np.array([system.machine_number(nm) for nm in self.names], dtype=int)
         self._mi = fast_index(self.m)
-        # two machines on one bus: their currents must accumulate (scatter_add with unique=False)
+        # two machines on one bus: their currents must accumulate (add_at with unique=False)
         self._uniq = len(set(self.bus.tolist())) == self.n
         self._bi = fast_index(self.bus) if self._uniq else self.bus
         psse = self.p["psse_shaft"] > 0
@@ -102,18 +103,19 @@ class SyncMachine(Component):
 
     def inject(self, ctx, I):
         """Add the machines' network currents ``I`` to ``ctx.I`` (accumulating on shared buses)."""
-        scatter_add(ctx.I, self._bi, self.connected(I), self._uniq)
+        add_at(self.xp, ctx.I, self._bi, self.connected(I), self._uniq)
 
     def publish(self, ctx, omega, delta, Pe, Qe, V, XadIfd):
-        m = self._mi
-        sig = ctx.sig
-        sig["omega"][..., m] = omega
-        sig["delta"][..., m] = delta
-        sig["Pe"][..., m] = Pe
-        sig["Qe"][..., m] = Qe
-        sig["Vt"][..., m] = sig["Ecomp"][..., m] = np.abs(V)
-        sig["theta"][..., m] = np.arctan2(V.imag, V.real)     # np.angle's arithmetic
-        sig["XadIfd"][..., m] = XadIfd
+        xp, m, sig = self.xp, self._mi, ctx.sig
+        vt = xp.abs(V)
+        put(xp, sig["omega"], m, omega)
+        put(xp, sig["delta"], m, delta)
+        put(xp, sig["Pe"], m, Pe)
+        put(xp, sig["Qe"], m, Qe)
+        put(xp, sig["Vt"], m, vt)
+        put(xp, sig["Ecomp"], m, vt)
+        put(xp, sig["theta"], m, xp.atan2(xp.imag(V), xp.real(V)))   # np.angle's arithmetic
+        put(xp, sig["XadIfd"], m, XadIfd)
 
 
 def saturated_rotor_angle(psi2, It, k, xq, xq2):

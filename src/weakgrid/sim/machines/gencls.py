@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels import Kernel, constants
+from ..namespace import take
 from .base import BASE_PARAMS, SyncMachine
 from .shaft import swing
 
@@ -37,6 +38,8 @@ class GENCLS(SyncMachine):
     Parameters, on the machine base unless stated:
     Sn [MVA], Vn [kV], fn [Hz], M = 2H [s], D [pu], ra [pu], xd1 = x'd [pu].
     """
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     #: PSS/E .dyr record after IBUS 'MODEL' ID (ICONs, then CONs: Program Application Guide order)
     psse_record = ("H", "D")
@@ -86,12 +89,12 @@ class GENCLS(SyncMachine):
         self._P = constants(self.n, (xq / det, ra / det, ra))
 
     def compute(self, ctx):
-        x = ctx.x
+        xp, x = self.xp, ctx.x
         delta, omega = x[..., self._sls[0]], x[..., self._sls[1]]
-        V = ctx.V[..., self._bi]
-        vf = ctx.sig["vf"][..., self._mi]
+        V = take(xp, ctx.V, self._bi)
+        vf = take(xp, ctx.sig["vf"], self._mi)
         Ire, Iim, Id, Iq, Pe, Qe, te = _KERNEL(
-            (np.sin(delta), np.cos(delta), V.real, V.imag, vf), self._P, (), ())
+            (xp.sin(delta), xp.cos(delta), xp.real(V), xp.imag(V), vf), self._P, (), ())
         self.inject(ctx, Ire + 1j * Iim)
         self._te = te
         self.publish(ctx, omega, delta, Pe, Qe, V, vf)
@@ -100,14 +103,15 @@ class GENCLS(SyncMachine):
         o["GENCLS.Id"], o["GENCLS.Iq"] = Id, Iq
 
     def finish(self, ctx):
+        xp = self.xp
         omega = ctx.x[..., self._sls[1]]
-        tm = ctx.sig["tm"][..., self.m]
-        ctx.out["GENCLS.vf"] = ctx.sig["vf"][..., self.m]
+        tm = take(xp, ctx.sig["tm"], self._mi)
+        ctx.out["GENCLS.vf"] = take(xp, ctx.sig["vf"], self._mi)
         te = self._te
         if self._psse_shaft is not None:   # PSS/E: the air-gap power over the speed (docstring)
-            te = np.where(self._psse_shaft, te / omega, te)
+            te = xp.where(self._psse_shaft, te / omega, te)
         d_delta, d_omega = swing(omega, tm, te, self.p["M"], self.p["D"], self.wb,
-                                 self._psse_shaft)
+                                 self._psse_shaft, xp)
         ctx.f[..., self._sls[0]] = d_delta
         ctx.f[..., self._sls[1]] = d_omega
 

@@ -36,6 +36,7 @@ import numpy as np
 from ..blocks import exp_saturation, quad_saturation_coeffs
 from ..errors import DataError
 from ..kernels import Kernel, constants
+from ..namespace import take
 from ..params import Param
 from .base import BASE_PARAMS, SyncMachine, psse_subtransient_params
 from .shaft import swing
@@ -50,6 +51,8 @@ class GENROU(SyncMachine):
     Sn, Vn, fn, M, D, ra, xd1 as in :class:`~weakgrid.sim.machines.gencls.GENCLS`;
     xl, xd, xq, xd2, xq1, xq2 [pu]; Td10, Td20, Tq10, Tq20 [s]; S10, S12 [pu].
     """
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     #: the last evaluation's values (read by ``finish``)
     scratch = ("_te", "_XadIfd")
@@ -167,14 +170,13 @@ class GENROU(SyncMachine):
                                    delta=delta, V=V)
 
     def compute(self, ctx):
-        x = ctx.x
-        sl = self._sls
+        xp, x, sl = self.xp, ctx.x, self._sls
         delta, omega = x[..., sl[0]], x[..., sl[1]]
-        V = ctx.V[..., self._bi]
-        sd, cd = np.sin(delta), np.cos(delta)
+        V = take(xp, ctx.V, self._bi)
+        sd, cd = xp.sin(delta), xp.cos(delta)
         (Ire, Iim, Id, Iq, XadIfd, Se, psi2, te, Pe, Qe, f3, f4, f5) = _KERNEL(
-            (x[..., sl[2]], x[..., sl[3]], x[..., sl[4]], x[..., sl[5]], sd, cd, V.real, V.imag),
-            self._P, self._flags, self._compiled_flags)
+            (x[..., sl[2]], x[..., sl[3]], x[..., sl[4]], x[..., sl[5]], sd, cd, xp.real(V),
+             xp.imag(V)), self._P, self._flags, self._compiled_flags)
         # injected current (Id + j Iq) exp(j(delta - pi/2))
         self.inject(ctx, Ire + 1j * Iim)
         self._te = te
@@ -191,13 +193,12 @@ class GENROU(SyncMachine):
 
     def finish(self, ctx):
         p = self.p
-        m = self._mi
-        sl = self._sls
+        xp, m, sl = self.xp, self._mi, self._sls
         omega = ctx.x[..., sl[1]]
-        vf = ctx.sig["vf"][..., m]
-        tm = ctx.sig["tm"][..., m]
+        vf = take(xp, ctx.sig["vf"], m)
+        tm = take(xp, ctx.sig["tm"], m)
         ctx.out[self._pre + "vf"] = vf
-        d_delta, d_omega = swing(omega, tm, self._te, p["M"], p["D"], self.wb, self._psse_shaft)
+        d_delta, d_omega = swing(omega, tm, self._te, p["M"], p["D"], self.wb, self._psse_shaft, xp)
         f = ctx.f
         f[..., sl[0]] = d_delta
         f[..., sl[1]] = d_omega
@@ -259,11 +260,12 @@ def genrou_core(s, p, ra0, sat):
 def quad_sat(psi2, A, B):
     """GENROU's saturation factor ``Se = B (psi2 - A)^2 / psi2`` for ``psi2 >= A``, else 0, and
     0 where that is not finite (arrays; :func:`quad_sat_scalar` is its compiled form)."""
-    if ((psi2 > 0) & (psi2 < np.inf)).all():   # fast path: same values as below there
+    ok = (psi2 > 0) & (psi2 < np.inf)
+    if np.all(ok):   # fast path: same values as below there
         return B * np.maximum(psi2 - A, 0.0) ** 2 / psi2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        Se = np.where(psi2 >= A, B * (psi2 - A) ** 2 / psi2, 0.0)
-    return np.where(np.isfinite(Se), Se, 0.0)
+    # elsewhere 0: where psi2 is 0 or not finite (divided by 1 there, nothing to warn of)
+    Se = B * np.maximum(psi2 - A, 0.0) ** 2 / np.where(ok, psi2, 1.0)
+    return np.where(ok & np.isfinite(Se), Se, 0.0)
 
 
 def quad_sat_scalar(psi2, A, B):

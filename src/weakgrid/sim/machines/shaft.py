@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 
-def swing(omega, tm, te, M, D, wb, psse=None):
+def swing(omega, tm, te, M, D, wb, psse=None, xp=np):
     """Return ``(d delta/dt, d omega/dt)`` of the single-mass shaft.
 
     Parameters
@@ -45,9 +45,11 @@ def swing(omega, tm, te, M, D, wb, psse=None):
     psse : ndarray of bool or None
         Where true, PSS/E's shaft: ``tm`` is the mechanical power and
         ``(tm - D dw) / omega`` the mechanical torque. ``None``: ANDES's everywhere.
+    xp : module
+        The arrays' namespace (:mod:`weakgrid.sim.namespace`).
     """
     dw = omega - 1.0
     if psse is None:
         return wb * dw, (tm - te - D * dw) / M
     tmd = tm - D * dw
-    return wb * dw, (np.where(psse, tmd / omega, tmd) - te) / M
+    return wb * dw, (xp.where(psse, tmd / omega, tmd) - te) / M

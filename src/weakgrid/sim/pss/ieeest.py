@@ -33,11 +33,14 @@ import numpy as np
 from ..blocks import LeadLag, Washout
 from ..control_base import MachineControl
 from ..errors import DataError
+from ..namespace import put, take
 from ..params import Param
 
 
 class IEEEST(MachineControl):
     """IEEE standard PSS. Parameters: MODE; A1..A6, T1..T6 [s]; KS [pu]; LSMAX, LSMIN, VCU, VCL [pu]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "pss"
     order = 1
@@ -130,22 +133,20 @@ class IEEEST(MachineControl):
         self._lp, self._ll, self._num = (a1, a2), (b1, b2), (A5, A6)
 
     def _signal(self, ctx):
-        p = self.p
-        m = self.mach
-        s = ctx.sig
+        xp, s, mi = self.xp, ctx.sig, self._mi
         if self._mode is not None:               # one input mode for all (the usual case)
-            mi = self._mi
             if self._mode == 1:
-                return s["omega"][..., mi] - 1.0
+                return take(xp, s["omega"], mi) - 1.0
             if self._mode == 3:
-                return s["Pe"][..., mi] * self._pe_scale
+                return take(xp, s["Pe"], mi) * self._pe_scale
             if self._mode == 4:
-                return s["tm"][..., mi] - s["tm0"][..., mi]
-            return s["Vt"][..., mi]
-        mode = p["MODE"]
-        return np.select([mode == 1, mode == 3, mode == 4, mode == 5],
-                         [s["omega"][..., m] - 1.0, s["Pe"][..., m] * self._pe_scale,
-                          s["tm"][..., m] - s["tm0"][..., m], s["Vt"][..., m]])
+                return take(xp, s["tm"], mi) - take(xp, s["tm0"], mi)
+            return take(xp, s["Vt"], mi)
+        mode = self.p["MODE"]      # per instance: numpy.select's choice, 0 for none
+        return xp.where(mode == 1, take(xp, s["omega"], mi) - 1.0,
+                        xp.where(mode == 3, take(xp, s["Pe"], mi) * self._pe_scale,
+                                 xp.where(mode == 4, take(xp, s["tm"], mi) - take(xp, s["tm0"], mi),
+                                          xp.where(mode == 5, take(xp, s["Vt"], mi), 0.0))))
 
     def init(self, system, x, sig):
         p = self.p
@@ -161,23 +162,20 @@ class IEEEST(MachineControl):
         x[self.sl(5)] = u0
         x[self.sl(6)] = p["KS"] * u0
 
-    @staticmethod
-    def _second_order(xa, xb, u, a1, a2):
+    def _second_order(self, xa, xb, u, a1, a2):
         """States of 1/(1 + a1 s + a2 s^2) (xa = output, xb = its derivative); a2 = 0 reduces order."""
+        xp = self.xp
         on2 = a2 > 0
         on1 = a1 > 0
-        a2s = np.where(on2, a2, 1.0)
-        a1s = np.where(on1, a1, 1.0)
-        dxa = np.where(on2, xb, np.where(on1, (u - xa) / a1s, 0.0))
-        dxb = np.where(on2, (u - xa - a1 * xb) / a2s, 0.0)
-        y = np.where(on2 | on1, xa, u)
+        a2s = xp.where(on2, a2, 1.0)
+        a1s = xp.where(on1, a1, 1.0)
+        dxa = xp.where(on2, xb, xp.where(on1, (u - xa) / a1s, 0.0))
+        dxb = xp.where(on2, (u - xa - a1 * xb) / a2s, 0.0)
+        y = xp.where(on2 | on1, xa, u)
         return y, dxa, dxb
 
     def compute(self, ctx):
-        p = self.p
-        x = ctx.x
-        f = ctx.f
-        sl = self._sls
+        xp, p, x, f, sl = self.xp, self.p, ctx.x, ctx.f, self._sls
         u = self._signal(ctx)
         if self._filt1:
             y1, f[..., sl[0]], f[..., sl[1]] = self._second_order(x[..., sl[0]], x[..., sl[1]], u, *self._lp)
@@ -188,8 +186,8 @@ class IEEEST(MachineControl):
             b1, b2 = self._ll
             A5, A6 = self._num
             w, f[..., sl[2]], f[..., sl[3]] = self._second_order(x[..., sl[2]], x[..., sl[3]], y1, b1, b2)
-            wdot = np.where(b2 > 0, x[..., sl[3]], np.where(b1 > 0, f[..., sl[2]], 0.0))
-            wdd = np.where(b2 > 0, f[..., sl[3]], 0.0)
+            wdot = xp.where(b2 > 0, x[..., sl[3]], xp.where(b1 > 0, f[..., sl[2]], 0.0))
+            wdd = xp.where(b2 > 0, f[..., sl[3]], 0.0)
             y2 = w + A5 * wdot + A6 * wdd
         else:
             y2 = y1
@@ -199,10 +197,10 @@ class IEEEST(MachineControl):
         vks = p["KS"] * y4
         vss, f[..., sl[6]] = self.WO.output_deriv(x6, vks)
         if self._any_wo_lag:
-            vss = np.where(self._wo_lag, x6, vss)
-        vs = np.minimum(np.maximum(vss, p["LSMIN"]), p["LSMAX"])
+            vss = xp.where(self._wo_lag, x6, vss)
+        vs = xp.minimum(xp.maximum(vss, p["LSMIN"]), p["LSMAX"])
         if not self._no_cut:
-            vt = ctx.sig["Vt"][..., self._mi]
-            vs = np.where((vt > self.VCL) & (vt < self.VCU), vs, 0.0)
-        ctx.sig["vs"][..., self._mi] = vs
+            vt = take(xp, ctx.sig["Vt"], self._mi)
+            vs = xp.where((vt > self.VCL) & (vt < self.VCU), vs, 0.0)
+        put(xp, ctx.sig["vs"], self._mi, vs)
         ctx.out["IEEEST.sig"], ctx.out["IEEEST.vss"] = u, vss

@@ -29,8 +29,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..blocks import Lag, Washout
-from ..component import Component, scatter_add
+from ..component import Component
 from ..errors import DataError
+from ..namespace import add_at
 from ..params import Param
 
 
@@ -213,7 +214,7 @@ class PVD1(Component):
         fHz = self.p["fn"] * (1.0 + df)
         ipcmd, iqcmd, R, _, ipul = self._commands(v, V, fHz, ipout, iqout, self._ip_gates(x))
         vs = np.where(v > 1e-6, v, 1e-6)
-        scatter_add(ctx.I, self.bus, self.connected((ipout - 1j * iqout) * V / vs), self._uniq)
+        add_at(self.xp, ctx.I, self.bus, self.connected((ipout - 1j * iqout) * V / vs), self._uniq)
         f = ctx.f
         f[..., sl[0]] = err / self.Lb._Ts
         f[..., sl[1]] = self.WOb.deriv(wo, L)

@@ -73,8 +73,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..blocks import Lag, LagRate, piecewise_linear
-from ..component import Component, scatter_add
+from ..component import Component
 from ..errors import DataError
+from ..namespace import add_at
 from ..params import Param
 
 
@@ -276,7 +277,7 @@ class REGCA1(Component):
         iqout = np.clip(s1 - hvg, p["Iolim"], 9999.0)
         vs = np.where(v > 1e-6, v, 1e-6)
         I = (ipout - 1j * iqout) * V / vs
-        scatter_add(ctx.I, self.bus, self.connected(I), self._uniq)
+        add_at(self.xp, ctx.I, self.bus, self.connected(I), self._uniq)
         # the converter's P and Q: with |V|, or with PSS/E's per-step estimate Vest
         vp = np.where(self._psse_if, 0.5 * (self._vest + v), v)
         # commands: constant unless an electrical control (REECA1) publishes them

@@ -30,8 +30,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..component import Component, scatter_add
+from ..component import Component
 from ..errors import DataError
+from ..namespace import add_at
 from ..network import PD, QD
 
 
@@ -148,7 +149,7 @@ class _BusConstraint(Component):
         V = ctx.V[..., self.bus]
         Isrc = Inet - ctx.I[..., self.bus]
         R = self.residual(V, Isrc)
-        scatter_add(ctx.I, self.bus, Isrc - R, True)
+        add_at(self.xp, ctx.I, self.bus, Isrc - R, True)
         S = V * np.conj(Isrc)
         ctx.out[f"{self.type_name}.P"], ctx.out[f"{self.type_name}.Q"] = S.real, S.imag
 
