@@ -35,8 +35,10 @@ What each member keeps of its own, so that its trajectory is the one of its one-
 (``exact=True``) so that a batch's members keep one step size; results equal one-by-one runs
 either way.
 
-The array code uses the namespace ``xp`` (NumPy) so that an array-API backend could replace
-it for large batches; the linear solves stay per member (LAPACK through
+Most of a step is the devices' evaluation of every member in one call, written for any
+array-API namespace (:mod:`weakgrid.sim.namespace`: an accelerator's arrays could replace
+NumPy's there); the batch's own arithmetic around it (the Newton updates, the held limits,
+the recorder) is NumPy's, and the linear solves stay per member (LAPACK through
 :mod:`weakgrid.sim.linsolve`, exactly the one-by-one factorization and solve).
 
 Per-member parameters: a member may bring its own grid (``scenario["system"]``, e.g. built by a
@@ -73,8 +75,6 @@ from .component import fast_index
 from .errors import DataError, SimulationError
 from .integrate import Simulator, _held, _held_change, _output_path, jump_guess
 from .results import Results
-
-xp = np     # the array namespace of the batched arithmetic (array API: swap for another backend)
 
 log = logging.getLogger(__name__)
 
@@ -134,16 +134,16 @@ class _BatchRecorder:
             if rec.sel is not None:
                 self._pieces = self._selected_pieces()
         if rec.sel is not None:
-            self.blocks.append((t, xp.asarray(members), self._selected(Z, ctx, pos)))
+            self.blocks.append((t, np.asarray(members), self._selected(Z, ctx, pos)))
             return
         nx, nb = self.sys.nx, self.sys.nb
-        row = xp.empty((len(members), rec._ncol))
+        row = np.empty((len(members), rec._ncol))
         row[:, :nx] = Z[:, :nx]
         Vr, Vi = Z[:, nx:nx + nb], Z[:, nx + nb:]
         bus = row[:, rec._bus]
         bus[:, 0::4], bus[:, 1::4] = Vr, Vi
-        bus[:, 2::4] = xp.hypot(Vr, Vi)
-        bus[:, 3::4] = xp.arctan2(Vi, Vr)
+        bus[:, 2::4] = np.hypot(Vr, Vi)
+        bus[:, 3::4] = np.arctan2(Vi, Vr)
         if self._ocols is None:
             self._ocols = fast_index([c for _, sl in rec._outs for c in range(sl.start, sl.stop)])
             self._okeys = [(key, sl.stop - sl.start) for key, sl in rec._outs]
@@ -151,14 +151,14 @@ class _BatchRecorder:
         every = len(pos) == n and list(pos) == list(range(n))    # all rows, in order: no gather
         if self._okeys:    # every output of the rows in one gather
             out = ctx.out
-            cols = [v if getattr(v, "ndim", 0) >= 2 else xp.broadcast_to(v, (n, w))
+            cols = [v if getattr(v, "ndim", 0) >= 2 else np.broadcast_to(v, (n, w))
                     for v, w in ((out[key], w) for key, w in self._okeys)]
-            cat = xp.concatenate(cols, axis=1)
+            cat = np.concatenate(cols, axis=1)
             row[:, self._ocols] = cat if every else cat[pos]
         tm, vs = ctx.sig["tm"], ctx.sig["vs"]
         row[:, rec._tm] = tm if every else tm[pos]
         row[:, rec._vs] = vs if every else vs[pos]
-        self.blocks.append((t, xp.asarray(members), row))
+        self.blocks.append((t, np.asarray(members), row))
 
     def _selected_pieces(self) -> list:
         """Where each selected column of a row comes from (a recorder with ``record``): a
@@ -193,18 +193,18 @@ class _BatchRecorder:
         n = ctx.x.shape[0]
         every = len(pos) == n and list(pos) == list(range(n))
         nx, nb = self.sys.nx, self.sys.nb
-        row = xp.empty((len(Z), len(self.rec.sel)))
+        row = np.empty((len(Z), len(self.rec.sel)))
         for src, cols, idx in self._pieces:
             if src == "z":
                 row[:, cols] = Z[:, idx]
                 continue
             if src in ("v", "a"):
                 Vr, Vi = Z[:, nx:nx + nb][:, idx], Z[:, nx + nb:][:, idx]
-                row[:, cols] = xp.hypot(Vr, Vi) if src == "v" else xp.arctan2(Vi, Vr)
+                row[:, cols] = np.hypot(Vr, Vi) if src == "v" else np.arctan2(Vi, Vr)
                 continue
             v = ctx.out[src[1]] if isinstance(src, tuple) else ctx.sig[src]
             if getattr(v, "ndim", 0) < 2:   # the same for every row
-                row[:, cols] = xp.asarray(v)[idx]
+                row[:, cols] = np.asarray(v)[idx]
             else:
                 row[:, cols] = (v if every else v[pos])[:, idx]
         return row
@@ -213,20 +213,20 @@ class _BatchRecorder:
         """One :class:`Results` per member ``0..B-1``."""
         rec = self.rec
         if not rec._layout_done:    # nothing recorded (every member failed at t = 0)
-            return [Results(xp.zeros(0), [], xp.zeros((0, 0)), [], [], failure=failures[k], stats=stats[k])
+            return [Results(np.zeros(0), [], np.zeros((0, 0)), [], [], failure=failures[k], stats=stats[k])
                     for k in range(B)]
         recorded = bool(self.blocks)
         if recorded:
             # each recorded row straight to its place in the rows sorted by member (stable: in
             # time within a member), block by block, each block released once placed: one copy
             # of the records, not a concatenation and a gather of it (two copies, 3× the memory)
-            K = xp.concatenate([m for _, m, _ in self.blocks])
-            order = xp.argsort(K, kind="stable")
-            cut = xp.searchsorted(K[order], xp.arange(B + 1))
-            dest = xp.empty_like(order)
-            dest[order] = xp.arange(len(order))
-            T = xp.empty(len(K))
-            D = xp.empty((len(K), self.blocks[0][2].shape[1]))
+            K = np.concatenate([m for _, m, _ in self.blocks])
+            order = np.argsort(K, kind="stable")
+            cut = np.searchsorted(K[order], np.arange(B + 1))
+            dest = np.empty_like(order)
+            dest[order] = np.arange(len(order))
+            T = np.empty(len(K))
+            D = np.empty((len(K), self.blocks[0][2].shape[1]))
             s = 0
             blocks, self.blocks = self.blocks, []
             for i, (t, m, d) in enumerate(blocks):
@@ -241,7 +241,7 @@ class _BatchRecorder:
                 a, b = cut[k], cut[k + 1]
                 t, data = T[a:b], D[a:b]     # views of the arrays sorted above: no copy
             else:
-                t, data = xp.zeros(0), xp.zeros((0, len(rec.names)))
+                t, data = np.zeros(0), np.zeros((0, len(rec.names)))
             out.append(Results(t, list(rec.names), data, list(rec.kinds), list(rec.fac),
                                failure=failures[k], stats=stats[k]))
         return out
@@ -393,10 +393,10 @@ def member_params(systems) -> list:
         for name in getattr(c, "batch_params", ()):
             if _bp_get(c, name) is None:
                 continue
-            rows = [xp.asarray(_bp_get(s.comps[j], name)) for s in systems]
-            rows = [r.astype(complex if xp.iscomplexobj(r) else float) for r in rows]   # a phasor stays one
-            if any(not xp.array_equal(r, rows[0]) for r in rows[1:]):
-                out.append((j, name, xp.stack(rows)))
+            rows = [np.asarray(_bp_get(s.comps[j], name)) for s in systems]
+            rows = [r.astype(complex if np.iscomplexobj(r) else float) for r in rows]   # a phasor stays one
+            if any(not np.array_equal(r, rows[0]) for r in rows[1:]):
+                out.append((j, name, np.stack(rows)))
     return out
 
 
@@ -405,9 +405,9 @@ def member_signals(systems):
     member grids ``systems`` stacked on a batch axis, ``(n_sig, B, n_machines)``; None when
     they are equal."""
     rows = [s._sig_stack for s in systems]
-    if all(xp.array_equal(r, rows[0]) for r in rows[1:]):
+    if all(np.array_equal(r, rows[0]) for r in rows[1:]):
         return None
-    return xp.stack(rows, axis=1)
+    return np.stack(rows, axis=1)
 
 
 def _member_system(system, scenario):
@@ -483,21 +483,21 @@ class BatchSimulator:
         self._inputs = []
         for c in self.tmpl.comps:
             for attr in getattr(c, "batch_inputs", ()):
-                stack = xp.stack([xp.asarray(getattr(s.sys.components[c.type_name], attr), dtype=float)
+                stack = np.stack([np.asarray(getattr(s.sys.components[c.type_name], attr), dtype=float)
                                   for s in self.sims])
                 for k, s in enumerate(self.sims):
                     setattr(s.sys.components[c.type_name], attr, stack[k])
                 self._inputs.append((c, attr, stack))
         # the states held at a limit: one (B, n_lim) array, each member's ``frozen`` a row view
         self._nlim = len(system.lim_idx)
-        self.frozen = xp.zeros((self.B, self._nlim), dtype=np.int8)
+        self.frozen = np.zeros((self.B, self._nlim), dtype=np.int8)
         for k, s in enumerate(self.sims):
             s.frozen = self.frozen[k]
         # each member's limits (fixed: limits that move with the solution are refused)
-        self.lim_hi = xp.stack([s.sys.lim_hi for s in self.sims])
-        self.lim_lo = xp.stack([s.sys.lim_lo for s in self.sims])
+        self.lim_hi = np.stack([s.sys.lim_hi for s in self.sims])
+        self.lim_lo = np.stack([s.sys.lim_lo for s in self.sims])
         nb = system.nb
-        self.Y = xp.empty((self.B, 2 * nb, 2 * nb))
+        self.Y = np.empty((self.B, 2 * nb, 2 * nb))
         self._ynet = [None] * self.B
         self.timing = dict.fromkeys(TIMED, 0.0)
         self.steps = 0
@@ -524,15 +524,15 @@ class BatchSimulator:
             return      # the stacks themselves are bound (row writes show through)
         for c, attr, stack in self._inputs:
             a = stack if every else stack[rows]
-            setattr(c, attr, a if rep == 1 else xp.repeat(a, rep, axis=0))
+            setattr(c, attr, a if rep == 1 else np.repeat(a, rep, axis=0))
         if same:
             return
         for c, name, stack in self._params:
             a = stack if every else stack[rows]
-            _bp_set(c, name, a if rep == 1 else xp.repeat(a, rep, axis=0))
+            _bp_set(c, name, a if rep == 1 else np.repeat(a, rep, axis=0))
         if self._signals is not None:   # Context reads them with the batch axis
             a = self._signals if every else self._signals[:, rows]
-            self.tmpl._sig_stack = a if rep == 1 else xp.repeat(a, rep, axis=1)
+            self.tmpl._sig_stack = a if rep == 1 else np.repeat(a, rep, axis=1)
         self._bound = key
 
     def _sync_network(self, rows):
@@ -557,12 +557,12 @@ class BatchSimulator:
         one = len(rows) == 1
         if one:
             self._bind_inputs(rows, 2)
-            Z = xp.repeat(Z, 2, axis=0)
+            Z = np.repeat(Z, 2, axis=0)
         else:
             self._bind_inputs(rows)
         F, ctx = self.tmpl.device_residual(t, Z)
         Y = self.Y if self._every(rows) else self.Y[rows]
-        F[:, nx:] += xp.matmul(Y, Z[:, nx:, None])[..., 0]
+        F[:, nx:] += np.matmul(Y, Z[:, nx:, None])[..., 0]
         self.timing["residual"] += time.perf_counter() - t0
         return (F[:1], ctx) if one else (F, ctx)
 
@@ -572,8 +572,8 @@ class BatchSimulator:
         t0 = time.perf_counter()
         s = self.tmpl
         nc, N = s.ncolours, self.N
-        H = 1e-7 * xp.maximum(1.0, xp.abs(Z))
-        P = xp.repeat(Z[:, None, :], nc + 1, axis=1)
+        H = 1e-7 * np.maximum(1.0, np.abs(Z))
+        P = np.repeat(Z[:, None, :], nc + 1, axis=1)
         cols = s._ccols
         P[:, s.colour[cols] + 1, cols] += H[:, cols]
         self._bind_inputs(rows, nc + 1)
@@ -599,10 +599,10 @@ class BatchSimulator:
         nx = self.nx
         done = {}
         n = len(rows)
-        live = xp.arange(n)
-        prev = xp.full(n, math.inf)
-        grow = xp.zeros(n, dtype=int)
-        tol = xp.asarray([self.sims[k].tol for k in rows])
+        live = np.arange(n)
+        prev = np.full(n, math.inf)
+        grow = np.zeros(n, dtype=int)
+        tol = np.asarray([self.sims[k].tol for k in rows])
         Z = Z.copy()
         for it in range(30):
             if not len(live):
@@ -610,14 +610,14 @@ class BatchSimulator:
             idx = [rows[j] for j in live.tolist()]
             F, ctx = self.residual(t, Z[live], idx)
             dy = self._alg_solve(idx, F[:, nx:])
-            nrm = xp.abs(dy).max(axis=1)
-            fin = xp.isfinite(nrm)
+            nrm = np.abs(dy).max(axis=1)
+            fin = np.isfinite(nrm)
             conv = fin & (nrm < tol[live])
-            for i in xp.nonzero(conv)[0].tolist():
+            for i in np.nonzero(conv)[0].tolist():
                 j = int(live[i])
                 done[rows[j]] = (Z[j].copy(), F[i].copy(), (ctx, i))
                 self.sims[rows[j]].stats["evals"] += it + 1   # a member that falls back counts its own
-            g = xp.where(nrm > 0.9 * prev[live], grow[live] + 1, 0)
+            g = np.where(nrm > 0.9 * prev[live], grow[live] + 1, 0)
             go = fin & ~conv & (g < 2)
             grow[live] = g
             keep = live[go]
@@ -633,13 +633,13 @@ class BatchSimulator:
         bit-equal where NumPy and SciPy share one LAPACK (NumPy 2 with SciPy's OpenBLAS), 1e-8
         off with another Newton count under NumPy 1.26's own OpenBLAS (then supported), and it
         saved little (the chord's time is its residual evaluations)."""
-        return xp.stack([self.sims[k]._alg_lu_get().solve(r) for k, r in zip(ks, R)])
+        return np.stack([self.sims[k]._alg_lu_get().solve(r) for k, r in zip(ks, R)])
 
     def _solve(self, lus, idx, R):
         """Chord solves ``M_j x = R[i]`` for ``j = idx[i]`` with each member's LU factors (LAPACK
         ``getrs``: the arithmetic of its run alone; a batched product with the inverses was
         slower here — more refreshes, a factorization's inverse per refresh — and not exact)."""
-        out = xp.empty(R.shape)
+        out = np.empty(R.shape)
         for i, j in enumerate(idx):
             out[i] = lus[j].solve(R[i])
         return out
@@ -660,14 +660,14 @@ class BatchSimulator:
             fz = FR != 0
             if fz.any():
                 li = self.tmpl.lim_idx
-                FZ, LV = xp.zeros((n, N), dtype=bool), xp.zeros((n, N))
+                FZ, LV = np.zeros((n, N), dtype=bool), np.zeros((n, N))
                 FZ[:, li] = fz
-                LV[:, li] = xp.where(fz, xp.where(FR > 0, self.lim_hi[rows], self.lim_lo[rows]), 0.0)
+                LV[:, li] = np.where(fz, np.where(FR > 0, self.lim_hi[rows], self.lim_lo[rows]), 0.0)
         # linearly implicit predictor of every member (used by those without a guess)
-        Rp = xp.zeros((n, N))
+        Rp = np.zeros((n, N))
         Rp[:, :nx] = -h * Fn
         if FZ is not None:
-            Rp = xp.where(FZ, Zn - LV, Rp)
+            Rp = np.where(FZ, Zn - LV, Rp)
         Zp = Zn - self._solve(lus, range(n), Rp)
         Z = Zp.copy()
         refresh = []
@@ -682,7 +682,7 @@ class BatchSimulator:
             else:
                 Z[j] = guess[k]
         if FZ is not None:
-            Z = xp.where(FZ, LV, Z)
+            Z = np.where(FZ, LV, Z)
         if refresh:   # the chord matrix refreshed at the predicted points (all in one evaluation)
             self.refresh_jacobian(t1, Z[refresh], [rows[j] for j in refresh])
             t0 = time.perf_counter()
@@ -695,7 +695,7 @@ class BatchSimulator:
         hh = 0.5 * h
         C = Zn[:, :nx] + hh * Fn
         done, failed = {}, set()
-        live = xp.arange(n)
+        live = np.arange(n)
         max_iter = self.sims[rows[0]].max_iter
         tol = self.sims[rows[0]].tol
         for it in range(max_iter):
@@ -705,14 +705,14 @@ class BatchSimulator:
             R = F
             R[:, :nx] = Z[live, :nx] - C[live] - hh * f
             if FZ is not None:
-                R = xp.where(FZ[live], Z[live] - LV[live], R)
+                R = np.where(FZ[live], Z[live] - LV[live], R)
             dz = self._solve(lus, live.tolist(), R)
-            nrm = xp.abs(dz).max(axis=1)
-            bad = ~xp.isfinite(nrm)
+            nrm = np.abs(dz).max(axis=1)
+            bad = ~np.isfinite(nrm)
             conv = nrm < tol
             stop = bad | conv
             if stop.any():
-                for i in xp.nonzero(stop)[0].tolist():
+                for i in np.nonzero(stop)[0].tolist():
                     j = int(live[i])
                     k = rows[j]
                     st = self.sims[k].stats
@@ -780,8 +780,8 @@ class BatchSimulator:
         pending = list(act)
         eject = []
         while pending:
-            Zn = xp.stack([zn[k] for k in pending])
-            Fn = xp.stack([fn[k] for k in pending])
+            Zn = np.stack([zn[k] for k in pending])
+            Fn = np.stack([fn[k] for k in pending])
             done, failed = self._newton(t + h, h, Zn, Fn, pending, guess, corr)
             nxt = []
             fresh = []
@@ -796,11 +796,11 @@ class BatchSimulator:
                         eject.append(k)
             ok = [k for k in pending if k in done]
             if ok and self._nlim:
-                Zd = xp.stack([done[k][0] for k in ok])
-                F1 = xp.stack([done[k][2] for k in ok])
+                Zd = np.stack([done[k][0] for k in ok])
+                F1 = np.stack([done[k][2] for k in ok])
                 new_hi, new_lo = self._limits(ok, Zd, F1)
                 hit = (new_hi | new_lo).any(axis=1)
-                for j in xp.nonzero(hit)[0].tolist():   # redo the step with them held
+                for j in np.nonzero(hit)[0].tolist():   # redo the step with them held
                     k = ok[j]
                     sim, s, li = self.sims[k], self.sims[k].sys, self.tmpl.lim_idx
                     z, nh, nl = done[k][0], new_hi[j], new_lo[j]
@@ -830,7 +830,7 @@ class BatchSimulator:
                 sim.t = sim.t + h     # its own time (the batch's to round-off)
                 sim.stats["steps"] += 1
             if fresh:
-                self.refresh_jacobian(t, xp.stack([zn[k] for k in fresh]), fresh)
+                self.refresh_jacobian(t, np.stack([zn[k] for k in fresh]), fresh)
             pending = nxt
         return eject
 
@@ -870,7 +870,7 @@ class BatchSimulator:
             self._failed.add(k)
 
         # initial point: network solved with the initial Jacobian, controllers' first samples
-        Z = xp.stack([self.sims[k].z for k in act])
+        Z = np.stack([self.sims[k].z for k in act])
         self.refresh_jacobian(0.0, Z, act)
         self._solve_jump(0.0, act, {}, {}, fail)
         with_ctl = [k for k in act if ctls[k]]
@@ -881,7 +881,7 @@ class BatchSimulator:
         self._accept_all(act)
         for k in act:
             ctx, j = self._cx[k]
-            self.sims[k]._delta0 = xp.array(ctx.sig["delta"][j], dtype=float, copy=True)
+            self.sims[k]._delta0 = np.array(ctx.sig["delta"][j], dtype=float, copy=True)
         self._record(act, recs)
         ev_i = [0] * B
         nstep = [0] * B
@@ -1013,7 +1013,7 @@ class BatchSimulator:
         guesses, du = {}, {}
         fresh = [k for k in jumps if new_jac.get(k)]
         if fresh:
-            self.refresh_jacobian(self.t, xp.stack([self.sims[k].z for k in fresh]), fresh)
+            self.refresh_jacobian(self.t, np.stack([self.sims[k].z for k in fresh]), fresh)
         for k in jumps:
             sim = self.sims[k]
             if new_jac.get(k):
@@ -1044,7 +1044,7 @@ class BatchSimulator:
         evaluated together, once."""
         miss = [k for k in act if k not in self._cx]
         if miss:
-            F, ctx = self.residual(self.t, xp.stack([self.sims[k].z for k in miss]), miss)
+            F, ctx = self.residual(self.t, np.stack([self.sims[k].z for k in miss]), miss)
             for j, k in enumerate(miss):
                 self._cx[k] = (ctx, j)
 
@@ -1064,7 +1064,7 @@ class BatchSimulator:
             return
         t0 = time.perf_counter()
         for ctx, ks, pos in self._by_ctx(rows):
-            recs.add(xp.asarray([self.sims[k].t for k in ks]), ks, xp.stack([self.sims[k].z for k in ks]),
+            recs.add(np.asarray([self.sims[k].t for k in ks]), ks, np.stack([self.sims[k].z for k in ks]),
                      ctx, pos)
         self.timing["record"] += time.perf_counter() - t0
 
@@ -1073,19 +1073,19 @@ class BatchSimulator:
         :meth:`_accept_all`), per member (as :meth:`Simulator._check`)."""
         if not act:
             return
-        Z = xp.stack([self.sims[k].z for k in act])
-        bad = ~(xp.abs(Z).max(axis=1) <= 1e6)
+        Z = np.stack([self.sims[k].z for k in act])
+        bad = ~(np.abs(Z).max(axis=1) <= 1e6)
         d = None
         at = {k: j for j, k in enumerate(act)}
         for ctx, ks, pos in self._by_ctx(act):
             dg = ctx.sig["delta"]
             if d is None:
-                d = xp.empty((len(act), dg.shape[-1]))
+                d = np.empty((len(act), dg.shape[-1]))
             d[[at[k] for k in ks]] = dg[pos]
         if d.shape[-1] > 1:
-            e = d - xp.stack([self.sims[k]._delta0 for k in act])
+            e = d - np.stack([self.sims[k]._delta0 for k in act])
             bad |= (e.max(axis=1) - e.min(axis=1)) > self.sims[act[0]].max_spread
-        for j in xp.nonzero(bad)[0].tolist():
+        for j in np.nonzero(bad)[0].tolist():
             k = act[j]
             sim = self.sims[k]
             sim._ctx = sim.sys.residual(sim.t, sim.z)[1]   # the member's own evaluation
@@ -1173,7 +1173,7 @@ class BatchSimulator:
         except Exception:    # a member's own error: each called alone, as in its run
             U, mk, mc, M = self._call_alone(t, mk, mc, M, changed, fail)
         try:
-            U = xp.asarray(U, dtype=float)
+            U = np.asarray(U, dtype=float)
             if mk and (U.ndim != 2 or U.shape[0] != len(mk)):
                 raise ValueError(f"a batched policy returned {U.shape[0] if U.ndim else 0} rows "
                                  f"for {len(mk)} (an array of shape {U.shape})")
@@ -1182,8 +1182,8 @@ class BatchSimulator:
                 fail(k, SimulationError(t, "controller", f"'{c.name}' raised {exc!r}"))
                 del changed[k]
             return
-        ok = (xp.isfinite(U).all(axis=1) if mk and U.shape[1] == mc[0].target.size
-              else xp.zeros(len(mk), dtype=bool))
+        ok = (np.isfinite(U).all(axis=1) if mk and U.shape[1] == mc[0].target.size
+              else np.zeros(len(mk), dtype=bool))
         for i, (k, c) in enumerate(zip(mk, mc)):
             if not ok[i]:    # its own message (as its run alone)
                 try:
@@ -1218,8 +1218,8 @@ class BatchSimulator:
             mc.append(c)
             mm.append(m)
         if not mk:
-            return xp.zeros((0, 0)), mk, mc, M[:0]
-        return xp.stack(U), mk, mc, xp.stack(mm)
+            return np.zeros((0, 0)), mk, mc, M[:0]
+        return np.stack(U), mk, mc, np.stack(mm)
 
     def _measure(self, t, ks, cs, fail):
         """The measurements of controllers ``cs`` of members ``ks`` at their accepted points:
@@ -1235,11 +1235,11 @@ class BatchSimulator:
                 Y = rows_of([fns[at[k]] for k in g], [self.sims[k] for k in g], t, ctx, pos)
                 if Y is None:
                     break
-                blocks.append(([at[k] for k in g], xp.asarray(Y, dtype=float)))
+                blocks.append(([at[k] for k in g], np.asarray(Y, dtype=float)))
             else:
                 if len(blocks) == 1:      # one context: the rows in the members' order
                     return list(ks), list(cs), blocks[0][1]
-                M = xp.empty((len(ks), blocks[0][1].shape[1]))
+                M = np.empty((len(ks), blocks[0][1].shape[1]))
                 for idx, Y in blocks:
                     M[idx] = Y
                 return list(ks), list(cs), M
@@ -1254,8 +1254,8 @@ class BatchSimulator:
                 continue
             mk.append(k)
             mc.append(c)
-            M.append(xp.asarray(m, dtype=float))
-        return mk, mc, (xp.stack(M) if M else xp.zeros((0, 0)))
+            M.append(np.asarray(m, dtype=float))
+        return mk, mc, (np.stack(M) if M else np.zeros((0, 0)))
 
     def _hold(self, t, ks, cs, U):
         """Hold output ``U[i]`` (checked) on the target of controller ``cs[i]`` of member
@@ -1271,14 +1271,14 @@ class BatchSimulator:
                 any(getattr(c.target, "slots", lambda: None)() != slots for c in cs[1:]):
             out = []
             for c, u in zip(cs, U):
-                ch = not xp.array_equal(c.target.get(), u)
+                ch = not np.array_equal(c.target.get(), u)
                 if ch:
                     c.target.apply(u)
                 out.append(ch)
             return out
-        U = xp.stack([xp.asarray(u, dtype=float) for u in U])
-        rows = xp.asarray(ks)
-        old = xp.stack([where[(typ, attr)][rows, i] for typ, attr, i in slots], axis=1)
+        U = np.stack([np.asarray(u, dtype=float) for u in U])
+        rows = np.asarray(ks)
+        old = np.stack([where[(typ, attr)][rows, i] for typ, attr, i in slots], axis=1)
         ch = (old != U).any(axis=1)
         if ch.any():
             r = rows[ch]
@@ -1294,7 +1294,7 @@ class BatchSimulator:
         if not rows:
             return
         nx = self.nx
-        Z = xp.stack([self.sims[k].z for k in rows])
+        Z = np.stack([self.sims[k].z for k in rows])
         for j, k in enumerate(rows):
             if guesses.get(k) is not None:
                 Z[j, nx:] = guesses[k]
