@@ -20,12 +20,15 @@ from __future__ import annotations
 
 from ..blocks import Lag, LeadLag, hard_limit
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 
 
 class EXAC4(MachineControl):
     """IEEE AC4 exciter. Times [s]: TR, TC, TB, TA; gains [pu]: KA, KC;
     limits VIMAX, VIMIN, VRMAX, VRMIN [pu, machine base]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -70,19 +73,20 @@ class EXAC4(MachineControl):
              "VRMIN - KC*XadIfd", "VRMAX - KC*XadIfd")]
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         lg, ll, vr = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        xad = s["XadIfd"][..., m]
-        vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
-        vil = hard_limit(vi, p["VIMIN"], p["VIMAX"])
+        v = take(xp, s["Ecomp"], m)
+        xad = take(xp, s["XadIfd"], m)
+        vi = self.vref0 - self.LG.output(lg, v) + take(xp, s["vs"], m)
+        vil = hard_limit(vi, p["VIMIN"], p["VIMAX"], xp)
         y = self.LL.output(ll, vil)
-        efd = hard_limit(self.LR.output(vr, y), p["VRMIN"] - p["KC"] * xad, p["VRMAX"] - p["KC"] * xad)
+        efd = hard_limit(self.LR.output(vr, y), p["VRMIN"] - p["KC"] * xad, p["VRMAX"] - p["KC"] * xad,
+                         xp)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LL.deriv(ll, vil)
         f[..., self._sls[2]] = self.LR.deriv(vr, y)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         ctx.out["EXAC4.vi"], ctx.out["EXAC4.vout"] = vi, efd

@@ -31,9 +31,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..blocks import Lag, LeadLag, PINonWindup, hard_limit, rectifier_fex
+from ..blocks import Lag, LeadLag, PINonWindup, hard_limit, quad_saturation, rectifier_fex
 from ..control_base import MachineControl
 from ..errors import DataError
+from ..namespace import NUMPY, put, take
 from ..params import Param
 from .dc_common import SATURATION_PARAMS, DCExciter
 
@@ -42,6 +43,8 @@ class EXPIC1(MachineControl):
     """Proportional/integral exciter. Times [s]: TR, TA1, TA2, TA3, TA4, TF1, TF2, TE; gains: KA
     [1/s], KF, KE, KP, KI, KC [pu]; limits [pu, machine base]: VR1, VR2 (PI), VRMAX, VRMIN
     (regulator), EFDMAX, EFDMIN (exciter input); E1, SE1, E2, SE2 (exciter saturation)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -96,6 +99,8 @@ class EXPIC1(MachineControl):
         self.FB1 = Lag(1.0, p["TF1"])
         self.FB2 = Lag(1.0, p["TF2"])
         self.EX = DCExciter(p["KE"], p["TE"], p["E1"], p["SE1"], p["E2"], p["SE2"])
+        #: the DC exciter's arrays (KE, A, B), held by the model for its namespace
+        self._ex = (self.EX.KE, self.EX.A, self.EX.B)
         self._te = p["TE"] > 0
         self._te_s = np.where(self._te, p["TE"], 1.0)
         self._nosrc = (p["KP"] == 0) & (p["KI"] == 0)
@@ -104,13 +109,12 @@ class EXPIC1(MachineControl):
     def limits(self):
         return [(self.idx("PI"), self.p["VR2"], self.p["VR1"])]
 
-    def _vb(self, V, S, xad):
+    def _vb(self, V, S, xad, xp=NUMPY):
         p = self.p
-        It = np.conj(S / V) * self._ibase
-        VE = np.abs(p["KP"] * V + 1j * p["KI"] * It)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            IN = np.where(VE > 0, p["KC"] * xad / np.where(VE > 0, VE, 1.0), 0.0)
-        return np.where(self._nosrc, 1.0, VE * rectifier_fex(IN))
+        It = xp.conj(S / V) * self._ibase
+        VE = xp.abs(p["KP"] * V + 1j * p["KI"] * It)
+        IN = xp.where(VE > 0, p["KC"] * xad / xp.where(VE > 0, VE, 1.0), 0.0)   # VE kept off 0
+        return xp.where(self._nosrc, 1.0, VE * rectifier_fex(IN, xp))
 
     def init(self, system, x, sig):
         p = self.p
@@ -137,25 +141,26 @@ class EXPIC1(MachineControl):
                                ("E0", E00, p["EFDMIN"], p["EFDMAX"], "EFDMIN", "EFDMAX")]
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
+        KE, A, B = self._ex
         m = self._mi
         lg, pi, x1, ll, vf1, vf, efd_x = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        xad = s["XadIfd"][..., m]
+        v = take(xp, s["Ecomp"], m)
+        xad = take(xp, s["XadIfd"], m)
         # rate feedback output: the VF state where TF2 > 0, else KF*dVF1/dt, static in VR; VR does
         # not depend on ev then (setup refuses the direct path), so it is evaluated with ev = 0
         vr_now = hard_limit(self.LL.output(ll, self.X1.output(x1, self.PIr.output(pi, 0.0 * v))),
-                            p["VRMIN"], p["VRMAX"])
+                            p["VRMIN"], p["VRMAX"], xp)
         dvf1 = self.FB1.deriv(vf1, vr_now)
-        vf_out = np.where(p["TF2"] > 0, vf, p["KF"] * dvf1)
-        ev = self.vref0 - self.LG.output(lg, v) - vf_out + s["vs"][..., m]
+        vf_out = xp.where(p["TF2"] > 0, vf, p["KF"] * dvf1)
+        ev = self.vref0 - self.LG.output(lg, v) - vf_out + take(xp, s["vs"], m)
         va = self.PIr.output(pi, ev)
         y1 = self.X1.output(x1, va)
-        vr = hard_limit(self.LL.output(ll, y1), p["VRMIN"], p["VRMAX"])
-        VB = self._vb(ctx.V[..., self.bus], s["Pe"][..., m] + 1j * s["Qe"][..., m], xad)
-        e0 = hard_limit(VB * vr, p["EFDMIN"], p["EFDMAX"])
-        efd = np.where(self._te, efd_x, e0)
+        vr = hard_limit(self.LL.output(ll, y1), p["VRMIN"], p["VRMAX"], xp)
+        VB = self._vb(take(xp, ctx.V, self.bus), take(xp, s["Pe"], m) + 1j * take(xp, s["Qe"], m), xad, xp)
+        e0 = hard_limit(VB * vr, p["EFDMIN"], p["EFDMAX"], xp)
+        efd = xp.where(self._te, efd_x, e0)
         dvf1 = self.FB1.deriv(vf1, vr)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
@@ -164,8 +169,10 @@ class EXPIC1(MachineControl):
         f[..., self._sls[3]] = self.LL.deriv(ll, y1)
         f[..., self._sls[4]] = dvf1
         f[..., self._sls[5]] = self.FB2.deriv(vf, p["KF"] * dvf1)
-        f[..., self._sls[6]] = np.where(self._te, (e0 - self.EX.vfe(efd_x)) / self._te_s, 0.0)
-        s["vf"][..., m] = efd
+        # DCExciter.vfe on the namespace: KE*Efd + B*(Efd - A)^2
+        vfe = KE * efd_x + quad_saturation(efd_x, A, B, xp)
+        f[..., self._sls[6]] = xp.where(self._te, (e0 - vfe) / self._te_s, 0.0)
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["EXPIC1.ev"], o["EXPIC1.VA"], o["EXPIC1.VR"] = ev, va, vr
         o["EXPIC1.VB"], o["EXPIC1.E0"], o["EXPIC1.vout"] = VB, e0, efd

@@ -29,16 +29,17 @@ off with the constant one).
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..blocks import Lag, LeadLag, Washout, hard_limit
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 
 
 class EXST1(MachineControl):
     """IEEE ST1 static exciter. Times [s]: TR, TC, TB, TA, TF; gains [pu]: KA, KC, KF;
     limits VIMAX, VIMIN, VRMAX, VRMIN [pu]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -97,25 +98,25 @@ class EXST1(MachineControl):
         x[self.sl(3)] = self.WF.init(vf0)
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         lg, ll, vr, wf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        xad = s["XadIfd"][..., m]
-        vt = np.where(self._vt, s["Vt"][..., m], 1.0)
-        lo = vt * p["VRMIN"] - np.where(self._vt, 0.0, p["KC"] * xad)
+        v = take(xp, s["Ecomp"], m)
+        xad = take(xp, s["XadIfd"], m)
+        vt = xp.where(self._vt, take(xp, s["Vt"], m), 1.0)
+        lo = vt * p["VRMIN"] - xp.where(self._vt, 0.0, p["KC"] * xad)
         hi = vt * p["VRMAX"] - p["KC"] * xad
-        fb_in = np.where(self._std, hard_limit(vr, lo, hi), vr)        # rate feedback input
+        fb_in = xp.where(self._std, hard_limit(vr, lo, hi, xp), vr)        # rate feedback input
         wfy = self.WF.output(wf, fb_in)
-        efd = np.where(self._std, fb_in, np.where(wfy > hi, hi, np.where(wfy < lo, lo, vr)))
-        vi = self.vref0 - self.LG.output(lg, v) - wfy + s["vs"][..., m]
-        vil = hard_limit(vi, p["VIMIN"], p["VIMAX"])
+        efd = xp.where(self._std, fb_in, xp.where(wfy > hi, hi, xp.where(wfy < lo, lo, vr)))
+        vi = self.vref0 - self.LG.output(lg, v) - wfy + take(xp, s["vs"], m)
+        vil = hard_limit(vi, p["VIMIN"], p["VIMAX"], xp)
         y = self.LL.output(ll, vil)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LL.deriv(ll, vil)
         f[..., self._sls[2]] = self.LR.deriv(vr, y)
         f[..., self._sls[3]] = self.WF.deriv(wf, fb_in)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         ctx.out["EXST1.vi"], ctx.out["EXST1.vout"] = vi, efd

@@ -16,8 +16,9 @@ starts at VRMAX" option is not implemented).
 
 from __future__ import annotations
 
-from ..blocks import Lag, LagNonWindup, Washout
+from ..blocks import Lag, LagNonWindup, Washout, quad_saturation
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 from .dc_common import SATURATION_PARAMS, DCExciter, vrmax_or_unlimited
 
@@ -25,6 +26,8 @@ from .dc_common import SATURATION_PARAMS, DCExciter, vrmax_or_unlimited
 class IEEET1(MachineControl):
     """IEEE type 1 exciter. Times [s]: TR, TA, TE, TF; gains [pu]: KA, KE, KF; VRMAX, VRMIN [pu];
     E1, SE1, E2, SE2 (saturation)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -54,6 +57,8 @@ class IEEET1(MachineControl):
         self.LG = Lag(1.0, p["TR"])
         self.LA = LagNonWindup(p["KA"], p["TA"], p["VRMIN"], vrmax_or_unlimited(p["VRMAX"]))
         self.EX = DCExciter(p["KE"], p["TE"], p["E1"], p["SE1"], p["E2"], p["SE2"])
+        #: the DC exciter's arrays (KE, TE, A, B), held by the model for its namespace
+        self._ex = (self.EX.KE, self.EX.TE, self.EX.A, self.EX.B)
         self.WF = Washout(p["KF"], p["TF"])
 
     def limits(self):
@@ -70,16 +75,18 @@ class IEEET1(MachineControl):
         x[self.sl(3)] = self.WF.init(vf0)
 
     def compute(self, ctx):
-        m = self._mi
+        xp, m = self.xp, self._mi
+        KE, TE, A, B = self._ex
         lg, vr, efd, wf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
+        v = take(xp, s["Ecomp"], m)
+        vi = self.vref0 - self.LG.output(lg, v) + take(xp, s["vs"], m)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         u = vi - self.WF.output(wf, efd)
         f[..., self._sls[1]] = self.LA.deriv(vr, u)
-        f[..., self._sls[2]] = self.EX.deriv(efd, self.LA.output(vr, u))   # = vr unless TA = 0
+        # DCExciter.deriv on the namespace: (vr - (KE*Efd + B*(Efd - A)^2)) / TE, = vr unless TA = 0
+        f[..., self._sls[2]] = (self.LA.output(vr, u) - (KE * efd + quad_saturation(efd, A, B, xp))) / TE
         f[..., self._sls[3]] = self.WF.deriv(wf, efd)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         ctx.out["IEEET1.vi"], ctx.out["IEEET1.vout"] = vi, efd

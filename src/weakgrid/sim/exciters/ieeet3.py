@@ -21,18 +21,19 @@ ANDES 2.0's IEEET3 follows the same diagram (no departure found).
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..blocks import Lag, LagNonWindup, Washout, hard_limit
 from ..control_base import MachineControl
+from ..namespace import NUMPY, put, take
 from ..params import Param
 from .dc_common import vrmax_or_unlimited
-from .esst3a import source_voltage, source_voltage0
+from .esst3a import source_voltage0
 
 
 class IEEET3(MachineControl):
     """IEEE type 3 exciter. Times [s]: TR, TA, TE, TF; gains [pu]: KA, KE, KF, KP, KI;
     limits [pu]: VRMAX, VRMIN (regulator), VBMAX (exciter input)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -68,9 +69,9 @@ class IEEET3(MachineControl):
         return [(self.idx("VR"), self.p["VRMIN"], self._vrmax)]
 
     @staticmethod
-    def _vb(VE, xad):
+    def _vb(VE, xad, xp=NUMPY):
         """Rectified compound-source voltage ``sqrt(max(VE^2 - (0.78*XadIfd)^2, 0))`` [pu]."""
-        return np.sqrt(np.maximum(VE * VE - (0.78 * xad) ** 2, 0.0))
+        return xp.sqrt(xp.maximum(VE * VE - (0.78 * xad) ** 2, 0.0))
 
     def init(self, system, x, sig):
         p = self.p
@@ -85,21 +86,25 @@ class IEEET3(MachineControl):
         x[self.sl(3)] = self.VF.init(vf0)
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         lg, vr, efd, vf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
+        v = take(xp, s["Ecomp"], m)
+        vi = self.vref0 - self.LG.output(lg, v) + take(xp, s["vs"], m)
         u = vi - self.VF.output(vf, efd)
-        VE = source_voltage(ctx, self.mach, self.bus, p["KP"], p["KI"], 0.0)
-        VB = self._vb(VE, s["XadIfd"][..., m])
-        vx = hard_limit(self.LA.output(vr, u) + VB, 0.0, p["VBMAX"])
+        # esst3a.source_voltage(ctx, mach, bus, KP, KI, 0.0) on the namespace
+        V = take(xp, ctx.V, self.bus)
+        It = xp.conj((take(xp, s["Pe"], self.mach) + 1j * take(xp, s["Qe"], self.mach)) / V)
+        KP = p["KP"]
+        VE = xp.abs(KP * V + 1j * (p["KI"] + KP * 0.0) * It)
+        VB = self._vb(VE, take(xp, s["XadIfd"], m), xp)
+        vx = hard_limit(self.LA.output(vr, u) + VB, 0.0, p["VBMAX"], xp)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LA.deriv(vr, u)
         f[..., self._sls[2]] = (vx - p["KE"] * efd) / p["TE"]
         f[..., self._sls[3]] = self.VF.deriv(vf, efd)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["IEEET3.vi"], o["IEEET3.VE"], o["IEEET3.VB"], o["IEEET3.vout"] = vi, VE, VB, efd

@@ -24,11 +24,14 @@ from __future__ import annotations
 import numpy as np
 
 from ..control_base import MachineControl
+from ..namespace import NUMPY, put, take
 from ..params import Param
 
 
 class IEEEVC(MachineControl):
     """Voltage compensator. Parameters: rc, xc [pu, machine base; system base if ``on_Sb``]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "compensator"
     order = 1.5          # after the machines (reads Vt, Pe, Qe), before the exciters (read Ecomp)
@@ -54,10 +57,10 @@ class IEEEVC(MachineControl):
         k = np.where(self.p["on_Sb"] > 0, 1.0, to_sys)
         self.Zc = (self.p["rc"] + 1j * self.p["xc"]) * k      # system base
 
-    def _ecomp(self, Vt, theta, Pe, Qe):
-        V = Vt * np.exp(1j * theta)
-        It = np.conj((Pe + 1j * Qe) / V)           # stator current, system base
-        return np.abs(V + self.Zc * It)
+    def _ecomp(self, Vt, theta, Pe, Qe, xp=NUMPY):
+        V = Vt * xp.exp(1j * theta)
+        It = xp.conj((Pe + 1j * Qe) / V)           # stator current, system base
+        return xp.abs(V + self.Zc * It)
 
     def init(self, system, x, sig):
         m = self.mach
@@ -65,8 +68,9 @@ class IEEEVC(MachineControl):
         sig["Ecomp"][m] = sig["Ecomp0"][m] = e
 
     def compute(self, ctx):
-        s = ctx.sig
+        xp, s = self.xp, ctx.sig
         m = self._mi
-        e = self._ecomp(s["Vt"][..., m], s["theta"][..., m], s["Pe"][..., m], s["Qe"][..., m])
-        s["Ecomp"][..., m] = e
+        e = self._ecomp(take(xp, s["Vt"], m), take(xp, s["theta"], m), take(xp, s["Pe"], m),
+                        take(xp, s["Qe"], m), xp)
+        put(xp, s["Ecomp"], m, e)
         ctx.out["IEEEVC.Ecomp"] = e

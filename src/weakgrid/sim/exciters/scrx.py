@@ -26,6 +26,7 @@ import numpy as np
 from ..blocks import Lag, LeadLag
 from ..control_base import MachineControl
 from ..errors import DataError
+from ..namespace import put, take
 from ..params import Param
 
 
@@ -33,6 +34,8 @@ class SCRX(MachineControl):
     """Bus-fed or solid-fed static exciter. Parameters: TATB [-], TB, TE [s], K [pu], EMIN, EMAX
     [pu, machine base], CSWITCH (0 bus fed, 1 solid fed), rc_rfd [-] (0: negative field current
     allowed; > 0: crowbar resistance / field resistance)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -98,18 +101,18 @@ class SCRX(MachineControl):
         self.initial_bounds = [("VR", VR0, p["EMIN"] - big, p["EMAX"] + big, "EMIN", "EMAX")]
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         ll, vr = ctx.x[..., self._sls[0]], ctx.x[..., self._sls[1]]
         s = ctx.sig
-        vi = self.vref0 - s["Ecomp"][..., m] + s["vs"][..., m]
+        vi = self.vref0 - take(xp, s["Ecomp"], m) + take(xp, s["vs"], m)
         y = self.LL.output(ll, vi)
-        VR = np.minimum(np.maximum(self.LA.output(vr, y), p["EMIN"]), p["EMAX"])
-        EX = np.where(self._bus_fed, VR * s["Vt"][..., m], VR)
-        xad = s["XadIfd"][..., m]
-        efd = np.where(self._crowbar & (xad <= 0), -p["rc_rfd"] * xad, EX)
+        VR = xp.minimum(xp.maximum(self.LA.output(vr, y), p["EMIN"]), p["EMAX"])
+        EX = xp.where(self._bus_fed, VR * take(xp, s["Vt"], m), VR)
+        xad = take(xp, s["XadIfd"], m)
+        efd = xp.where(self._crowbar & (xad <= 0), -p["rc_rfd"] * xad, EX)
         ctx.f[..., self._sls[0]] = self.LL.deriv(ll, vi)
         ctx.f[..., self._sls[1]] = self.LA.deriv(vr, y)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["SCRX.vi"], o["SCRX.EX"], o["SCRX.vout"] = vi, EX, efd

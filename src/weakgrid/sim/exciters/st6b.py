@@ -47,6 +47,7 @@ import numpy as np
 from ..blocks import Lag, Washout, hard_limit
 from ..control_base import MachineControl
 from ..errors import DataError
+from ..namespace import NUMPY, put, take
 from ..params import Param
 
 
@@ -54,6 +55,8 @@ class ST6B(MachineControl):
     """IEEE ST6B static exciter. Times [s]: TR, TDA, TG; gains: KPA [pu], KIA [1/s], KDA [s], KFF,
     KM, KCI, KLR, KG [pu]; limits VAMAX, VAMIN, VRMAX, VRMIN [pu, machine base]; ILR [pu field
     current]; OEL input selector (0, 1, 2; unused)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -111,10 +114,10 @@ class ST6B(MachineControl):
     def limits(self):
         return [(self.idx("PI"), self.p["VAMIN"], self.p["VAMAX"])]
 
-    def _vr1(self, xad):
+    def _vr1(self, xad, xp=NUMPY):
         """Field-current limiter branch of the low-value gate [pu]."""
         p = self.p
-        return np.maximum(p["KLR"] * (p["KCI"] * p["ILR"] - xad), p["VRMIN"])
+        return xp.maximum(p["KLR"] * (p["KCI"] * p["ILR"] - xad), p["VRMIN"])
 
     def init(self, system, x, sig):
         p = self.p
@@ -144,27 +147,27 @@ class ST6B(MachineControl):
         ]
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         lg, pi, pd, vg = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        vt = s["Vt"][..., m]
-        xad = s["XadIfd"][..., m]
-        vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
-        va = hard_limit(p["KPA"] * vi + pi + self.PD.output(pd, vi), p["VAMIN"], p["VAMAX"])
-        vr1 = self._vr1(xad)
+        v = take(xp, s["Ecomp"], m)
+        vt = take(xp, s["Vt"], m)
+        xad = take(xp, s["XadIfd"], m)
+        vi = self.vref0 - self.LG.output(lg, v) + take(xp, s["vs"], m)
+        va = hard_limit(p["KPA"] * vi + pi + self.PD.output(pd, vi), p["VAMIN"], p["VAMAX"], xp)
+        vr1 = self._vr1(xad, xp)
         kff, km = p["KFF"], p["KM"]
         vr2_lag = kff * va + km * (va - vg)
         vr2_static = (kff + km) * va / (1.0 + km * p["KG"] * vt)       # TG = 0: VG = KG*Efd
-        vr2 = hard_limit(np.where(self._tg, vr2_lag, vr2_static), p["VRMIN"], p["VRMAX"])
-        vr = np.minimum(vr1, vr2)
+        vr2 = hard_limit(xp.where(self._tg, vr2_lag, vr2_static), p["VRMIN"], p["VRMAX"], xp)
+        vr = xp.minimum(vr1, vr2)
         efd = vr * vt
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = p["KIA"] * vi
         f[..., self._sls[2]] = self.PD.deriv(pd, vi)
         f[..., self._sls[3]] = self.LGV.deriv(vg, efd)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["ST6B.vi"], o["ST6B.VA"], o["ST6B.VR"], o["ST6B.VR1"], o["ST6B.vout"] = vi, va, vr, vr1, efd

@@ -45,20 +45,23 @@ import numpy as np
 from ..blocks import Lag, LagNonWindup, hard_limit, rectifier_fex
 from ..control_base import MachineControl
 from ..errors import DataError
+from ..namespace import NUMPY, put, take
 from ..params import Param
 
 
-def _rectified(VE, XadIfd, KC, VBMAX):
-    """``min(VE * FEX(KC*XadIfd/VE), VBMAX)``; 0 where ``VE <= 0`` [pu]."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        IN = np.where(VE > 0, KC * XadIfd / np.where(VE > 0, VE, 1.0), 0.0)
-    return np.where(VE > 0, np.minimum(VE * rectifier_fex(IN), VBMAX), 0.0)
+def _rectified(VE, XadIfd, KC, VBMAX, xp=NUMPY):
+    """``min(VE * FEX(KC*XadIfd/VE), VBMAX)``; 0 where ``VE <= 0`` [pu] (``xp``: the arrays'
+    namespace)."""
+    IN = xp.where(VE > 0, KC * XadIfd / xp.where(VE > 0, VE, 1.0), 0.0)   # VE kept off 0
+    return xp.where(VE > 0, xp.minimum(VE * rectifier_fex(IN, xp), VBMAX), 0.0)
 
 
 class ST8C(MachineControl):
     """IEEE ST8C static exciter. Times [s]: TR, TA, TF; gains: KPR, KPA, KA, KF, KC1, KP, KI1, KC2,
     KI2 [pu], KIR, KIA [1/s]; XL [pu]; THETAP [deg]; limits VPIMAX, VPIMIN, VAMAX, VAMIN, VRMAX,
     VRMIN, VB1MAX, VB2MAX [pu, machine base]; flags OEL, UEL, SCL (unused), SW1 (power source)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -124,13 +127,13 @@ class ST8C(MachineControl):
         return [(self.idx("PR"), p["VPIMIN"], p["VPIMAX"]), (self.idx("PA"), p["VAMIN"], p["VAMAX"]),
                 (self.idx("VR")[on], p["VRMIN"][on], p["VRMAX"][on])]
 
-    def _sources(self, V, S, xad):
+    def _sources(self, V, S, xad, xp=NUMPY):
         """``(VB1, VB2)`` from the terminal voltage ``V`` and power ``S`` (system base) [pu]."""
         p = self.p
-        It = np.conj(S / V) * self._ibase
-        VE1 = np.where(self._terminal, np.abs(self.KPC * V + 1j * (p["KI1"] + self.KPC * p["XL"]) * It), p["KP"])
-        VB1 = _rectified(VE1, xad, p["KC1"], p["VB1MAX"])
-        VB2 = _rectified(p["KI2"] * np.abs(It), xad, p["KC2"], p["VB2MAX"])
+        It = xp.conj(S / V) * self._ibase
+        VE1 = xp.where(self._terminal, xp.abs(self.KPC * V + 1j * (p["KI1"] + self.KPC * p["XL"]) * It), p["KP"])
+        VB1 = _rectified(VE1, xad, p["KC1"], p["VB1MAX"], xp)
+        VB2 = _rectified(p["KI2"] * xp.abs(It), xad, p["KC2"], p["VB2MAX"], xp)
         return VB1, VB2
 
     def init(self, system, x, sig):
@@ -158,19 +161,20 @@ class ST8C(MachineControl):
         self.initial_bounds = [("VR", VR0, p["VRMIN"] - big, p["VRMAX"] + big, "VRMIN", "VRMAX")]
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         lg, pr, pa, vr, ifb = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        xad = s["XadIfd"][..., m]
-        vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
-        ifdref = hard_limit(p["KPR"] * vi + pr, p["VPIMIN"], p["VPIMAX"])
+        v = take(xp, s["Ecomp"], m)
+        xad = take(xp, s["XadIfd"], m)
+        vi = self.vref0 - self.LG.output(lg, v) + take(xp, s["vs"], m)
+        ifdref = hard_limit(p["KPR"] * vi + pr, p["VPIMIN"], p["VPIMAX"], xp)
         fb = self.FB.output(ifb, xad)
         ea = ifdref - fb
-        va = hard_limit(p["KPA"] * ea + pa, p["VAMIN"], p["VAMAX"])
+        va = hard_limit(p["KPA"] * ea + pa, p["VAMIN"], p["VAMAX"], xp)
         VR = self.LA.output(vr, va)
-        VB1, VB2 = self._sources(ctx.V[..., self.bus], s["Pe"][..., m] + 1j * s["Qe"][..., m], xad)
+        VB1, VB2 = self._sources(take(xp, ctx.V, self.bus), take(xp, s["Pe"], m) + 1j * take(xp, s["Qe"], m),
+                                 xad, xp)
         efd = VR * VB1 + VB2
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
@@ -178,7 +182,7 @@ class ST8C(MachineControl):
         f[..., self._sls[2]] = p["KIA"] * ea
         f[..., self._sls[3]] = self.LA.deriv(vr, va)
         f[..., self._sls[4]] = self.FB.deriv(ifb, xad)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["ST8C.vi"], o["ST8C.IFDREF"], o["ST8C.VA"] = vi, ifdref, va
         o["ST8C.VB1"], o["ST8C.VB2"], o["ST8C.vout"] = VB1, VB2, efd

@@ -18,13 +18,15 @@ import numpy as np
 
 from ..component import Component
 from ..errors import DataError
-from ..namespace import add_at
+from ..namespace import add_at, take
 from ..network import PD, QD
 from ..params import Param
 
 
 class ZIP(Component):
     """Polynomial loads, one per bus load share; add with :meth:`add_zip`."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "device"
     #: the power-flow voltage magnitude and the admittance it gives the share (from the operating
@@ -93,12 +95,14 @@ class ZIP(Component):
         self.cq = self.Q0 * np.array([p["kqp"], p["kqi"], p["kqz"]]) / 100.0
 
     def compute(self, ctx):
-        V = ctx.V[..., self.bus]
-        v = np.abs(V)
+        xp = self.xp
+        V = take(xp, ctx.V, self.bus)
+        v = xp.abs(V)
         r = v / self.v0
-        P = self.cp[0] + self.cp[1] * r + self.cp[2] * r * r
-        Q = self.cq[0] + self.cq[1] * r + self.cq[2] * r * r
-        Vs = np.where(np.abs(V) > 1e-6, V, 1e-6)
-        I = -np.conj((P + 1j * Q) / Vs) + self.y0 * V
-        add_at(self.xp, ctx.I, self.bus, I, self._uniq)
+        cp, cq = self.cp, self.cq
+        P = cp[0, ...] + cp[1, ...] * r + cp[2, ...] * r * r
+        Q = cq[0, ...] + cq[1, ...] * r + cq[2, ...] * r * r
+        Vs = xp.where(xp.abs(V) > 1e-6, V, 1e-6)
+        I = -xp.conj((P + 1j * Q) / Vs) + self.y0 * V
+        add_at(xp, ctx.I, self.bus, I, self._uniq)
         ctx.out["ZIP.P"], ctx.out["ZIP.Q"] = P, Q

@@ -30,6 +30,8 @@ class GENROE(GENROU):
     Parameters and states as :class:`~weakgrid.sim.machines.genrou.GENROU`.
     """
 
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
+
     params = with_default(GENROU.params, "psse_shaft", 1.0)
 
     #: PSS/E .dyr record (Program Application Guide, as GENROU): T'do, T''do, T'qo, T''qo,

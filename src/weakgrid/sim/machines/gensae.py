@@ -17,7 +17,7 @@ The initialization solves ``psi2q*(1 + Se*(xq-xl)/(xd-xl)) = (xq-xq2)*Iq`` with 
 
 from __future__ import annotations
 
-from ..blocks import exp_saturation, exp_saturation_coeffs
+from ..blocks import exp_saturation_coeffs
 from .gensal import GENSAL
 
 
@@ -29,6 +29,8 @@ class GENSAE(GENSAL):
     Parameters, states, shaft and PSS/E record as :class:`~weakgrid.sim.machines.gensal.GENSAL`.
     """
 
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
+
     saturation = "exponential"
     q_saturation = True
 
@@ -37,4 +39,7 @@ class GENSAE(GENSAL):
         return exp_saturation_coeffs(1.0, S10, 1.2, S12)
 
     def _sat(self, x):
-        return exp_saturation(x, self.SA, self.SB)
+        # blocks.exp_saturation on the namespace: B*x^A for x > 0 (x kept off 0 elsewhere), else 0
+        xp = self.xp
+        x = xp.astype(x, xp.float64, copy=False)
+        return xp.where(x > 0, self.SB * xp.abs(xp.where(x > 0, x, 1.0)) ** self.SA, 0.0)

@@ -41,6 +41,7 @@ import numpy as np
 
 from ..blocks import quad_saturation_coeffs
 from ..errors import DataError
+from ..namespace import take
 from ..params import Param
 from .base import (BASE_PARAMS, SyncMachine, psse_subtransient_params, saturated_rotor_angle,
                    with_default)
@@ -59,6 +60,8 @@ class GENSAL(SyncMachine):
     (psi''_q) [pu]. The shaft is PSS/E's by default (``psse_shaft = 1``: the mechanical
     input is power, divided by the speed; :mod:`~weakgrid.sim.machines.shaft`).
     """
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     #: the last evaluation's values (read by ``finish``)
     scratch = ("_te", "_XadIfd")
@@ -138,9 +141,10 @@ class GENSAL(SyncMachine):
 
     def _sat(self, x):
         """Saturation factor ``Se(x)`` (quadratic: ``B (x-A)^2 / x`` for ``x > A``, else 0)."""
-        with np.errstate(divide="ignore", invalid="ignore"):
-            Se = np.where(x > self.SA, self.SB * (x - self.SA) ** 2 / x, 0.0)
-        return np.where(np.isfinite(Se) & (x > 0), Se, 0.0)
+        xp = self.xp
+        # x kept off 0 where x <= 0 (there the result is 0 anyway)
+        Se = xp.where(x > self.SA, self.SB * (x - self.SA) ** 2 / xp.where(x > 0, x, 1.0), 0.0)
+        return xp.where(xp.isfinite(Se) & (x > 0), Se, 0.0)
 
     # ------------------------------------------------------------------- init
     def init(self, system, x, sig):
@@ -173,16 +177,17 @@ class GENSAL(SyncMachine):
 
     # ---------------------------------------------------------------- equations
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         x = ctx.x
         sl = self._sls
         delta, omega = x[..., sl[0]], x[..., sl[1]]
         e1q, e2d, psi2q = x[..., sl[2]], x[..., sl[3]], x[..., sl[4]]
         psi2d = self.gd1 * e1q + (1.0 - self.gd1) * e2d
-        V = ctx.V[..., self._bi]
-        sd, cd = np.sin(delta), np.cos(delta)
-        vd = V.real * sd - V.imag * cd
-        vq = V.real * cd + V.imag * sd
+        V = take(xp, ctx.V, self._bi)
+        sd, cd = xp.sin(delta), xp.cos(delta)
+        Vre, Vim = xp.real(V), xp.imag(V)
+        vd = Vre * sd - Vim * cd
+        vq = Vre * cd + Vim * sd
         # stator: xd2*Id + ra*Iq = a,  -ra*Id + xq2*Iq = b
         a = psi2d - vq
         b = vd - psi2q
@@ -192,11 +197,11 @@ class GENSAL(SyncMachine):
         psid = ra * Iq + vq
         psiq = -(ra * Id + vd)
         self.inject(ctx, (Id * sd + Iq * cd) + 1j * (Iq * sd - Id * cd))
-        psi2 = np.sqrt(psi2d * psi2d + psi2q * psi2q)
+        psi2 = xp.sqrt(psi2d * psi2d + psi2q * psi2q)
         XadIfd = e1q + (p["xd"] - p["xd1"]) * (self.gd1 * Id + self.gd2 * (e1q - e2d))
         dpsi2q = -psi2q + (p["xq"] - p["xq2"]) * Iq
         if self._nosat:
-            Se = np.zeros_like(psi2)
+            Se = xp.zeros_like(psi2)
         elif self.q_saturation:
             Se = self._sat(psi2)
             XadIfd = XadIfd + Se * psi2d
@@ -219,12 +224,12 @@ class GENSAL(SyncMachine):
 
     def finish(self, ctx):
         p = self.p
-        sl = self._sls
+        xp, m, sl = self.xp, self._mi, self._sls
         omega = ctx.x[..., sl[1]]
-        vf = ctx.sig["vf"][..., self._mi]
-        tm = ctx.sig["tm"][..., self._mi]
+        vf = take(xp, ctx.sig["vf"], m)
+        tm = take(xp, ctx.sig["tm"], m)
         ctx.out[self._pre + "vf"] = vf
-        d_delta, d_omega = swing(omega, tm, self._te, p["M"], p["D"], self.wb, self._psse_shaft)
+        d_delta, d_omega = swing(omega, tm, self._te, p["M"], p["D"], self.wb, self._psse_shaft, xp)
         f = ctx.f
         f[..., sl[0]] = d_delta
         f[..., sl[1]] = d_omega
