@@ -39,6 +39,7 @@ import numpy as np
 
 from ..blocks import Lag, LagNonWindup, PITrackAW, Washout, hard_limit
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 from .dc_common import SATURATION_PARAMS, DCExciter
 from .esst4b import ANDES_TRACKING_GAIN
@@ -49,6 +50,8 @@ class AC8B(MachineControl):
     """IEEE AC8B exciter. Times [s]: TR, Td, TA, TE; gains: kP [pu], kI [1/s], kD [s], KA, KE,
     KD, KC [pu]; limits VPMAX, VPMIN, VRMAX, VRMIN, VFEMAX, VEMIN [pu, machine base];
     E1, SE1, E2, SE2 (saturation)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     order = 2
@@ -137,24 +140,25 @@ class AC8B(MachineControl):
         self.initial_bounds = [("VPID", vpid0, p["VPMIN"] - big, p["VPMAX"] + big, "VPMIN", "VPMAX")]
 
     def compute(self, ctx):
+        xp = self.xp
         p = self.p
         m = self._mi
         lg, xi, xd, vr, ve = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        xad = s["XadIfd"][..., m]
-        vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
+        v = take(xp, s["Ecomp"], m)
+        xad = take(xp, s["XadIfd"], m)
+        vi = self.vref0 - self.LG.output(lg, v) + take(xp, s["vs"], m)
         ys = p["kP"] * vi + xi + self.PDf.output(xd, vi)     # PID before its limiter
-        vpid = hard_limit(ys, p["VPMIN"], p["VPMAX"])
-        dxi = np.where(self._nw, p["kI"] * vi, self.PIt.Ki * (vi - self.PIt.Ks * (ys - vpid)))
+        vpid = hard_limit(ys, p["VPMIN"], p["VPMAX"], xp)
+        dxi = xp.where(self._nw, p["kI"] * vi, self.PIt.Ki * (vi - self.PIt.Ks * (ys - vpid)))
         vfe = self.EX.vfe(ve) + p["KD"] * xad
-        efd = _efd(ve, p["KC"], xad)
+        efd = _efd(ve, p["KC"], xad, xp)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = dxi
         f[..., self._sls[2]] = self.PDf.deriv(xd, vi)
         f[..., self._sls[3]] = self.LA.deriv(vr, vpid)
         f[..., self._sls[4]] = (self.LA.output(vr, vpid) - vfe) / p["TE"]
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["AC8B.vi"], o["AC8B.VPID"], o["AC8B.VFE"], o["AC8B.vout"] = vi, vpid, vfe, efd

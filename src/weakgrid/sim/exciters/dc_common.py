@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..blocks import quad_saturation, quad_saturation_coeffs
+from ..blocks import Block, quad_saturation, quad_saturation_coeffs
 from ..params import Param
 
 SATURATION_PARAMS = (
@@ -15,11 +15,12 @@ SATURATION_PARAMS = (
 )
 
 
-class DCExciter:
+class DCExciter(Block):
     r"""DC exciter :math:`T_E \dot E_{fd} = V_R - V_{FE}`, :math:`V_{FE} = K_E E_{fd} + E_{fd} S_E(E_{fd})`.
 
     The saturation product :math:`E_{fd} S_E(E_{fd}) = B (E_{fd} - A)^2` for :math:`E_{fd} \ge A`
     (quadratic curve through ``(E1, SE1)``, ``(E2, SE2)``; ``SE1 = 0`` or ``SE2 = 0`` disables it).
+    A block (:class:`~weakgrid.sim.blocks.Block`): its arrays and namespace follow the grid's.
     """
 
     def __init__(self, KE, TE, E1, SE1, E2, SE2):
@@ -29,7 +30,7 @@ class DCExciter:
 
     def vfe(self, efd):
         """Exciter feedback ``KE*Efd + Efd*SE(Efd)`` [pu]."""
-        return self.KE * efd + quad_saturation(efd, self.A, self.B)
+        return self.KE * efd + quad_saturation(efd, self.A, self.B, self.xp)
 
     def deriv(self, efd, vr):
         return (vr - self.vfe(efd)) / self.TE

@@ -33,6 +33,7 @@ import numpy as np
 
 from ..blocks import Lag, LagNonWindup, LeadLag, Washout, hard_limit
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 from .dc_common import SATURATION_PARAMS, DCExciter
 from .exac1 import _efd, init_ac_exciter
@@ -45,6 +46,8 @@ class ESAC1A(MachineControl):
     VAMIN (regulator), VRMAX, VRMIN (exciter field voltage); E1, SE1, E2, SE2 (saturation of
     the exciter alternator). ``XadIfd`` is the field current in pu of the machine.
     """
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -101,23 +104,24 @@ class ESAC1A(MachineControl):
         init_ac_exciter(self, x, sig, self.VF)
 
     def compute(self, ctx):
+        xp = self.xp
         p = self.p
         m = self._mi
         lg, ll, va, ve, vf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        xad = s["XadIfd"][..., m]
+        v = take(xp, s["Ecomp"], m)
+        xad = take(xp, s["XadIfd"], m)
         vfe = self.EX.vfe(ve) + p["KD"] * xad
-        vi = self.vref0 - self.LG.output(lg, v) - self._fb * self.VF.output(vf, vfe) + s["vs"][..., m]
+        vi = self.vref0 - self.LG.output(lg, v) - self._fb * self.VF.output(vf, vfe) + take(xp, s["vs"], m)
         y = self.LL.output(ll, vi)
-        vr = hard_limit(self.LA.output(va, y), self._vrmin, self._vrmax)
-        efd = _efd(ve, p["KC"], xad)
+        vr = hard_limit(self.LA.output(va, y), self._vrmin, self._vrmax, xp)
+        efd = _efd(ve, p["KC"], xad, xp)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LL.deriv(ll, vi)
         f[..., self._sls[2]] = self.LA.deriv(va, y)
         f[..., self._sls[3]] = (vr - vfe) / p["TE"]
         f[..., self._sls[4]] = self.VF.deriv(vf, vfe)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["ESAC1A.vi"], o["ESAC1A.VR"], o["ESAC1A.VFE"], o["ESAC1A.vout"] = vi, vr, vfe, efd

@@ -32,6 +32,7 @@ import numpy as np
 
 from ..blocks import Lag, LeadLag, hard_limit
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 from .dc_common import SATURATION_PARAMS, DCExciter
 from .exac1 import _efd, ve_for_efd
@@ -41,6 +42,8 @@ class ESAC6A(MachineControl):
     """IEEE AC6A exciter. Times [s]: TR, TA, TK, TB, TC, TE, TH, TJ; gains [pu]: KA, KH, KC, KD,
     KE; limits [pu, machine base]: VAMAX, VAMIN, VRMAX, VRMIN (times Vt), VHMAX; VFELIM [pu]
     (field-current limiter reference); E1, SE1, E2, SE2 (exciter saturation)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -94,7 +97,7 @@ class ESAC6A(MachineControl):
                 (self.idx("VE"), np.zeros(self.n), inf)]
 
     def _vh(self, lh, vfe):
-        return hard_limit(self.LH.output(lh, vfe - self.p["VFELIM"]), 0.0, self.p["VHMAX"])
+        return hard_limit(self.LH.output(lh, vfe - self.p["VFELIM"]), 0.0, self.p["VHMAX"], self.xp)
 
     def init(self, system, x, sig):
         p = self.p
@@ -117,27 +120,28 @@ class ESAC6A(MachineControl):
                                ("VA", VA0, p["VAMIN"] - big, p["VAMAX"] + big, "VAMIN", "VAMAX")]
 
     def compute(self, ctx):
+        xp = self.xp
         p = self.p
         m = self._mi
         lg, la, ll, ve, lh = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        vt = s["Vt"][..., m]
-        xad = s["XadIfd"][..., m]
-        vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
+        v = take(xp, s["Ecomp"], m)
+        vt = take(xp, s["Vt"], m)
+        xad = take(xp, s["XadIfd"], m)
+        vi = self.vref0 - self.LG.output(lg, v) + take(xp, s["vs"], m)
         ka_vi = p["KA"] * vi
-        va = hard_limit(self.LA.output(la, ka_vi), p["VAMIN"], p["VAMAX"])
-        vr = hard_limit(self.LL.output(ll, va), vt * p["VRMIN"], vt * p["VRMAX"])
+        va = hard_limit(self.LA.output(la, ka_vi), p["VAMIN"], p["VAMAX"], xp)
+        vr = hard_limit(self.LL.output(ll, va), vt * p["VRMIN"], vt * p["VRMAX"], xp)
         vfe = self.EX.vfe(ve) + p["KD"] * xad
         vh = self._vh(lh, vfe)
-        efd = _efd(ve, p["KC"], xad)
+        efd = _efd(ve, p["KC"], xad, xp)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LA.deriv(la, ka_vi)
         f[..., self._sls[2]] = self.LL.deriv(ll, va)
         f[..., self._sls[3]] = (vr - vh - vfe) / p["TE"]
         f[..., self._sls[4]] = self.LH.deriv(lh, vfe - p["VFELIM"])
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["ESAC6A.vi"], o["ESAC6A.VA"], o["ESAC6A.VR"] = vi, va, vr
         o["ESAC6A.VFE"], o["ESAC6A.VH"], o["ESAC6A.vout"] = vfe, vh, efd

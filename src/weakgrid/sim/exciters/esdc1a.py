@@ -35,6 +35,7 @@ import numpy as np
 
 from ..blocks import Lag, LagNonWindup, LeadLag, Washout
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 from .dc_common import DCExciter, vrmax_or_unlimited
 
@@ -42,6 +43,8 @@ from .dc_common import DCExciter, vrmax_or_unlimited
 class ESDC1A(MachineControl):
     """IEEE DC1A exciter. Times [s]: TR, TA, TB, TC, TE, TF1; gains [pu]: KA, KE, KF;
     VRMAX, VRMIN [pu]; E1, SE1, E2, SE2 (saturation of the DC exciter, pu of Efd)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference and the compensated voltage at init (ESDC2A's limit): per batch member
@@ -102,18 +105,19 @@ class ESDC1A(MachineControl):
         x[self.sl(4)] = self.WF.init(vf0)
 
     def compute(self, ctx):
+        xp = self.xp
         m = self._mi
         lg, ll, vr, efd, wf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        sensed = np.where(self._lagged, self.LG.output(lg, v), v)
-        vi = self.vref0 - sensed - self.WF.output(wf, efd) + s["vs"][..., m]
+        v = take(xp, s["Ecomp"], m)
+        sensed = xp.where(self._lagged, self.LG.output(lg, v), v)
+        vi = self.vref0 - sensed - self.WF.output(wf, efd) + take(xp, s["vs"], m)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LL.deriv(ll, vi)
         f[..., self._sls[2]] = self.LA.deriv(vr, self.LL.output(ll, vi))
         f[..., self._sls[3]] = self.EX.deriv(efd, vr)
         f[..., self._sls[4]] = self.WF.deriv(wf, efd)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o[f"{self.type_name}.vi"], o[f"{self.type_name}.vout"] = vi, efd

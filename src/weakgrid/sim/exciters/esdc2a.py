@@ -35,6 +35,8 @@ class ESDC2A(ESDC1A):
     """IEEE DC2A exciter. Times [s]: TR, TA, TB, TC, TE, TF1; gains [pu]: KA, KE, KF;
     VRMAX, VRMIN [pu, times Vt]; E1, SE1, E2, SE2 (saturation)."""
 
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
+
     params = tuple(
         Param("VRMAX", 7.3, "pu", "maximum regulator output at Vt = 1 (0: unlimited)", "") if p.name == "VRMAX"
         else Param("VRMIN", -7.3, "pu", "minimum regulator output at Vt = 1", "") if p.name == "VRMIN"

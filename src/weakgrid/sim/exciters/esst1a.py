@@ -34,6 +34,7 @@ import numpy as np
 from ..blocks import Lag, LagNonWindup, LeadLag, Washout, hard_limit
 from ..control_base import MachineControl
 from ..errors import DataError
+from ..namespace import put, take
 from ..params import Param
 
 
@@ -44,6 +45,8 @@ class ESST1A(MachineControl):
     VIMAX, VIMIN (input error), VAMAX, VAMIN (regulator), VRMAX, VRMIN (output, times Vt);
     ILR [pu field current, machine base]; UELc, VOSc: input codes (PSS/E).
     """
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -103,7 +106,7 @@ class ESST1A(MachineControl):
 
     def _ilr(self, xad):
         """Field-current limiter output ``max(KLR*(XadIfd - ILR), 0)`` [pu]."""
-        return np.maximum(self.p["KLR"] * (xad - self.p["ILR"]), 0.0)
+        return self.xp.maximum(self.p["KLR"] * (xad - self.p["ILR"]), 0.0)
 
     def init(self, system, x, sig):
         m = self.mach
@@ -118,30 +121,31 @@ class ESST1A(MachineControl):
         x[self.sl(4)] = self.VF.init(vf0)
 
     def compute(self, ctx):
+        xp = self.xp
         p = self.p
         m = self._mi
         lg, ll, ll1, va, vf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        xad = s["XadIfd"][..., m]
-        vs = s["vs"][..., m]
+        v = take(xp, s["Ecomp"], m)
+        xad = take(xp, s["XadIfd"], m)
+        vs = take(xp, s["vs"], m)
         ilr = self._ilr(xad)
-        vs2 = np.where(self._vs_in, 0.0, vs)
+        vs2 = xp.where(self._vs_in, 0.0, vs)
         # rate feedback from the regulator state (setup() refuses TA = 0 with an active feedback,
         # an algebraic loop; where TA = 0 the feedback output is zero)
         vas_fb = va + vs2 - ilr
-        vi = self.vref0 - self.LG.output(lg, v) - self.VF.output(vf, vas_fb) + np.where(self._vs_in, vs, 0.0)
-        vil = hard_limit(vi, p["VIMIN"], p["VIMAX"])
+        vi = self.vref0 - self.LG.output(lg, v) - self.VF.output(vf, vas_fb) + xp.where(self._vs_in, vs, 0.0)
+        vil = hard_limit(vi, p["VIMIN"], p["VIMAX"], xp)
         y1 = self.LL.output(ll, vil)
         y2 = self.LL1.output(ll1, y1)
         vas = self.LA.output(va, y2) + vs2 - ilr          # = vas_fb unless TA = 0
-        efd = hard_limit(vas, v * p["VRMIN"], v * p["VRMAX"] - p["KC"] * xad)
+        efd = hard_limit(vas, v * p["VRMIN"], v * p["VRMAX"] - p["KC"] * xad, xp)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LL.deriv(ll, vil)
         f[..., self._sls[2]] = self.LL1.deriv(ll1, y1)
         f[..., self._sls[3]] = self.LA.deriv(va, y2)
         f[..., self._sls[4]] = self.VF.deriv(vf, vas)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["ESST1A.vi"], o["ESST1A.vas"], o["ESST1A.vout"] = vi, vas, efd

@@ -28,23 +28,26 @@ import numpy as np
 
 from ..blocks import Lag, LagNonWindup, LeadLag, hard_limit, rectifier_fex
 from ..control_base import MachineControl
+from ..namespace import NUMPY, put, take
 from ..params import Param
 
 
-def source_voltage(ctx, mach, bus, KPC, KI, XL):
-    """``|KPC*Vt + j(KI + KPC*XL)*It|`` of machines ``mach`` at buses ``bus`` (system-base pu)."""
+def source_voltage(ctx, mach, bus, KPC, KI, XL, xp=NUMPY):
+    """``|KPC*Vt + j(KI + KPC*XL)*It|`` of machines ``mach`` at buses ``bus`` (system-base pu;
+    ``xp``: the arrays' namespace)."""
     s = ctx.sig
-    V = ctx.V[..., bus]
-    S = s["Pe"][..., mach] + 1j * s["Qe"][..., mach]
-    It = np.conj(S / V)
-    return np.abs(KPC * V + 1j * (KI + KPC * XL) * It)
+    V = take(xp, ctx.V, bus)
+    S = take(xp, s["Pe"], mach) + 1j * take(xp, s["Qe"], mach)
+    It = xp.conj(S / V)
+    return xp.abs(KPC * V + 1j * (KI + KPC * XL) * It)
 
 
-def rectified_voltage(VE, XadIfd, KC, VBMAX):
-    """Available exciter voltage ``VB = min(VE * FEX(IN), VBMAX)``, ``IN = KC*XadIfd/VE`` [pu]."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        IN = np.where(VE > 0, KC * XadIfd / VE, 0.0)
-    return np.minimum(VE * rectifier_fex(IN), VBMAX)
+def rectified_voltage(VE, XadIfd, KC, VBMAX, xp=NUMPY):
+    """Available exciter voltage ``VB = min(VE * FEX(IN), VBMAX)``, ``IN = KC*XadIfd/VE`` [pu]
+    (``xp``: the arrays' namespace; ``VE`` is kept off 0 where ``IN`` is not used)."""
+    on = VE > 0
+    IN = xp.where(on, KC * XadIfd / xp.where(on, VE, 1.0), 0.0)
+    return xp.minimum(VE * rectifier_fex(IN, xp), VBMAX)
 
 
 def source_voltage0(sig, mach, KPC, KI, XL):
@@ -57,6 +60,8 @@ def source_voltage0(sig, mach, KPC, KI, XL):
 class ESST3A(MachineControl):
     """IEEE ST3A static exciter. Times [s]: TR, TC, TB, TA, TM; gains [pu]: KA, KM, KG, KP, KI, KC;
     reactance XL [pu]; THETAP [deg]; limits VIMAX, VIMIN, VRMAX, VRMIN, VMMAX, VMMIN, VBMAX, VGMAX [pu]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -105,7 +110,7 @@ class ESST3A(MachineControl):
         return [(self.idx("VR"), p["VRMIN"], p["VRMAX"]), (self.idx("VM"), p["VMMIN"], p["VMMAX"])]
 
     def _vb(self, VE, XadIfd):
-        return rectified_voltage(VE, XadIfd, self.p["KC"], self.p["VBMAX"])
+        return rectified_voltage(VE, XadIfd, self.p["KC"], self.p["VBMAX"], self.xp)
 
     def init(self, system, x, sig):
         p = self.p
@@ -123,24 +128,25 @@ class ESST3A(MachineControl):
         x[self.sl(3)] = VM0
 
     def compute(self, ctx):
+        xp = self.xp
         p = self.p
         m = self._mi
         lg, ll, vr, vm = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
-        vil = hard_limit(vi, p["VIMIN"], p["VIMAX"])
+        v = take(xp, s["Ecomp"], m)
+        vi = self.vref0 - self.LG.output(lg, v) + take(xp, s["vs"], m)
+        vil = hard_limit(vi, p["VIMIN"], p["VIMAX"], xp)
         va = self.LL.output(ll, vil)
-        VE = source_voltage(ctx, self.mach, self.bus, self.KPC, p["KI"], p["XL"])
-        VB = self._vb(VE, s["XadIfd"][..., m])
+        VE = source_voltage(ctx, self.mach, self.bus, self.KPC, p["KI"], p["XL"], xp)
+        VB = self._vb(VE, take(xp, s["XadIfd"], m))
         efd = VB * vm
-        vg = np.minimum(p["KG"] * efd, p["VGMAX"])
+        vg = xp.minimum(p["KG"] * efd, p["VGMAX"])
         vr_out = self.LA.output(vr, va)           # = vr unless TA = 0 (then clip(KA*va))
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LL.deriv(ll, vil)
         f[..., self._sls[2]] = self.LA.deriv(vr, va)
         f[..., self._sls[3]] = self.LM.deriv(vm, vr_out - vg)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["ESST3A.vi"], o["ESST3A.VE"], o["ESST3A.VB"], o["ESST3A.vout"] = vi, VE, VB, efd

@@ -34,6 +34,7 @@ import numpy as np
 
 from ..blocks import Lag, PINonWindup, PITrackAW
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 from .esst3a import rectified_voltage, source_voltage, source_voltage0
 
@@ -45,6 +46,8 @@ class ESST4B(MachineControl):
     """IEEE ST4B static exciter. Times [s]: TR, TA; gains [pu]: KPR, KIR [1/s], KPM, KIM [1/s],
     KG, KP, KI, KC; reactance XL [pu]; THETAP [deg]; limits VRMAX, VRMIN, VMMAX, VMMIN, VBMAX,
     VGMAX [pu, machine base]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -97,9 +100,10 @@ class ESST4B(MachineControl):
         self.PRt = PITrackAW(p["KPR"], p["KIR"], ANDES_TRACKING_GAIN)
         self.PMt = PITrackAW(p["KPM"], p["KIM"], ANDES_TRACKING_GAIN)
         self._nw = p["PI_nonwindup"] > 0
+        self._nw_all, self._nw_any = bool(np.all(self._nw)), bool(np.any(self._nw))
 
     def _vb(self, VE, XadIfd):
-        return rectified_voltage(VE, XadIfd, self.p["KC"], self.p["VBMAX"])
+        return rectified_voltage(VE, XadIfd, self.p["KC"], self.p["VBMAX"], self.xp)
 
     def limits(self):
         p = self.p
@@ -128,24 +132,26 @@ class ESST4B(MachineControl):
 
     def _pi(self, x, u, nw, tr, lo, hi):
         """Output and derivative of a PI: non-windup where ``PI_nonwindup``, else tracking."""
-        if np.all(self._nw):
+        xp = self.xp
+        if self._nw_all:
             return nw.output(x, u), nw.deriv(x, u)
-        if not np.any(self._nw):
+        if not self._nw_any:
             return tr.output(x, u, lo, hi), tr.deriv(x, u, lo, hi)
-        return (np.where(self._nw, nw.output(x, u), tr.output(x, u, lo, hi)),
-                np.where(self._nw, nw.deriv(x, u), tr.deriv(x, u, lo, hi)))
+        return (xp.where(self._nw, nw.output(x, u), tr.output(x, u, lo, hi)),
+                xp.where(self._nw, nw.deriv(x, u), tr.deriv(x, u, lo, hi)))
 
     def compute(self, ctx):
+        xp = self.xp
         p = self.p
         m = self._mi
         lg, pr, va, pm = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        vi = self.vref0 - self.LG.output(lg, v) + s["vs"][..., m]
+        v = take(xp, s["Ecomp"], m)
+        vi = self.vref0 - self.LG.output(lg, v) + take(xp, s["vs"], m)
         vr, dpr = self._pi(pr, vi, self.PR, self.PRt, p["VRMIN"], p["VRMAX"])
         va_y = self.LA.output(va, vr)
-        VE = source_voltage(ctx, self.mach, self.bus, self.KPC, p["KI"], p["XL"])
-        VB = self._vb(VE, s["XadIfd"][..., m])
+        VE = source_voltage(ctx, self.mach, self.bus, self.KPC, p["KI"], p["XL"], xp)
+        VB = self._vb(VE, take(xp, s["XadIfd"], m))
         # Efd = VB*VM and VG = min(KG*Efd, VGMAX) feed back into VM's own input: an algebraic
         # loop, solved in closed form on each branch of the VGMAX gate
         vm, dpm = self._inner(pm, va_y, VB)
@@ -155,7 +161,7 @@ class ESST4B(MachineControl):
         f[..., self._sls[1]] = dpr
         f[..., self._sls[2]] = self.LA.deriv(va, vr)
         f[..., self._sls[3]] = dpm
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["ESST4B.vi"], o["ESST4B.VR"], o["ESST4B.VM"] = vi, vr, vm
         o["ESST4B.VE"], o["ESST4B.VB"], o["ESST4B.vout"] = VE, VB, efd
@@ -168,14 +174,14 @@ class ESST4B(MachineControl):
         VGMAX: ``VM = KPM*(VA - VGMAX) + PM``. The gate is on the branch whose VG is lower
         (min).
         """
-        p = self.p
+        xp, p = self.xp, self.p
         kpm, kg = p["KPM"], p["KG"]
         vm_free = (kpm * va + pm) / (1.0 + kpm * kg * VB)
         vm_cap = kpm * (va - p["VGMAX"]) + pm
-        vm_s = np.where(kg * VB * vm_free <= p["VGMAX"], vm_free, vm_cap)
+        vm_s = xp.where(kg * VB * vm_free <= p["VGMAX"], vm_free, vm_cap)
         # the PI limits act on that output (the loop map is decreasing in VM: its fixed point
         # with the limiter is the clipped one); VG from the limited VM
-        vm = np.clip(vm_s, p["VMMIN"], p["VMMAX"])
-        vg = np.minimum(kg * VB * vm, p["VGMAX"])
+        vm = xp.clip(vm_s, p["VMMIN"], p["VMMAX"])
+        vg = xp.minimum(kg * VB * vm, p["VGMAX"])
         u = va - vg
         return self._pi(pm, u, self.PM, self.PMt, p["VMMIN"], p["VMMAX"])

@@ -30,15 +30,17 @@ import numpy as np
 
 from ..blocks import Lag, LagNonWindup, LeadLag, Washout, rectifier_fex
 from ..control_base import MachineControl
+from ..namespace import NUMPY, put, take
 from ..params import Param
 from .dc_common import SATURATION_PARAMS, DCExciter
 
 
-def _efd(VE, KC, XadIfd):
-    """Rectifier output ``VE * FEX(KC*XadIfd/VE)`` of an AC exciter [pu]."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        IN = np.where(VE > 0, KC * XadIfd / VE, 0.0)
-    return VE * rectifier_fex(IN)
+def _efd(VE, KC, XadIfd, xp=NUMPY):
+    """Rectifier output ``VE * FEX(KC*XadIfd/VE)`` of an AC exciter [pu] (``xp``: the arrays'
+    namespace; ``VE`` is kept off 0 where ``IN`` is not used)."""
+    on = VE > 0
+    IN = xp.where(on, KC * XadIfd / xp.where(on, VE, 1.0), 0.0)
+    return VE * rectifier_fex(IN, xp)
 
 
 def ve_for_efd(vf0, KC, XadIfd):
@@ -73,6 +75,8 @@ def init_ac_exciter(c, x, sig, feedback):
 class EXAC1(MachineControl):
     """IEEE AC1 exciter. Times [s]: TR, TB, TC, TA, TE, TF; gains [pu]: KA, KF, KC, KD, KE;
     VRMAX, VRMIN [pu]; E1, SE1, E2, SE2 (saturation)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -118,22 +122,23 @@ class EXAC1(MachineControl):
         init_ac_exciter(self, x, sig, self.WF)
 
     def compute(self, ctx):
+        xp = self.xp
         p = self.p
         m = self._mi
         lg, ll, vr, ve, wf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        xad = s["XadIfd"][..., m]
+        v = take(xp, s["Ecomp"], m)
+        xad = take(xp, s["XadIfd"], m)
         vfe = self.EX.vfe(ve) + p["KD"] * xad
-        sensed = np.where(self._lagged, self.LG.output(lg, v), v)
-        vi = self.vref0 - sensed - self.WF.output(wf, vfe) + s["vs"][..., m]
-        efd = _efd(ve, p["KC"], xad)
+        sensed = xp.where(self._lagged, self.LG.output(lg, v), v)
+        vi = self.vref0 - sensed - self.WF.output(wf, vfe) + take(xp, s["vs"], m)
+        efd = _efd(ve, p["KC"], xad, xp)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LL.deriv(ll, vi)
         f[..., self._sls[2]] = self.LA.deriv(vr, self.LL.output(ll, vi))
         f[..., self._sls[3]] = (vr - vfe) / p["TE"]
         f[..., self._sls[4]] = self.WF.deriv(wf, vfe)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["EXAC1.vi"], o["EXAC1.VFE"], o["EXAC1.vout"] = vi, vfe, efd

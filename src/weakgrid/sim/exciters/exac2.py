@@ -37,6 +37,7 @@ import numpy as np
 
 from ..blocks import Lag, LagNonWindup, LeadLag, Washout, hard_limit
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 from .dc_common import SATURATION_PARAMS, DCExciter
 from .exac1 import _efd, ve_for_efd
@@ -46,6 +47,8 @@ class EXAC2(MachineControl):
     """IEEE AC2 exciter. Times [s]: TR, TB, TC, TA, TE, TF; gains [pu]: KA, KB, KL, KH, KF, KC, KD,
     KE; limits [pu, machine base]: VAMAX, VAMIN, VRMAX, VRMIN; VLR [pu] (field-current limit
     reference); E1, SE1, E2, SE2 (saturation)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "exciter"
     #: the voltage reference computed at init (from the operating point): per batch member
@@ -122,28 +125,29 @@ class EXAC2(MachineControl):
         ]
 
     def compute(self, ctx):
+        xp = self.xp
         p = self.p
         m = self._mi
         lg, ll, va, ve, vf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
-        v = s["Ecomp"][..., m]
-        xad = s["XadIfd"][..., m]
+        v = take(xp, s["Ecomp"], m)
+        xad = take(xp, s["XadIfd"], m)
         vfe = self.EX.vfe(ve) + p["KD"] * xad
-        sensed = np.where(self._lagged, self.LG.output(lg, v), v)
-        vi = self.vref0 - sensed - self.VF.output(vf, vfe) + s["vs"][..., m]
+        sensed = xp.where(self._lagged, self.LG.output(lg, v), v)
+        vi = self.vref0 - sensed - self.VF.output(vf, vfe) + take(xp, s["vs"], m)
         y = self.LL.output(ll, vi)
         va_y = self.LA.output(va, y)
         vh = va_y - p["KH"] * vfe
         vl = p["KL"] * (p["VLR"] - vfe)
-        vr = hard_limit(p["KB"] * np.minimum(vh, vl), p["VRMIN"], p["VRMAX"])
-        efd = _efd(ve, p["KC"], xad)
+        vr = hard_limit(p["KB"] * xp.minimum(vh, vl), p["VRMIN"], p["VRMAX"], xp)
+        efd = _efd(ve, p["KC"], xad, xp)
         f = ctx.f
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         f[..., self._sls[1]] = self.LL.deriv(ll, vi)
         f[..., self._sls[2]] = self.LA.deriv(va, y)
         f[..., self._sls[3]] = (vr - vfe) / p["TE"]
         f[..., self._sls[4]] = self.VF.deriv(vf, vfe)
-        s["vf"][..., m] = efd
+        put(xp, s["vf"], m, efd)
         o = ctx.out
         o["EXAC2.vi"], o["EXAC2.VH"], o["EXAC2.VL"], o["EXAC2.VR"] = vi, vh, vl, vr
         o["EXAC2.VFE"], o["EXAC2.vout"] = vfe, efd
