@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..blocks import Lag, LeadLag, PINonWindup, hard_limit, quad_saturation, rectifier_fex
+from ..blocks import Lag, LeadLag, PINonWindup, hard_limit, rectifier_fex
 from ..control_base import MachineControl
 from ..errors import DataError
 from ..namespace import NUMPY, put, take
@@ -99,8 +99,6 @@ class EXPIC1(MachineControl):
         self.FB1 = Lag(1.0, p["TF1"])
         self.FB2 = Lag(1.0, p["TF2"])
         self.EX = DCExciter(p["KE"], p["TE"], p["E1"], p["SE1"], p["E2"], p["SE2"])
-        #: the DC exciter's arrays (KE, A, B), held by the model for its namespace
-        self._ex = (self.EX.KE, self.EX.A, self.EX.B)
         self._te = p["TE"] > 0
         self._te_s = np.where(self._te, p["TE"], 1.0)
         self._nosrc = (p["KP"] == 0) & (p["KI"] == 0)
@@ -142,7 +140,6 @@ class EXPIC1(MachineControl):
 
     def compute(self, ctx):
         xp, p = self.xp, self.p
-        KE, A, B = self._ex
         m = self._mi
         lg, pi, x1, ll, vf1, vf, efd_x = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
@@ -169,9 +166,7 @@ class EXPIC1(MachineControl):
         f[..., self._sls[3]] = self.LL.deriv(ll, y1)
         f[..., self._sls[4]] = dvf1
         f[..., self._sls[5]] = self.FB2.deriv(vf, p["KF"] * dvf1)
-        # DCExciter.vfe on the namespace: KE*Efd + B*(Efd - A)^2
-        vfe = KE * efd_x + quad_saturation(efd_x, A, B, xp)
-        f[..., self._sls[6]] = xp.where(self._te, (e0 - vfe) / self._te_s, 0.0)
+        f[..., self._sls[6]] = xp.where(self._te, (e0 - self.EX.vfe(efd_x)) / self._te_s, 0.0)
         put(xp, s["vf"], m, efd)
         o = ctx.out
         o["EXPIC1.ev"], o["EXPIC1.VA"], o["EXPIC1.VR"] = ev, va, vr

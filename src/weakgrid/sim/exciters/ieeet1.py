@@ -16,7 +16,7 @@ starts at VRMAX" option is not implemented).
 
 from __future__ import annotations
 
-from ..blocks import Lag, LagNonWindup, Washout, quad_saturation
+from ..blocks import Lag, LagNonWindup, Washout
 from ..control_base import MachineControl
 from ..namespace import put, take
 from ..params import Param
@@ -57,8 +57,6 @@ class IEEET1(MachineControl):
         self.LG = Lag(1.0, p["TR"])
         self.LA = LagNonWindup(p["KA"], p["TA"], p["VRMIN"], vrmax_or_unlimited(p["VRMAX"]))
         self.EX = DCExciter(p["KE"], p["TE"], p["E1"], p["SE1"], p["E2"], p["SE2"])
-        #: the DC exciter's arrays (KE, TE, A, B), held by the model for its namespace
-        self._ex = (self.EX.KE, self.EX.TE, self.EX.A, self.EX.B)
         self.WF = Washout(p["KF"], p["TF"])
 
     def limits(self):
@@ -76,7 +74,6 @@ class IEEET1(MachineControl):
 
     def compute(self, ctx):
         xp, m = self.xp, self._mi
-        KE, TE, A, B = self._ex
         lg, vr, efd, wf = (ctx.x[..., s] for s in self._sls)
         s = ctx.sig
         v = take(xp, s["Ecomp"], m)
@@ -85,8 +82,7 @@ class IEEET1(MachineControl):
         f[..., self._sls[0]] = self.LG.deriv(lg, v)
         u = vi - self.WF.output(wf, efd)
         f[..., self._sls[1]] = self.LA.deriv(vr, u)
-        # DCExciter.deriv on the namespace: (vr - (KE*Efd + B*(Efd - A)^2)) / TE, = vr unless TA = 0
-        f[..., self._sls[2]] = (self.LA.output(vr, u) - (KE * efd + quad_saturation(efd, A, B, xp))) / TE
+        f[..., self._sls[2]] = self.EX.deriv(efd, self.LA.output(vr, u))   # = vr unless TA = 0
         f[..., self._sls[3]] = self.WF.deriv(wf, efd)
         put(xp, s["vf"], m, efd)
         ctx.out["IEEET1.vi"], ctx.out["IEEET1.vout"] = vi, efd

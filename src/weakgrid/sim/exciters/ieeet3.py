@@ -26,7 +26,7 @@ from ..control_base import MachineControl
 from ..namespace import NUMPY, put, take
 from ..params import Param
 from .dc_common import vrmax_or_unlimited
-from .esst3a import source_voltage0
+from .esst3a import source_voltage, source_voltage0
 
 
 class IEEET3(MachineControl):
@@ -93,11 +93,7 @@ class IEEET3(MachineControl):
         v = take(xp, s["Ecomp"], m)
         vi = self.vref0 - self.LG.output(lg, v) + take(xp, s["vs"], m)
         u = vi - self.VF.output(vf, efd)
-        # esst3a.source_voltage(ctx, mach, bus, KP, KI, 0.0) on the namespace
-        V = take(xp, ctx.V, self.bus)
-        It = xp.conj((take(xp, s["Pe"], self.mach) + 1j * take(xp, s["Qe"], self.mach)) / V)
-        KP = p["KP"]
-        VE = xp.abs(KP * V + 1j * (p["KI"] + KP * 0.0) * It)
+        VE = source_voltage(ctx, self.mach, self.bus, p["KP"], p["KI"], 0.0, xp)
         VB = self._vb(VE, take(xp, s["XadIfd"], m), xp)
         vx = hard_limit(self.LA.output(vr, u) + VB, 0.0, p["VBMAX"], xp)
         f = ctx.f
