@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import DataError
+from ..namespace import NUMPY, put
 
 
 def resolve(comp, system, field, target):
@@ -54,16 +55,16 @@ def chain_of(comp):
     return comp.ree_comp, comp.ree
 
 
-def publish(ctx, key, n, idx, values, default):
+def publish(ctx, key, n, idx, values, default, xp=NUMPY):
     """Write ``values`` at positions ``idx`` of the signal ``key`` (``n`` entries, ``default``
-    elsewhere unless the signal already exists)."""
+    elsewhere unless the signal already exists); ``xp``: the arrays' namespace."""
     x = ctx.x
-    shape = x.shape[:-1] + (n,)
+    shape = tuple(x.shape[:-1]) + (n,)
     arr = ctx.sig.get(key)
-    if arr is None or np.shape(arr) != shape:
-        arr = np.broadcast_to(np.asarray(default, float), shape).copy()
+    if arr is None or tuple(getattr(arr, "shape", ())) != shape:
+        arr = xp.asarray(xp.broadcast_to(xp.asarray(default, dtype=xp.float64), shape), copy=True)
         ctx.sig[key] = arr
-    arr[..., idx] = values
+    put(xp, arr, idx, values)
     return arr
 
 
@@ -87,11 +88,12 @@ def chain_pattern(system, ree_comp, ree_idx, extra_states):
     return (v, v)
 
 
-def held(dx, x, lower, upper):
+def held(dx, x, lower, upper, xp=NUMPY):
     """``dx`` with 0 where the state ``x`` sits at a non-windup limit and is pushed outward.
 
     The integrator holds such a state (:mod:`weakgrid.sim.integrate`); writing the held
     derivative also makes a state that *starts* at its limit with an outward push (ANDES's
     pitch controller, whose speed reference is below the initial speed) an equilibrium.
+    ``xp``: the arrays' namespace.
     """
-    return np.where(((x <= lower) & (dx < 0)) | ((x >= upper) & (dx > 0)), 0.0, dx)
+    return xp.where(((x <= lower) & (dx < 0)) | ((x >= upper) & (dx > 0)), 0.0, dx)

@@ -16,8 +16,6 @@ takes the BusFreq constants as ``Tf_meas``, ``Tw_meas`` (``Tf`` is the SOC's, as
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..params import Param
 from .pvd1 import PVD1
 
@@ -26,6 +24,8 @@ _MEAS = {"Tf": "Tf_meas", "Tw": "Tw_meas"}
 
 class ESD1(PVD1):
     """Distributed energy storage (WECC ESD1): PVD1 + charging + state of charge."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     params = tuple(Param(_MEAS.get(p.name, p.name), p.default, p.unit, p.info, p.rule, p.base)
                    for p in PVD1.params) + (
@@ -50,8 +50,8 @@ class ESD1(PVD1):
         self._kE = system.Sb / (3600.0 * p["En"] * p["Tf"])     # dSOC/dt per pu of power
 
     def _gates_of(self, soc):
-        p = self.p
-        return -(soc < p["SOCmax"]).astype(float), (soc > p["SOCmin"]).astype(float)
+        xp, p = self.xp, self.p
+        return -xp.astype(soc < p["SOCmax"], xp.float64), xp.astype(soc > p["SOCmin"], xp.float64)
 
     def _init_gates(self):
         return self._gates_of(self.p["SOCinit"])
@@ -65,7 +65,7 @@ class ESD1(PVD1):
 
     def compute(self, ctx):
         ipout, v = super().compute(ctx)
-        p = self.p
+        xp, p = self.xp, self.p
         P = ipout * v
-        ctx.f[..., self._sls[4]] = -self._kE * np.where(P < 0.0, P * p["EtaC"], P / p["EtaD"])
+        ctx.f[..., self._sls[4]] = -self._kE * xp.where(P < 0.0, P * p["EtaC"], P / p["EtaD"])
         ctx.out[self._key["SOC"]] = ctx.x[..., self._sls[4]]

@@ -31,22 +31,24 @@ import numpy as np
 from ..blocks import Lag, Washout
 from ..component import Component
 from ..errors import DataError
-from ..namespace import add_at
+from ..namespace import NUMPY, add_at, take
 from ..params import Param
 
 
-def _band_lo(u, p0, p1):
+def _band_lo(u, p0, p1, xp=NUMPY):
     """0 at or below p0, linear to 1 at p1, 1 above (ANDES Limiter zones)."""
-    return np.where(u <= p0, 0.0, np.where(u >= p1, 1.0, (u - p0) / (p1 - p0)))
+    return xp.where(u <= p0, 0.0, xp.where(u >= p1, 1.0, (u - p0) / (p1 - p0)))
 
 
-def _band_hi(u, p2, p3):
+def _band_hi(u, p2, p3, xp=NUMPY):
     """1 at or below p2, linear to 0 at p3, 0 above."""
-    return np.where(u <= p2, 1.0, np.where(u >= p3, 0.0, 1.0 + (p2 - u) / (p3 - p2)))
+    return xp.where(u <= p2, 1.0, xp.where(u >= p3, 0.0, 1.0 + (p2 - u) / (p3 - p2)))
 
 
 class PVD1(Component):
     """Distributed PV (WECC PVD1); several devices may share one static generator row."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "device"
     #: the power-flow voltage and power references computed at init: per batch member
@@ -143,33 +145,33 @@ class PVD1(Component):
         return 0.0, 1.0
 
     def _commands(self, v, V, fHz, ipout, iqout, gates):
-        p = self.p
-        vp = np.maximum(v, 0.01)
-        R = _band_lo(v, p["vt0"], p["vt1"]) * _band_hi(v, p["vt2"], p["vt3"]) \
-            * _band_lo(fHz, p["ft0"], p["ft1"]) * _band_hi(fHz, p["ft2"], p["ft3"])
-        R = np.where(p["recflag"] > 0, R, 1.0)
+        xp, p = self.xp, self.p
+        vp = xp.maximum(v, 0.01)
+        R = _band_lo(v, p["vt0"], p["vt1"], xp) * _band_hi(v, p["vt2"], p["vt3"], xp) \
+            * _band_lo(fHz, p["ft0"], p["ft1"], xp) * _band_hi(fHz, p["ft2"], p["ft3"], xp)
+        R = xp.where(p["recflag"] > 0, R, 1.0)
         fdev = p["fn"] - fHz
-        pdrp = p["ddn"] * (np.where(fdev >= 999.0, fdev - 999.0, 0.0)
-                           + np.where(fdev <= p["fdbd"], fdev - p["fdbd"], 0.0))
+        pdrp = p["ddn"] * (xp.where(fdev >= 999.0, fdev - 999.0, 0.0)
+                           + xp.where(fdev <= p["fdbd"], fdev - p["fdbd"], 0.0))
         psum = self.pref0 + pdrp
         pmin = self.pmin_frac * p["pmx"]
-        ipul = np.where(psum >= p["pmx"], p["pmx"], np.where(psum <= pmin, pmin, psum)) / vp
-        vcomp = np.abs(V + 1j * p["xc"] * (ipout + 1j * iqout))
-        qdrp = np.where(vcomp <= self.Vql, p["qmx"], 0.0) + np.where(vcomp >= self.Vqu, p["qmn"], 0.0) \
-            + np.where((vcomp > self.Vql) & (vcomp < p["v0"]), p["qmx"] + p["dqdv"] * (self.Vqu - vcomp), 0.0) \
-            + np.where((vcomp > p["v1"]) & (vcomp < self.Vqu), p["dqdv"] * (p["v1"] - vcomp), 0.0)
+        ipul = xp.where(psum >= p["pmx"], p["pmx"], xp.where(psum <= pmin, pmin, psum)) / vp
+        vcomp = xp.abs(V + 1j * p["xc"] * (ipout + 1j * iqout))
+        qdrp = xp.where(vcomp <= self.Vql, p["qmx"], 0.0) + xp.where(vcomp >= self.Vqu, p["qmn"], 0.0) \
+            + xp.where((vcomp > self.Vql) & (vcomp < p["v0"]), p["qmx"] + p["dqdv"] * (self.Vqu - vcomp), 0.0) \
+            + xp.where((vcomp > p["v1"]) & (vcomp < self.Vqu), p["dqdv"] * (p["v1"] - vcomp), 0.0)
         iqul = (self.qref0 + qdrp) / vp
         pri = p["pqflag"] > 0
         lim = p["ialim"]
         # P priority: Ip limited by ialim, Iq by what is left; Q priority the other way round
         glo, ghi = gates
-        ipcmd_p = R * np.clip(ipul, glo * lim, ghi * lim)
-        iqmax_p = np.sqrt(np.maximum(lim ** 2 - ipcmd_p ** 2, 0.0))
-        iqcmd_p = R * np.clip(iqul, -iqmax_p, iqmax_p)
-        iqcmd_q = R * np.clip(iqul, -lim, lim)
-        ipmax_q = np.sqrt(np.maximum(lim ** 2 - iqcmd_q ** 2, 0.0))
-        ipcmd_q = R * np.clip(ipul, glo * ipmax_q, ghi * ipmax_q)
-        return np.where(pri, ipcmd_p, ipcmd_q), np.where(pri, iqcmd_p, iqcmd_q), R, qdrp, ipul
+        ipcmd_p = R * xp.clip(ipul, glo * lim, ghi * lim)
+        iqmax_p = xp.sqrt(xp.maximum(lim ** 2 - ipcmd_p ** 2, 0.0))
+        iqcmd_p = R * xp.clip(iqul, -iqmax_p, iqmax_p)
+        iqcmd_q = R * xp.clip(iqul, -lim, lim)
+        ipmax_q = xp.sqrt(xp.maximum(lim ** 2 - iqcmd_q ** 2, 0.0))
+        ipcmd_q = R * xp.clip(ipul, glo * ipmax_q, ghi * ipmax_q)
+        return xp.where(pri, ipcmd_p, ipcmd_q), xp.where(pri, iqcmd_p, iqcmd_q), R, qdrp, ipul
 
     def init(self, system, x, sig):
         pf = system.network.pf
@@ -202,19 +204,19 @@ class PVD1(Component):
 
     # -------------------------------------------------------------- equations
     def compute(self, ctx):
-        x = ctx.x
-        sl = self._sls
+        xp, x, sl = self.xp, ctx.x, self._sls
         L, wo, ipout, iqout = (x[..., sl[k]] for k in range(4))
-        V = ctx.V[..., self.bus]
-        v = np.abs(V)
+        V = take(xp, ctx.V, self.bus)
+        v = xp.abs(V)
         # (a - a0) - L, wrapped: L stays a continuous (unwrapped) angle even when the grid
         # frequency drifts for long (the bus angle itself is only known modulo 2 pi)
-        err = np.angle(V * np.conj(self.V0) * np.exp(-1j * L))
+        z = V * xp.conj(self.V0) * xp.exp(-1j * L)
+        err = xp.atan2(xp.imag(z), xp.real(z))      # numpy.angle
         df = self.WOb.output(wo, L)
         fHz = self.p["fn"] * (1.0 + df)
         ipcmd, iqcmd, R, _, ipul = self._commands(v, V, fHz, ipout, iqout, self._ip_gates(x))
-        vs = np.where(v > 1e-6, v, 1e-6)
-        add_at(self.xp, ctx.I, self.bus, self.connected((ipout - 1j * iqout) * V / vs), self._uniq)
+        vs = xp.where(v > 1e-6, v, 1e-6)
+        add_at(xp, ctx.I, self.bus, self.connected((ipout - 1j * iqout) * V / vs), self._uniq)
         f = ctx.f
         f[..., sl[0]] = err / self.Lb._Ts
         f[..., sl[1]] = self.WOb.deriv(wo, L)

@@ -79,6 +79,7 @@ import numpy as np
 from ..blocks import Lag, LagRate, PITrackAW, deadband, piecewise_linear
 from ..component import Component
 from ..errors import DataError
+from ..namespace import put, take
 from ..params import Param
 
 BIG = 1e8    # "no limit" (ANDES's replacement value)
@@ -90,6 +91,8 @@ def _flag(name, info):
 
 class REECA1(Component):
     """Renewable energy electrical control model A (WECC); drives one REGCA1."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "device"
     order = 2            # after REGCA1 (reads its P, Q, v) and REPCA1 (reads Pext, Qext)
@@ -278,20 +281,20 @@ class REECA1(Component):
 
     # ------------------------------------------------------------ current limit
     def _vdl(self, s0):
-        p = self.p
+        xp, p = self.xp, self.p
         vdl1 = piecewise_linear(s0, [p["Vq1"], p["Vq2"], p["Vq3"], p["Vq4"]],
-                                [p["Iq1"], p["Iq2"], p["Iq3"], p["Iq4"]])
+                                [p["Iq1"], p["Iq2"], p["Iq3"], p["Iq4"]], xp)
         vdl2 = piecewise_linear(s0, [p["Vp1"], p["Vp2"], p["Vp3"], p["Vp4"]],
-                                [p["Ip1"], p["Ip2"], p["Ip3"], p["Ip4"]])
-        iq1 = np.where(self.zVDL1, np.minimum(vdl1, self.Imaxr), BIG)
-        ip1 = np.where(self.zVDL2, np.minimum(vdl2, self.Imaxr), BIG)
+                                [p["Ip1"], p["Ip2"], p["Ip3"], p["Ip4"]], xp)
+        iq1 = xp.where(self.zVDL1, xp.minimum(vdl1, self.Imaxr), BIG)
+        ip1 = xp.where(self.zVDL2, xp.minimum(vdl2, self.Imaxr), BIG)
         return iq1, ip1
 
     # ------------------------------------------------- variant hooks (REECB1)
     def _vdiv(self, v, s0y):
         """Voltage dividing the power orders into currents: ``max(v, 0.01)``, the terminal
         voltage (ANDES 2.0)."""
-        return np.where(v <= 0.01, 0.01, v)
+        return self.xp.where(v <= 0.01, 0.01, v)
 
     def _piq0(self, v):
         """Initial state of the Q PI (``Qerr = 0`` there): 0 (ANDES), or the nearest value within
@@ -305,20 +308,20 @@ class REECA1(Component):
         return -np.where(p["QFLAG"] > 0, v - p["Vref1"], self.Iqcmd0 * vp)
 
     def _vsel(self, piq, pfsel):
-        p = self.p
-        return np.clip(np.where(p["VFLAG"] > 0, piq, p["Vref1"] + pfsel), p["VMIN"], p["VMAX"])
+        xp, p = self.xp, self.p
+        return xp.clip(xp.where(p["VFLAG"] > 0, piq, p["Vref1"] + pfsel), p["VMIN"], p["VMAX"])
 
     def _piv_input(self, vsel, s0y):
-        p = self.p
-        return np.where(p["QFLAG"] > 0, vsel - np.where(p["VFLAG"] > 0, 0.0, s0y), 0.0)
+        xp, p = self.xp, self.p
+        return xp.where(p["QFLAG"] > 0, vsel - xp.where(p["VFLAG"] > 0, 0.0, s0y), 0.0)
 
     def _iqinj(self, iqv, dip, t):
-        p = self.p
+        xp, p = self.xp, self.p
         run = ~dip
         ext = run & ((self._dip_prev & (self.Thld_abs > 0)) | (t < self._t_thld))
-        iqinj = np.where(dip, iqv, np.where(ext, np.where(p["Thld"] < 0, iqv,
-                                                          np.where(p["Thld"] > 0, p["Iqfrz"], 0.0)), 0.0))
-        return np.clip(iqinj, p["Iql1"], p["Iqh1"])
+        iqinj = xp.where(dip, iqv, xp.where(ext, xp.where(p["Thld"] < 0, iqv,
+                                                          xp.where(p["Thld"] > 0, p["Iqfrz"], 0.0)), 0.0))
+        return xp.clip(iqinj, p["Iql1"], p["Iqh1"])
 
     # -------------------------------------------------------------------- init
     def init(self, system, x, sig):
@@ -381,14 +384,12 @@ class REECA1(Component):
 
     # --------------------------------------------------------------- equations
     def compute(self, ctx):
-        p = self.p
-        x = ctx.x
-        sl = self._sls
+        xp, p, x, sl = self.xp, self.p, ctx.x, self._sls
         s0, S1, xq, s4, pfl, s5, xv = (x[..., sl[k]] for k in range(7))
         r = self.reg
-        v = ctx.sig["REGCA1.v"][..., r]
-        Pe = ctx.sig["REGCA1.Pe"][..., r]
-        Qe = ctx.sig["REGCA1.Qe"][..., r]
+        v = take(xp, ctx.sig["REGCA1.v"], r)
+        Pe = take(xp, ctx.sig["REGCA1.Pe"], r)
+        Qe = take(xp, ctx.sig["REGCA1.Qe"], r)
         pext = ctx.sig.get(f"{self.type_name}.Pext", 0.0)
         qext = ctx.sig.get(f"{self.type_name}.Qext", 0.0)
         t = ctx.t
@@ -399,24 +400,24 @@ class REECA1(Component):
         S1y = self.S1b.output(S1, Pe)
         # reactive power
         qref = self.Qref0 + qext
-        qcpf = np.where(self.zp, self.q0, S1y * np.tan(self.pfaref0))
-        pfsel = np.where(p["PFFLAG"] > 0, qcpf, qref)
-        qerr = np.clip(pfsel, p["QMin"], p["QMax"]) - Qe
+        qcpf = xp.where(self.zp, self.q0, S1y * xp.tan(self.pfaref0))
+        pfsel = xp.where(p["PFFLAG"] > 0, qcpf, qref)
+        qerr = xp.clip(pfsel, p["QMin"], p["QMax"]) - Qe
         vflag, qflag = p["VFLAG"] > 0, p["QFLAG"] > 0
-        uq = np.where(vflag, qerr, 0.0)
-        piq = np.where(dip, self._piq_hold, self.PIQb.output(xq, uq, p["VMIN"], p["VMAX"]))
+        uq = xp.where(vflag, qerr, 0.0)
+        piq = xp.where(dip, self._piq_hold, self.PIQb.output(xq, uq, p["VMIN"], p["VMAX"]))
         vsel = self._vsel(piq, pfsel)
         s4y = self.s4b.output(s4, pfsel / vp)
-        s4y = np.where(dip & (p["Tiq"] <= 0), self._s4_hold, s4y)     # a frozen pass-through holds
+        s4y = xp.where(dip & (p["Tiq"] <= 0), self._s4_hold, s4y)     # a frozen pass-through holds
         # voltage-dip reactive current injection
-        iqv = p["Kqv"] * deadband(self.Vref0r - s0y, p["dbd1"], p["dbd2"])
+        iqv = p["Kqv"] * deadband(self.Vref0r - s0y, p["dbd1"], p["dbd2"], xp)
         iqinj = self._iqinj(iqv, dip, t)
         # active power: Pref from a torque controller (WTTQA1) if any, wg from a drive train
         pref = ctx.sig.get(f"{self.type_name}.Pref", self.Pref0) + pext
         pfy = pfl                      # LagRate: output = state (tpfilt > 0)
-        pfy = np.where(p["PFLAG"] > 0, ctx.sig.get(f"{self.type_name}.wg", 1.0) * pfy, pfy)   # Psel
+        pfy = xp.where(p["PFLAG"] > 0, ctx.sig.get(f"{self.type_name}.wg", 1.0) * pfy, pfy)   # Psel
         # Tpord = 0: the limiter only (held in a dip, as a frozen state)
-        pord = np.where(p["Tpord"] > 0, s5, np.where(dip, self._pord_hold, np.clip(pfy, p["PMIN"], p["PMAX"])))
+        pord = xp.where(p["Tpord"] > 0, s5, xp.where(dip, self._pord_hold, xp.clip(pfy, p["PMIN"], p["PMAX"])))
         # current limiter
         iq1, ip1 = self._vdl(s0y)
         fthld2 = run & ((self._dip_prev & (p["Thld2"] > 0)) | (t < self._t_thld2))
@@ -425,27 +426,27 @@ class REECA1(Component):
         uv = self._piv_input(vsel, s0y)
         # Q priority: Iq first
         iqmax_q = iq1
-        piv_q = np.where(dip, self._piv_hold, self.PIVb.output(xv, uv, -iqmax_q, iqmax_q))
-        iqcmd_q = np.clip(np.where(qflag, piv_q, s4y) + iqinj, -iqmax_q, iqmax_q)
+        piv_q = xp.where(dip, self._piv_hold, self.PIVb.output(xv, uv, -iqmax_q, iqmax_q))
+        iqcmd_q = xp.clip(xp.where(qflag, piv_q, s4y) + iqinj, -iqmax_q, iqmax_q)
         np_ = p["vdl_np"] > 0
-        ipmax_q = np.minimum(np.where(np_, ip1, BIG), np.sqrt(np.maximum(I2 - iqcmd_q ** 2, 0.0)))
+        ipmax_q = xp.minimum(xp.where(np_, ip1, BIG), xp.sqrt(xp.maximum(I2 - iqcmd_q ** 2, 0.0)))
         # P priority: Ip first
         ipmax_p = ip1
-        ipmax = np.where(pri, ipmax_p, ipmax_q)
-        ipmax = np.where(fthld2, self._ipmax_hold, ipmax)
-        ipcmd = np.clip(pord / vp, 0.0, ipmax)
-        iqmax_p = np.minimum(np.where(np_, iq1, BIG), np.sqrt(np.maximum(I2 - ipcmd ** 2, 0.0)))
-        piv_p = np.where(dip, self._piv_hold, self.PIVb.output(xv, uv, -iqmax_p, iqmax_p))
-        iqcmd_p = np.clip(np.where(qflag, piv_p, s4y) + iqinj, -iqmax_p, iqmax_p)
-        iqmax = np.where(pri, iqmax_p, iqmax_q)
-        iqcmd = np.where(pri, iqcmd_p, iqcmd_q)
-        piv = np.where(pri, piv_p, piv_q)
-        qsel = np.where(qflag, piv, s4y)
-        ctx.sig["REGCA1.Ipcmd"][..., r] = ipcmd + self.Ip_offset
-        ctx.sig["REGCA1.Iqcmd"][..., r] = -iqcmd
+        ipmax = xp.where(pri, ipmax_p, ipmax_q)
+        ipmax = xp.where(fthld2, self._ipmax_hold, ipmax)
+        ipcmd = xp.clip(pord / vp, 0.0, ipmax)
+        iqmax_p = xp.minimum(xp.where(np_, iq1, BIG), xp.sqrt(xp.maximum(I2 - ipcmd ** 2, 0.0)))
+        piv_p = xp.where(dip, self._piv_hold, self.PIVb.output(xv, uv, -iqmax_p, iqmax_p))
+        iqcmd_p = xp.clip(xp.where(qflag, piv_p, s4y) + iqinj, -iqmax_p, iqmax_p)
+        iqmax = xp.where(pri, iqmax_p, iqmax_q)
+        iqcmd = xp.where(pri, iqcmd_p, iqcmd_q)
+        piv = xp.where(pri, piv_p, piv_q)
+        qsel = xp.where(qflag, piv, s4y)
+        put(xp, ctx.sig["REGCA1.Ipcmd"], r, ipcmd + self.Ip_offset)
+        put(xp, ctx.sig["REGCA1.Iqcmd"], r, -iqcmd)
         # derivatives
         f = ctx.f
-        frz = np.where(dip, 0.0, 1.0)
+        frz = xp.where(dip, xp.asarray(0.0, dtype=xp.float64), 1.0)
         f[..., sl[0]] = self.s0b.deriv(s0, v)
         f[..., sl[1]] = self.S1b.deriv(S1, Pe)
         f[..., sl[2]] = frz * self.PIQb.deriv(xq, uq, p["VMIN"], p["VMAX"])
@@ -458,25 +459,25 @@ class REECA1(Component):
         o[f"{tn}.Ipcmd"], o[f"{tn}.Iqcmd"] = ipcmd, iqcmd
         o[f"{tn}.Ipmax"], o[f"{tn}.Iqmax"] = ipmax, iqmax
         o[f"{tn}.Iqinj"], o[f"{tn}.Pord"] = iqinj, pord
-        o[f"{tn}.Volt_dip"] = dip.astype(float)
+        o[f"{tn}.Volt_dip"] = xp.astype(dip, xp.float64)
         o[f"{tn}.Qsel"], o[f"{tn}.PIQ_y"], o[f"{tn}.PIV_y"] = qsel, piq, piv
-        o[f"{tn}.fThld2"] = fthld2.astype(float)
+        o[f"{tn}.fThld2"] = xp.astype(fthld2, xp.float64)
         o[f"{tn}.s4_y"] = s4y
         o[f"{tn}.Pref"] = pref
 
     def accept(self, t, ctx):
         """Update the discrete memory at an accepted point: dip end times, held values."""
-        o = ctx.out
+        xp, o = self.xp, ctx.out
         tn = self.type_name
         dip = o[f"{tn}.Volt_dip"] > 0.5
         ended = self._dip_prev & ~dip
-        self._t_thld = np.where(ended, t + self.Thld_abs, self._t_thld)
-        self._t_thld2 = np.where(ended, t + self.p["Thld2"], self._t_thld2)
+        self._t_thld = xp.where(ended, t + self.Thld_abs, self._t_thld)
+        self._t_thld2 = xp.where(ended, t + self.p["Thld2"], self._t_thld2)
         self._dip_prev = dip
         run = ~dip
-        self._piq_hold = np.where(run, o[f"{tn}.PIQ_y"], self._piq_hold)
-        self._piv_hold = np.where(run, o[f"{tn}.PIV_y"], self._piv_hold)
-        self._s4_hold = np.where(run, o[f"{tn}.s4_y"], self._s4_hold)
-        self._pord_hold = np.where(run, o[f"{tn}.Pord"], self._pord_hold)
+        self._piq_hold = xp.where(run, o[f"{tn}.PIQ_y"], self._piq_hold)
+        self._piv_hold = xp.where(run, o[f"{tn}.PIV_y"], self._piv_hold)
+        self._s4_hold = xp.where(run, o[f"{tn}.s4_y"], self._s4_hold)
+        self._pord_hold = xp.where(run, o[f"{tn}.Pord"], self._pord_hold)
         f2 = o[f"{tn}.fThld2"] > 0.5
-        self._ipmax_hold = np.where(f2, self._ipmax_hold, o[f"{tn}.Ipmax"])
+        self._ipmax_hold = xp.where(f2, self._ipmax_hold, o[f"{tn}.Ipmax"])

@@ -46,6 +46,8 @@ _ONLY_A = {"PFLAG", "Vref1", "Iqfrz", "Thld", "Thld2", "vdl_np"} | {
 class REECB1(REECA1):
     """Renewable energy electrical control model B (WECC); drives one REGCA1."""
 
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
+
     params = tuple(p for p in REECA1.params if p.name not in _ONLY_A) + (
         Param("wecc", 0.0, "-", "1 PSS/E's REECB1 (the V PI regulates Vsel - s0; Vsel = PIQ, or the Q "
               "reference with VFLAG = 0; currents = orders / s0), 0 ANDES 2.0 (V PI input Vsel = clip(PIQ "
@@ -67,8 +69,8 @@ class REECB1(REECA1):
         self._setup_links(system)
 
     def _vdl(self, s0):
-        shape = np.shape(s0)
-        return np.broadcast_to(self.Imaxr, shape), np.broadcast_to(self.Imaxr, shape)
+        xp, shape = self.xp, tuple(s0.shape)
+        return xp.broadcast_to(self.Imaxr, shape), xp.broadcast_to(self.Imaxr, shape)
 
     @classmethod
     def psse_params(cls, values, ctx):
@@ -82,7 +84,8 @@ class REECB1(REECA1):
 
     def _vdiv(self, v, s0y):
         # PSS/E: Ipcmd = Pord / Vt_filt, Iqcmd = Q / Vt_filt (the Trv-filtered voltage s0)
-        return np.where(self._std(), np.maximum(s0y, 0.01), super()._vdiv(v, s0y))
+        xp = self.xp
+        return xp.where(self._std(), xp.maximum(s0y, 0.01), super()._vdiv(v, s0y))
 
     def _piq0(self, v):
         p = self.p
@@ -95,12 +98,13 @@ class REECB1(REECA1):
         return np.where(self._std() & (p["VFLAG"] <= 0) & (p["QFLAG"] > 0), v, self.q0)
 
     def _vsel(self, piq, pfsel):
-        p = self.p
-        ands = np.clip(np.where(p["VFLAG"] > 0, piq, 0.0), p["VMIN"], p["VMAX"])
-        return np.where(self._std(), np.where(p["VFLAG"] > 0, piq, pfsel), ands)
+        xp, p = self.xp, self.p
+        ands = xp.clip(xp.where(p["VFLAG"] > 0, piq, 0.0), p["VMIN"], p["VMAX"])
+        return xp.where(self._std(), xp.where(p["VFLAG"] > 0, piq, pfsel), ands)
 
     def _piv_input(self, vsel, s0y):
-        return np.where(self.p["QFLAG"] > 0, vsel - np.where(self._std(), s0y, 0.0), 0.0)
+        xp = self.xp
+        return xp.where(self.p["QFLAG"] > 0, vsel - xp.where(self._std(), s0y, 0.0), 0.0)
 
     def _iqinj(self, iqv, dip, t):
-        return np.clip(iqv, self.p["Iql1"], self.p["Iqh1"])
+        return self.xp.clip(iqv, self.p["Iql1"], self.p["Iqh1"])

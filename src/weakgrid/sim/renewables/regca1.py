@@ -75,7 +75,7 @@ import numpy as np
 from ..blocks import Lag, LagRate, piecewise_linear
 from ..component import Component
 from ..errors import DataError
-from ..namespace import add_at
+from ..namespace import add_at, take
 from ..params import Param
 
 
@@ -94,6 +94,8 @@ class REGCA1(Component):
     before REPCA1) and, for REPCA1 with a monitored branch, ``branch_row(from_bus, to_bus, ckt)`` ->
     0-based branch row (PSS/E bus numbers, stripped circuit id).
     """
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "device"
     gen_shared = True        # with machines or other converters, by the shares gammap, gammaq
@@ -190,14 +192,14 @@ class REGCA1(Component):
     # ---------------------------------------------------------------- algebra
     def _lvg(self, v):
         p = self.p
-        return piecewise_linear(v, [p["Lvpnt0"], p["Lvpnt1"]], [0.0, 1.0])
+        return piecewise_linear(v, [p["Lvpnt0"], p["Lvpnt1"]], [0.0, 1.0], self.xp)
 
     def _lvpl(self, s2):
-        p = self.p
+        xp, p = self.xp, self.p
         on = p["Lvplsw"] > 0
         seg = (s2 - p["Zerox"]) * p["Lvpl1"] / (p["Brkpt"] - p["Zerox"])
-        lim = np.where(s2 <= p["Zerox"], 0.0, np.where(s2 <= p["Brkpt"], seg, 9999.0))
-        return np.where(on, lim, 9999.0)
+        lim = xp.where(s2 <= p["Zerox"], 0.0, xp.where(s2 <= p["Brkpt"], seg, 9999.0))
+        return xp.where(on, lim, 9999.0)
 
     limit_fields = {"S0": ("lower limit", "LVPL (Brkpt, Zerox, Lvpl1)")}
 
@@ -262,28 +264,26 @@ class REGCA1(Component):
 
     # -------------------------------------------------------------- equations
     def compute(self, ctx):
-        p = self.p
-        x = ctx.x
-        sl = self._sls
+        xp, p, x, sl = self.xp, self.p, ctx.x, self._sls
         s0, s1, s2 = x[..., sl[0]], x[..., sl[1]], x[..., sl[2]]
-        V = ctx.V[..., self.bus]
-        v = np.abs(V)
+        V = take(xp, ctx.V, self.bus)
+        v = xp.abs(V)
         lvpl = self._lvpl(s2)
         self._lvpl_v = lvpl
         ip = s0                       # held at/below LVPL by the integrator (anti-windup reset)
         lvg = self._lvg(v)
         ipout = ip * lvg
-        hvg = np.maximum(p["Khv"] * (v - p["Volim"]), 0.0)
-        iqout = np.clip(s1 - hvg, p["Iolim"], 9999.0)
-        vs = np.where(v > 1e-6, v, 1e-6)
+        hvg = xp.maximum(p["Khv"] * (v - p["Volim"]), 0.0)
+        iqout = xp.clip(s1 - hvg, p["Iolim"], 9999.0)
+        vs = xp.where(v > 1e-6, v, 1e-6)
         I = (ipout - 1j * iqout) * V / vs
-        add_at(self.xp, ctx.I, self.bus, self.connected(I), self._uniq)
+        add_at(xp, ctx.I, self.bus, self.connected(I), self._uniq)
         # the converter's P and Q: with |V|, or with PSS/E's per-step estimate Vest
-        vp = np.where(self._psse_if, 0.5 * (self._vest + v), v)
+        vp = xp.where(self._psse_if, 0.5 * (self._vest + v), v)
         # commands: constant unless an electrical control (REECA1) publishes them
         shape = x.shape[:-1] + (self.n,)
-        ctx.sig["REGCA1.Ipcmd"] = np.broadcast_to(self.Ipcmd0, shape).copy()
-        ctx.sig["REGCA1.Iqcmd"] = np.broadcast_to(self.Iqcmd0, shape).copy()
+        ctx.sig["REGCA1.Ipcmd"] = xp.asarray(xp.broadcast_to(self.Ipcmd0, shape), copy=True)
+        ctx.sig["REGCA1.Iqcmd"] = xp.asarray(xp.broadcast_to(self.Iqcmd0, shape), copy=True)
         ctx.sig["REGCA1.v"] = v
         ctx.sig["REGCA1.Pe"] = ipout * vp
         ctx.sig["REGCA1.Qe"] = iqout * vp
@@ -307,5 +307,6 @@ class REGCA1(Component):
     def _accept_vest(self, t, ctx):
         """PSS/E's interface (``psse_interface = 1``): keep ``Vest`` of the accepted point ``t``,
         ``(Vest_prev + |V|)/2``, for the next step's network solutions."""
-        v = np.abs(ctx.V[..., self.bus])
-        self._vest = np.where(self._psse_if, 0.5 * (self._vest + v), self._vest)
+        xp = self.xp
+        v = xp.abs(take(xp, ctx.V, self.bus))
+        self._vest = xp.where(self._psse_if, 0.5 * (self._vest + v), self._vest)

@@ -48,6 +48,7 @@ import numpy as np
 from ..blocks import Lag, LeadLag, PITrackAW, Washout, deadband
 from ..component import Component
 from ..errors import DataError
+from ..namespace import put, take
 from ..params import Param
 
 _EC = ("REECA1", "REECB1")     # electrical controls a plant control may drive
@@ -59,6 +60,8 @@ def _flag(name, info, default=None):
 
 class REPCA1(Component):
     """Renewable plant control model A (WECC); drives one REECA1 or REECB1."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "device"
     order = 1            # before REECA1/REECB1, which read Pext and Qext
@@ -218,6 +221,7 @@ class REPCA1(Component):
         self.isign = np.zeros(self.n)
         self.zl = np.ones(self.n, complex)
         self.term = np.array([bool(lk.get("terminal")) for lk in self.links], bool)
+        self._any_term = bool(self.term.any())
         self.r = np.zeros(self.n, int)        # REGCA1 of each plant control
         Sn = np.zeros(self.n)
         for i, lk in enumerate(self.links):
@@ -285,17 +289,18 @@ class REPCA1(Component):
     # ---------------------------------------------------------------- algebra
     def _line(self, V, PQ=None):
         """Pline, Qline, VCsel, |V|; ``PQ`` = the converters' ``Pe + jQe`` (terminal measurement)."""
-        V1, V2 = V[..., self.b1], V[..., self.b2]
-        Vb = V[..., self.bus]
+        xp = self.xp
+        V1, V2 = take(xp, V, self.b1), take(xp, V, self.b2)
+        Vb = take(xp, V, self.bus)
         I = self.isign * (V1 - V2) / self.zl
-        S = self.isign * V1 * np.conj((V1 - V2) / self.zl)
-        if PQ is not None and self.term.any():
-            S = np.where(self.term, PQ, S)
-            I = np.where(self.term, np.conj(PQ / np.where(np.abs(Vb) > 1e-6, Vb, 1e-6)), I)
-        Vc = np.abs(Vb - (self.p["Rc"] + 1j * self.p["Xc"]) * I)
-        v = np.abs(Vb)
-        vcsel = np.where(self.p["VCFlag"] > 0, Vc, S.imag * self.p["Kc"] + v)
-        return S.real, S.imag, vcsel, v
+        S = self.isign * V1 * xp.conj((V1 - V2) / self.zl)
+        if PQ is not None and self._any_term:
+            S = xp.where(self.term, PQ, S)
+            I = xp.where(self.term, xp.conj(PQ / xp.where(xp.abs(Vb) > 1e-6, Vb, 1e-6)), I)
+        Vc = xp.abs(Vb - (self.p["Rc"] + 1j * self.p["Xc"]) * I)
+        v = xp.abs(Vb)
+        vcsel = xp.where(self.p["VCFlag"] > 0, Vc, xp.imag(S) * self.p["Kc"] + v)
+        return xp.real(S), xp.imag(S), vcsel, v
 
     def init(self, system, x, sig):
         V = system.network.pf.V
@@ -318,37 +323,36 @@ class REPCA1(Component):
         self._ehold = np.zeros(self.n)
 
     def compute(self, ctx):
-        p = self.p
-        x = ctx.x
-        sl = self._sls
+        xp, p, x, sl = self.xp, self.p, ctx.x, self._sls
         s0, s1, s2, s3, s4, s5, s6, L, wo = (x[..., sl[k]] for k in range(9))
         r = self.r
-        P, Q, vcsel, v = self._line(ctx.V, ctx.sig["REGCA1.Pe"][..., r] + 1j * ctx.sig["REGCA1.Qe"][..., r])
+        P, Q, vcsel, v = self._line(ctx.V, take(xp, ctx.sig["REGCA1.Pe"], r) + 1j * take(xp, ctx.sig["REGCA1.Qe"], r))
         # frequency at the bus (ANDES BusFreq): angle lag and washout
-        Vb = ctx.V[..., self.bus]
-        err = np.angle(Vb * np.conj(self.V0) * np.exp(-1j * L))
+        Vb = take(xp, ctx.V, self.bus)
+        z = Vb * xp.conj(self.V0) * xp.exp(-1j * L)
+        err = xp.atan2(xp.imag(z), xp.real(z))      # numpy.angle
         f = 1.0 + self.WOb.output(wo, L)
         # reactive power / voltage
         s0y, s1y = self.s0b.output(s0, vcsel), self.s1b.output(s1, Q)
-        refsel = np.where(p["RefFlag"] > 0, self.Vref0 - s0y, self.Qline0 - s1y)
-        enf = np.clip(deadband(refsel, p["dbd1"], p["dbd2"]), p["emin"], p["emax"])
+        refsel = xp.where(p["RefFlag"] > 0, self.Vref0 - s0y, self.Qline0 - s1y)
+        enf = xp.clip(deadband(refsel, p["dbd1"], p["dbd2"], xp), p["emin"], p["emax"])
         held = v < p["Vfrz"]
-        ehld = np.where(held, self._ehold, enf)
+        ehld = xp.where(held, self._ehold, enf)
         s2y = self.s2b.output(s2, ehld, p["Qmin"], p["Qmax"])
         qext = self.s3b.output(s3, s2y)
         # active power / frequency
         s4y = self.s4b.output(s4, P)
-        fdb = deadband(1.0 - f, p["fdbd1"], p["fdbd2"])
-        droop = np.where(fdb < 0, fdb * p["Ddn"], fdb * p["Dup"])
-        perr = droop + np.where(p["PLflag"] > 0, self.Pline0 - s4y, 0.0)
-        fe = np.clip(perr, p["femin"], p["femax"])
+        fdb = deadband(1.0 - f, p["fdbd1"], p["fdbd2"], xp)
+        droop = xp.where(fdb < 0, fdb * p["Ddn"], fdb * p["Dup"])
+        perr = droop + xp.where(p["PLflag"] > 0, self.Pline0 - s4y, 0.0)
+        fe = xp.clip(perr, p["femin"], p["femax"])
         s5y = self.s5b.output(s5, fe, self.Plo, self.Phi)
         s6y = self.s6b.output(s6, s5y)
-        pext = np.where(p["Fflag"] > 0, s6y, 0.0)
+        pext = xp.where(p["Fflag"] > 0, s6y, 0.0)
         for tn, (n, rows, idx) in self._targets.items():
             for key, val in (("Pext", pext), ("Qext", qext)):
-                arr = np.zeros(x.shape[:-1] + (n,))
-                arr[..., idx] = val[..., rows]
+                arr = xp.zeros(x.shape[:-1] + (n,), dtype=xp.float64)
+                put(xp, arr, idx, take(xp, val, rows))
                 ctx.sig[f"{tn}.{key}"] = arr
         fd = ctx.f
         fd[..., sl[0]] = self.s0b.deriv(s0, vcsel)
@@ -364,10 +368,11 @@ class REPCA1(Component):
         o["REPCA1.Pext"], o["REPCA1.Qext"], o["REPCA1.f"] = pext, qext, f
         o["REPCA1.Pline"], o["REPCA1.Qline"], o["REPCA1.eHld"] = P, Q, ehld
         o["REPCA1.fe"], o["REPCA1.s5_y"] = fe, s5y
-        o["REPCA1.held"] = held.astype(float)
+        o["REPCA1.held"] = xp.astype(held, xp.float64)
         o["REPCA1.enf"] = enf
 
     def accept(self, t, ctx):
         """Hold memory of ``e``: its last value while the voltage was above Vfrz."""
+        xp = self.xp
         held = ctx.out["REPCA1.held"] > 0.5
-        self._ehold = np.where(held, self._ehold, ctx.out["REPCA1.enf"])
+        self._ehold = xp.where(held, self._ehold, ctx.out["REPCA1.enf"])

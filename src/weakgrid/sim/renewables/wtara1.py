@@ -16,12 +16,15 @@ import numpy as np
 
 from ..component import Component
 from ..errors import DataError
+from ..namespace import take
 from ..params import Param
 from ._wind import andes_link, resolve
 
 
 class WTARA1(Component):
     """Aerodynamics of a type-3 wind turbine (WECC); linked to one WTDTA1 (``rego``)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "device"
     order = 1.2          # after WTDTA1 (initialized first); WTDTA1 reads Pm from pm()
@@ -74,17 +77,17 @@ class WTARA1(Component):
 
     def theta(self, x):
         """Pitch angle [deg]: the pitch controller's output, or ``theta0``."""
-        th0 = self.p["theta0"]
+        xp, th0 = self.xp, self.p["theta0"]
         if self.pitch is None:
-            return np.broadcast_to(th0, x.shape[:-1] + (self.n,))
+            return xp.broadcast_to(th0, tuple(x.shape[:-1]) + (self.n,))
         pc, k = self.pitch
         th = pc.theta(x)
-        return np.where(k >= 0, th[..., np.maximum(k, 0)], th0)
+        return xp.where(k >= 0, take(xp, th, xp.maximum(k, 0)), th0)
 
     def pm(self, x):
         """Mechanical power [pu, system base] of each instance."""
         th = self.theta(x)
-        return self.dt.Pm0[self.rego] - self.p["Ka"] * th * (th - self.p["theta0"])
+        return take(self.xp, self.dt.Pm0, self.rego) - self.p["Ka"] * th * (th - self.p["theta0"])
 
     def compute(self, ctx):
         th = self.theta(ctx.x)

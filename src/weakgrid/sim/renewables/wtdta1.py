@@ -31,12 +31,15 @@ import numpy as np
 from ..blocks import Integrator
 from ..component import Component
 from ..errors import DataError
+from ..namespace import take
 from ..params import Param
 from ._wind import andes_link, chain_pattern, publish, resolve
 
 
 class WTDTA1(Component):
     """Two-mass drive train of a type-3 wind turbine (WECC); linked to one REECA1 (``ree``)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "device"
     order = 1.1          # before WTTQA1 and REECA1 (which read wg)
@@ -114,21 +117,19 @@ class WTDTA1(Component):
         return [chain_pattern(system, self.ree_comp, int(self.ree[i]), self.instance_states(i)) for i in range(self.n)]
 
     def compute(self, ctx):
-        p = self.p
-        x = ctx.x
-        sl = self._sls
+        xp, p, x, sl = self.xp, self.p, ctx.x, self._sls
         wt, wg, tsh = x[..., sl[0]], x[..., sl[1]], x[..., sl[2]]
-        pe = ctx.sig["REGCA1.Pe"][..., self.reg]
+        pe = take(xp, ctx.sig["REGCA1.Pe"], self.reg)
         pm = self.Pm0
         if self.aero is not None:
             ac, k = self.aero
-            pm = np.where(k >= 0, ac.pm(x)[..., np.maximum(k, 0)], pm)
+            pm = xp.where(k >= 0, take(xp, ac.pm(x), xp.maximum(k, 0)), pm)
         pd = p["Dshaft"] * (wt - wg)
         f = ctx.f
         f[..., sl[0]] = self.wtb.deriv(wt, pm / wt - tsh - pd)
         f[..., sl[1]] = self.wgb.deriv(wg, -pe / wg + tsh + pd - p["DAMP"] * (wg - p["w0"]))
         f[..., sl[2]] = self.Tshb.deriv(tsh, wt - wg)
-        publish(ctx, "REECA1.wg", self.ree_comp.n, self.ree, wg, 1.0)
+        publish(ctx, "REECA1.wg", self.ree_comp.n, self.ree, wg, 1.0, xp)
         o = ctx.out
-        o["WTDTA1.Pm"] = np.broadcast_to(pm, wt.shape) + 0.0
+        o["WTDTA1.Pm"] = xp.broadcast_to(pm, wt.shape) + 0.0
         o["WTDTA1.Pd"], o["WTDTA1.Pe"] = pd, pe + 0.0

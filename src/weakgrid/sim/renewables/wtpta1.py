@@ -33,12 +33,15 @@ import numpy as np
 from ..blocks import LagRate, PINonWindup
 from ..component import Component
 from ..errors import DataError
+from ..namespace import take
 from ..params import Param
 from ._wind import andes_link, chain_pattern, held, resolve
 
 
 class WTPTA1(Component):
     """Pitch controller of a type-3 wind turbine (WECC); linked to one WTARA1 (``rea``)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "device"
     order = 1.3
@@ -124,32 +127,31 @@ class WTPTA1(Component):
         return x[..., self.sl(2)]
 
     def _wref(self, x):
-        ref = np.broadcast_to(self.wref0, x.shape[:-1] + (self.n,))
+        xp = self.xp
+        ref = xp.broadcast_to(self.wref0, tuple(x.shape[:-1]) + (self.n,))
         if self.tq is None:
             return ref
         tc, k = self.tq
-        w = tc.wref(x)[..., np.maximum(k, 0)]
-        return np.where((k >= 0) & (self.p["wref_tq"] > 0), w, ref)
+        w = take(xp, tc.wref(x), xp.maximum(k, 0))
+        return xp.where((k >= 0) & (self.p["wref_tq"] > 0), w, ref)
 
     def pattern(self, system):
         return [chain_pattern(system, self.ree_comp, int(self.ree[i]), self.instance_states(i)) for i in range(self.n)]
 
     def finish(self, ctx):
-        p = self.p
-        x = ctx.x
-        sl = self._sls
+        xp, p, x, sl = self.xp, self.p, ctx.x, self._sls
         xc, xw, th = x[..., sl[0]], x[..., sl[1]], x[..., sl[2]]
-        e = ctx.out["REECA1.Pord"][..., self.ree] - ctx.out["REECA1.Pref"][..., self.ree]
-        wt = x[..., self.dt.sl(0)][..., self.rego]
+        e = take(xp, ctx.out["REECA1.Pord"], self.ree) - take(xp, ctx.out["REECA1.Pref"], self.ree)
+        wt = take(xp, x[..., self.dt.sl(0)], self.rego)
         wref = self._wref(x)
         uw = p["Kcc"] * e + wt - wref
         yc = self.PIcb.output(xc, e)
         yw = self.PIwb.output(xw, uw)
         f = ctx.f
         lo, hi = p["thmin"], p["thmax"]
-        f[..., sl[0]] = held(self.PIcb.deriv(xc, e), xc, lo, hi)
-        f[..., sl[1]] = held(self.PIwb.deriv(xw, uw), xw, lo, hi)
-        f[..., sl[2]] = held(self.LGb.deriv(th, yc + yw), th, lo, hi)
+        f[..., sl[0]] = held(self.PIcb.deriv(xc, e), xc, lo, hi, xp)
+        f[..., sl[1]] = held(self.PIwb.deriv(xw, uw), xw, lo, hi, xp)
+        f[..., sl[2]] = held(self.LGb.deriv(th, yc + yw), th, lo, hi, xp)
         o = ctx.out
         o["WTPTA1.theta"], o["WTPTA1.wref"] = th + 0.0, wref + 0.0
         o["WTPTA1.PIc_y"], o["WTPTA1.PIw_y"] = yc, yw

@@ -38,12 +38,15 @@ import numpy as np
 from ..blocks import Lag, PINonWindup, piecewise_linear
 from ..component import Component
 from ..errors import DataError
+from ..namespace import take
 from ..params import Param
 from ._wind import andes_link, chain_pattern, held, publish, resolve
 
 
 class WTTQA1(Component):
     """Torque (Pref) controller of a type-3 wind turbine (WECC); linked to one WTPTA1 (``rep``)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "device"
     order = 1.4          # after WTDTA1 (wg), before REECA1 (reads Pref)
@@ -147,40 +150,39 @@ class WTTQA1(Component):
 
     def _fpe(self, s1):
         p = self.p
-        return piecewise_linear(s1, [p["p1"], p["p2"], p["p3"], p["p4"]], [p["sp1"], p["sp2"], p["sp3"], p["sp4"]])
+        return piecewise_linear(s1, [p["p1"], p["p2"], p["p3"], p["p4"]], [p["sp1"], p["sp2"], p["sp3"], p["sp4"]],
+                                self.xp)
 
     def wref(self, x):
         """Speed reference [pu] (``s2``; with ``Twref = 0`` the map of the filtered power)."""
         s1, s2 = x[..., self.sl(0)], x[..., self.sl(1)]
-        return np.where(self.p["Twref"] > 0, s2, self._fpe(s1))
+        return self.xp.where(self.p["Twref"] > 0, s2, self._fpe(s1))
 
     def pattern(self, system):
         return [chain_pattern(system, self.ree_comp, int(self.ree[i]), self.instance_states(i)) for i in range(self.n)]
 
     def compute(self, ctx):
-        p = self.p
-        x = ctx.x
-        sl = self._sls
+        xp, p, x, sl = self.xp, self.p, ctx.x, self._sls
         s1, s2, xi = x[..., sl[0]], x[..., sl[1]], x[..., sl[2]]
-        pe = ctx.sig["REGCA1.Pe"][..., self.dt.reg[self.rego]]
-        wg = x[..., self.dt.sl(1)][..., self.rego]
+        pe = take(xp, ctx.sig["REGCA1.Pe"], take(xp, self.dt.reg, self.rego))
+        wg = take(xp, x[..., self.dt.sl(1)], self.rego)
         s1y = self.s1b.output(s1, pe)
         fpe = self._fpe(s1y)
         wref = self.s2b.output(s2, fpe)
-        sign = np.where(p["speed_err"] > 0, 1.0, -1.0)
-        pe_sel = np.where(p["Pe_filt"] > 0, s1y, pe)
-        tsel = np.where(p["Tflag"] > 0, (pe_sel - self.Pref0) / wg, sign * (wg - wref))
+        sign = xp.where(p["speed_err"] > 0, xp.asarray(1.0, dtype=xp.float64), -1.0)
+        pe_sel = xp.where(p["Pe_filt"] > 0, s1y, pe)
+        tsel = xp.where(p["Tflag"] > 0, (pe_sel - self.Pref0) / wg, sign * (wg - wref))
         te = self.PIb.output(xi, tsel)
         pref = te * wg
         n = self.ree_comp.n
-        publish(ctx, "REECA1.Pref", n, self.ree, pref, self.ree_comp.Pref0)
-        if np.any(p["wg_reset"] > 0):
-            wg_r = np.where(p["wg_reset"] > 0, 1.0 + wg - fpe, wg)
-            publish(ctx, "REECA1.wg", n, self.ree, wg_r, 1.0)
+        publish(ctx, "REECA1.Pref", n, self.ree, pref, self.ree_comp.Pref0, xp)
+        if xp.any(p["wg_reset"] > 0):
+            wg_r = xp.where(p["wg_reset"] > 0, 1.0 + wg - fpe, wg)
+            publish(ctx, "REECA1.wg", n, self.ree, wg_r, 1.0, xp)
         f = ctx.f
         f[..., sl[0]] = self.s1b.deriv(s1, pe)
         f[..., sl[1]] = self.s2b.deriv(s2, fpe)
-        f[..., sl[2]] = held(self.PIb.deriv(xi, tsel), xi, p["Temin"], p["Temax"])
+        f[..., sl[2]] = held(self.PIb.deriv(xi, tsel), xi, p["Temin"], p["Temax"], xp)
         o = ctx.out
         o["WTTQA1.Pref"], o["WTTQA1.Te"], o["WTTQA1.Tsel"] = pref, te, tsel
         o["WTTQA1.fPe"], o["WTTQA1.wref"] = fpe, wref + 0.0

@@ -32,12 +32,14 @@ import numpy as np
 
 from ..component import Component
 from ..errors import DataError
-from ..namespace import add_at
+from ..namespace import NUMPY, add_at, take, to_numpy
 from ..network import PD, QD
 
 
 class _BusConstraint(Component):
     """A source holding two real quantities of its bus; linked to a gen-table row (``gen``)."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "device"
     order = 9            # last: reads the currents of every other device at its bus
@@ -130,28 +132,35 @@ class _BusConstraint(Component):
         self._nb = net.nb
 
     def _rows(self, system):
-        """Rows ``b`` and ``nb + b`` of the real-form admittance matrix (as applied now)."""
+        """Rows ``b`` and ``nb + b`` of the real-form admittance matrix (as applied now), in
+        the namespace of the evaluation (computed on NumPy when the network changes)."""
         if self._ver != system.net_version:
             nb = self._nb
             Yr = system.Yr
-            self._Yre = Yr[self.bus].toarray()
-            self._Yim = Yr[self.bus + nb].toarray()
-            ybb = np.abs(self._Yre[np.arange(self.n), self.bus] + 1j * self._Yim[np.arange(self.n), self.bus])
+            bus = to_numpy(self.bus)
+            Yre = Yr[bus].toarray()
+            Yim = Yr[bus + nb].toarray()
+            ybb = np.abs(Yre[np.arange(self.n), bus] + 1j * Yim[np.arange(self.n), bus])
+            xp = self.xp
             if not hasattr(self, "k"):
                 self.k = np.maximum(ybb, 1.0)   # fixed at the first evaluation (pre-event network)
+                if xp is not NUMPY:
+                    self.k = xp.asarray(self.k)
+            self._Yre, self._Yim = (Yre, Yim) if xp is NUMPY else (xp.asarray(Yre), xp.asarray(Yim))
             self._ver = system.net_version
         return self._Yre, self._Yim
 
     def finish(self, ctx):
+        xp = self.xp
         Yre, Yim = self._rows(ctx.system)
-        vec = np.concatenate([ctx.V.real, ctx.V.imag], axis=-1)
+        vec = xp.concat([xp.real(ctx.V), xp.imag(ctx.V)], axis=-1)
         Inet = vec @ Yre.T + 1j * (vec @ Yim.T)
-        V = ctx.V[..., self.bus]
-        Isrc = Inet - ctx.I[..., self.bus]
+        V = take(xp, ctx.V, self.bus)
+        Isrc = Inet - take(xp, ctx.I, self.bus)
         R = self.residual(V, Isrc)
-        add_at(self.xp, ctx.I, self.bus, Isrc - R, True)
-        S = V * np.conj(Isrc)
-        ctx.out[f"{self.type_name}.P"], ctx.out[f"{self.type_name}.Q"] = S.real, S.imag
+        add_at(xp, ctx.I, self.bus, Isrc - R, True)
+        S = V * xp.conj(Isrc)
+        ctx.out[f"{self.type_name}.P"], ctx.out[f"{self.type_name}.Q"] = xp.real(S), xp.imag(S)
 
     def residual(self, V, Isrc):
         raise NotImplementedError
@@ -165,6 +174,8 @@ class InfiniteBus(_BusConstraint):
     infinite inertia (constant frequency and angle), unlimited active and reactive power
     and current. Outputs ``P``, ``Q`` [pu, system base]: the power it supplies.
     """
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     def residual(self, V, Isrc):
         return self.k * (V - self.V0)
@@ -180,6 +191,9 @@ class PVSource(_BusConstraint):
     power flow. Outputs ``P``, ``Q`` [pu, system base].
     """
 
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
+
     def residual(self, V, Isrc):
-        P = (V * np.conj(Isrc)).real
-        return (P - self.p0) + 1j * self.k * (np.abs(V) - np.abs(self.V0))
+        xp = self.xp
+        P = xp.real(V * xp.conj(Isrc))
+        return (P - self.p0) + 1j * self.k * (xp.abs(V) - xp.abs(self.V0))
