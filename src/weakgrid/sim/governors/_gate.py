@@ -31,14 +31,14 @@ def check_gate_table(comp):
 
 def gate_power(comp, g):
     """Turbine power [pu] at gate ``g`` (broken line, zero below G0, extrapolated beyond 1)."""
-    p = comp.p
+    xp, p = comp.xp, comp.p
     G0, G1, G2, P1, P2, P3 = (p[k] for k in ("G0", "G1", "G2", "P1", "P2", "P3"))
     s1 = P1 / (G1 - G0)
     s2 = (P2 - P1) / (G2 - G1)
     s3 = (P3 - P2) / (1.0 - G2)
-    return np.where(g <= G0, 0.0,
-                    np.where(g <= G1, s1 * (g - G0),
-                             np.where(g <= G2, P1 + s2 * (g - G1), P2 + s3 * (g - G2))))
+    return xp.where(g <= G0, 0.0,
+                    xp.where(g <= G1, s1 * (g - G0),
+                             xp.where(g <= G2, P1 + s2 * (g - G1), P2 + s3 * (g - G2))))
 
 
 def power_gate(comp, P):

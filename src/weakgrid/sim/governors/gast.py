@@ -25,12 +25,15 @@ import numpy as np
 
 from ..blocks import Lag, LagNonWindup
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 
 
 class GAST(MachineControl):
     """Gas turbine-governor GAST. Parameters: R, VMAX, VMIN, AT, Dt [pu, turbine base];
     KT [pu/pu]; T1, T2, T3 [s]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "governor"
     #: the power reference computed at init (from the operating point): per batch member
@@ -79,18 +82,18 @@ class GAST(MachineControl):
                                 "lower limit", "AT + KT*(AT - tm0)")]
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         lag, lg2, lt = (ctx.x[..., s] for s in self._sls)
-        wd = ctx.sig["omega"][..., m] - p["wref0"]
+        wd = take(xp, ctx.sig["omega"], m) - p["wref0"]
         pd = self.pref0 + (self.paux - wd) / p["R"]
         plim = p["AT"] + p["KT"] * (p["AT"] - self.LT.output(lt, lg2))
-        vin = np.minimum(pd, plim)                           # low-value gate
+        vin = xp.minimum(pd, plim)                           # low-value gate
         y2 = self.LG2.output(lg2, lag)
         f = ctx.f
         f[..., self._sls[0]] = self.LAG.deriv(lag, vin)
         f[..., self._sls[1]] = self.LG2.deriv(lg2, lag)
         f[..., self._sls[2]] = self.LT.deriv(lt, y2)
         pout = y2 - p["Dt"] * wd
-        ctx.sig["tm"][..., m] = pout
+        put(xp, ctx.sig["tm"], m, pout)
         ctx.out["GAST.pd"], ctx.out["GAST.plim"], ctx.out["GAST.pout"] = pd, plim, pout

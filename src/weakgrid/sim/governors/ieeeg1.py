@@ -25,12 +25,15 @@ import numpy as np
 from ..blocks import IntegratorNonWindup, Lag, LeadLag, hard_limit
 from ..control_base import MachineControl
 from ..errors import DataError
+from ..namespace import put, take
 from ..params import Param
 
 
 class IEEEG1(MachineControl):
     """IEEE type 1 turbine-governor. Link ``machine`` (speed, HP power) and optional ``machine2``
     (LP power). Parameters: K [pu], T1..T7 [s], UO, UC [pu/s], PMAX, PMIN [pu], K1..K8 [-]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "governor"
     #: the initial gate/power reference computed at init (from the operating point): per batch member
@@ -86,6 +89,9 @@ class IEEEG1(MachineControl):
         self.mach2 = np.array([system.machine_number(lk["machine2"]) if lk.get("machine2") is not None else -1
                                for lk in self.links], dtype=int)
         self.has2 = self.mach2 >= 0
+        self._any2 = bool(self.has2.any())
+        self._i2 = np.nonzero(self.has2)[0]          # the instances with an LP machine
+        self._m2 = self.mach2[self._i2]              # and their LP machines
         Sn2 = np.zeros(n)
         for i in np.nonzero(self.has2)[0]:
             mtype, mname = system._machines[self.mach2[i]]
@@ -132,12 +138,12 @@ class IEEEG1(MachineControl):
             x[self.sl(k)] = self.P0
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         ll, gv, l4, l5, l6, l7 = (ctx.x[..., s] for s in self._sls)
-        wd = p["wref0"] - ctx.sig["omega"][..., m]
+        wd = p["wref0"] - take(xp, ctx.sig["omega"], m)
         y = self.LL.output(ll, wd)
-        vs = hard_limit((y + self.P0 + self.paux - gv) / p["T3"], p["UC"], p["UO"])
+        vs = hard_limit((y + self.P0 + self.paux - gv) / p["T3"], p["UC"], p["UO"], xp)
         y4 = self.L[0].output(l4, gv)
         y5 = self.L[1].output(l5, y4)
         y6 = self.L[2].output(l6, y5)
@@ -149,12 +155,11 @@ class IEEEG1(MachineControl):
         f[..., self._sls[3]] = self.L[1].deriv(l5, y4)
         f[..., self._sls[4]] = self.L[2].deriv(l6, y5)
         f[..., self._sls[5]] = self.L[3].deriv(l7, y6)
-        K = self.Kn
+        K = [self.Kn[j, ...] for j in range(8)]
         php = K[0] * y4 + K[2] * y5 + K[4] * y6 + K[6] * y7
         plp = K[1] * y4 + K[3] * y5 + K[5] * y6 + K[7] * y7
-        ctx.sig["tm"][..., m] = php
-        if self.has2.any():
-            i2 = np.nonzero(self.has2)[0]
-            ctx.sig["tm"][..., self.mach2[i2]] = plp[..., i2]
+        put(xp, ctx.sig["tm"], m, php)
+        if self._any2:
+            put(xp, ctx.sig["tm"], self._m2, take(xp, plp, self._i2))
         o = ctx.out
         o["IEEEG1.vs"], o["IEEEG1.PHP"], o["IEEEG1.PLP"] = vs, php, plp

@@ -20,11 +20,14 @@ import numpy as np
 
 from ..blocks import Lag, LeadLag, hard_limit
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 
 
 class IEESGO(MachineControl):
     """IEEE standard governor. Parameters: T1..T6 [s]; K1 [pu/pu speed], K2, K3 [-]; PMAX, PMIN [pu]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "governor"
     #: the power reference computed at init (from the operating point): per batch member
@@ -71,13 +74,13 @@ class IEESGO(MachineControl):
         x[self.sl(4)] = self.F5.init(self.F4.init(tm0))
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         f1, f2, f3, f4, f5 = (ctx.x[..., s] for s in self._sls)
-        wd = ctx.sig["omega"][..., m] - p["wref0"]
+        wd = take(xp, ctx.sig["omega"], m) - p["wref0"]
         y1 = self.F1.output(f1, wd)
         y2 = self.F2.output(f2, y1)
-        pv = hard_limit(self.pref0 + self.paux - y2, p["PMIN"], p["PMAX"])
+        pv = hard_limit(self.pref0 + self.paux - y2, p["PMIN"], p["PMAX"], xp)
         y3 = self.F3.output(f3, pv)
         y4 = self.F4.output(f4, y3)
         y5 = self.F5.output(f5, y4)
@@ -88,5 +91,5 @@ class IEESGO(MachineControl):
         f[..., self._sls[3]] = self.F4.deriv(f4, y3)
         f[..., self._sls[4]] = self.F5.deriv(f5, y4)
         pout = (1 - p["K2"]) * y3 + (1 - p["K3"]) * y4 + y5
-        ctx.sig["tm"][..., m] = pout
+        put(xp, ctx.sig["tm"], m, pout)
         ctx.out["IEESGO.P"], ctx.out["IEESGO.pout"] = pv, pout

@@ -41,6 +41,7 @@ import numpy as np
 from ..blocks import IntegratorNonWindup, Lag, LeadLag, Washout
 from ..control_base import MachineControl
 from ..errors import DataError
+from ..namespace import put, take
 from ..params import Param
 from ._gate import check_gate_table, gate_power, power_gate
 
@@ -49,6 +50,8 @@ class PIDGOV(MachineControl):
     """Hydro PID governor (PSS/E PIDGOV). Parameters: Flag; Rperm [pu]; Treg, Ta, Tb, Tw [s]; Kp [pu],
     Ki [1/s], Kd [s]; Dturb [pu]; gate table G0, G1, P1, G2, P2, P3; Gmax, Gmin [pu]; Atw [-];
     Velmax, Velmin [pu/s]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "governor"
     #: the power reference computed at init (from the operating point): per batch member
@@ -117,13 +120,13 @@ class PIDGOV(MachineControl):
             x[self.sl(k)] = v
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         xreg, xpi, xa, xd, xb, gate, xw = (ctx.x[..., s] for s in self._sls)
-        omega = ctx.sig["omega"][..., m]
+        omega = take(xp, ctx.sig["omega"], m)
         dw = omega - 1.0
-        pe = ctx.sig["Pe"][..., m] / self.k
-        fb = np.where(p["Flag"] > 0, gate, pe)
+        pe = take(xp, ctx.sig["Pe"], m) / self.k
+        fb = xp.where(p["Flag"] > 0, gate, pe)
         ein = self.pref0 - fb
         u = self.REG.output(xreg, ein) - dw
         ypi = p["Kp"] * u + xpi
@@ -131,7 +134,7 @@ class PIDGOV(MachineControl):
         ya = self.LA.output(xa, ypi)
         yb_in = ya + yd
         yb = self.LA.output(xb, yb_in)
-        v = np.clip((yb - gate) / p["Tb"], p["Velmin"], p["Velmax"])
+        v = xp.clip((yb - gate) / p["Tb"], p["Velmin"], p["Velmax"])
         pg = gate_power(self, gate)
         pt = self.WATER.output(xw, pg)
         pm = pt - p["Dturb"] * dw
@@ -143,5 +146,5 @@ class PIDGOV(MachineControl):
         f[..., self._sls[4]] = self.LA.deriv(xb, yb_in)
         f[..., self._sls[5]] = v
         f[..., self._sls[6]] = self.WATER.deriv(xw, pg)
-        ctx.sig["tm"][..., m] = pm * self.k   # PMECH: the PSS/E shaft divides by omega
+        put(xp, ctx.sig["tm"], m, pm * self.k)   # PMECH: the PSS/E shaft divides by omega
         ctx.out["PIDGOV.Pg"], ctx.out["PIDGOV.PMECH"] = pg, pm

@@ -19,11 +19,14 @@ import numpy as np
 
 from ..blocks import LeadLag, hard_limit
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 
 
 class TG2(MachineControl):
     """Turbine-governor type 2. Parameters: R, pmax, pmin [pu, turbine base]; T1, T2 [s]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "governor"
     #: the power reference computed at init (from the operating point): per batch member
@@ -53,11 +56,11 @@ class TG2(MachineControl):
         x[self.sl(0)] = self.LL.init(np.zeros(self.n))
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         ll = ctx.x[..., self._sls[0]]
-        u = (p["wref0"] - ctx.sig["omega"][..., m]) / p["R"]
+        u = (p["wref0"] - take(xp, ctx.sig["omega"], m)) / p["R"]
         ctx.f[..., self._sls[0]] = self.LL.deriv(ll, u)
-        pout = hard_limit(self.pref0 + self.LL.output(ll, u), p["pmin"], p["pmax"])
-        ctx.sig["tm"][..., m] = pout
+        pout = hard_limit(self.pref0 + self.LL.output(ll, u), p["pmin"], p["pmax"], xp)
+        put(xp, ctx.sig["tm"], m, pout)
         ctx.out["TG2.pout"] = pout

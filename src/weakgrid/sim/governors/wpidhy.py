@@ -43,6 +43,7 @@ import numpy as np
 from ..blocks import IntegratorNonWindup, Lag, LeadLag, Washout
 from ..control_base import MachineControl
 from ..errors import DataError
+from ..namespace import put, take
 from ..params import Param
 from ._gate import check_gate_table, gate_power, power_gate
 
@@ -50,6 +51,8 @@ from ._gate import check_gate_table, gate_power, power_gate
 class WPIDHY(MachineControl):
     """Woodward PID hydro governor (PSS/E WPIDHY). Parameters: TREG, TA, TB, TW [s]; REG [pu]; KP [pu],
     KI [1/s], KD [s]; VELMX, VELMN [pu/s]; GATMX, GATMN, PMAX, PMIN, D [pu]; gate table G0..P3."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "governor"
     #: the power reference computed at init (from the operating point): per batch member
@@ -124,19 +127,19 @@ class WPIDHY(MachineControl):
                                 "PMIN", "PMAX")]
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         xreg, xpi, xd, xa, xb, gate, xw = (ctx.x[..., s] for s in self._sls)
-        omega = ctx.sig["omega"][..., m]
+        omega = take(xp, ctx.sig["omega"], m)
         dw = omega - 1.0
-        ein = ctx.sig["Pe"][..., m] / self.k - self.pref0
+        ein = take(xp, ctx.sig["Pe"], m) / self.k - self.pref0
         u = self.REGL.output(xreg, ein) - dw
         ypid = self.kp * u + xpi + self.D.output(xd, u)
         ya = self.LA.output(xa, ypid)
         yb = self.LB.output(xb, ya)
-        v = np.clip(yb, p["VELMN"], p["VELMX"])
+        v = xp.clip(yb, p["VELMN"], p["VELMX"])
         pg = gate_power(self, gate)
-        pt = np.clip(self.WATER.output(xw, pg), p["PMIN"], p["PMAX"])
+        pt = xp.clip(self.WATER.output(xw, pg), p["PMIN"], p["PMAX"])
         pm = pt - p["D"] * dw
         f = ctx.f
         f[..., self._sls[0]] = self.REGL.deriv(xreg, ein)
@@ -146,5 +149,5 @@ class WPIDHY(MachineControl):
         f[..., self._sls[4]] = self.LB.deriv(xb, ya)
         f[..., self._sls[5]] = v
         f[..., self._sls[6]] = self.WATER.deriv(xw, pg)
-        ctx.sig["tm"][..., m] = pm * self.k   # PMECH: the PSS/E shaft divides by omega
+        put(xp, ctx.sig["tm"], m, pm * self.k)   # PMECH: the PSS/E shaft divides by omega
         ctx.out["WPIDHY.Pg"], ctx.out["WPIDHY.PMECH"] = pg, pm

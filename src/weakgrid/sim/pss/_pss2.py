@@ -37,9 +37,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..blocks import Lag, LeadLag, Washout, WashoutBypass, hard_limit
+from ..blocks import Block, Lag, LeadLag, Washout, WashoutBypass, hard_limit
 from ..control_base import MachineControl
 from ..errors import DataError
+from ..namespace import put, take
 from ..params import Param
 
 #: PSS/E input signal codes of the dual-input stabilizers.
@@ -82,7 +83,7 @@ def check_codes(element, values, bus=None):
                         "improper (a lead without a lag): give M >= 1 and T9 > 0, or T8 = 0, or N = 0")
 
 
-class RampTrackingFilter:
+class RampTrackingFilter(Block):
     r"""Ramp-tracking filter :math:`[(1+sT_8)/(1+sT_9)^M]^N` as a chain of first-order stages.
 
     Section ``j`` (``N`` sections) is the lead-lag :math:`(1+sT_8)/(1+sT_9)` followed by ``M-1``
@@ -108,9 +109,10 @@ class RampTrackingFilter:
 
     def step(self, k, x, u):
         """Output and derivative of stage ``k`` (state ``x``, input ``u``)."""
-        on = self.on[k]
-        y = np.where(on, x + self.c[k] * (u - x), u)
-        return y, np.where(on, (u - x) / self.T9, 0.0)
+        xp = self.xp
+        on = self.on[k, ...]
+        y = xp.where(on, x + self.c[k, ...] * (u - x), u)
+        return y, xp.where(on, (u - x) / self.T9, 0.0)
 
 
 #: parameters shared by PSS2A and PSS2B (PSS/E names), in PSS/E's CON order after the ICONs
@@ -145,6 +147,8 @@ PSSE_ICONS = ("ICS1", "_REMBUS1", "ICS2", "_REMBUS2", "M", "N")
 class DualInputPSS(MachineControl):
     """Base of PSS2A / PSS2B (see the module docstring). Subclasses set ``params``,
     ``states`` (``LEAD_LAGS`` names the lead-lag pairs) and ``psse_record``."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "pss"
     order = 1
@@ -181,7 +185,9 @@ class DualInputPSS(MachineControl):
 
     # ---------------------------------------------------------------- signals
     def _signal(self, code, omega, Pe, Vt):
-        return np.select([code == 1, code == 3, code == 5], [omega - 1.0, Pe * self._pe_scale, Vt], 0.0)
+        xp = self.xp     # numpy.select's choice in its order, 0 for none
+        return xp.where(code == 1, omega - 1.0,
+                        xp.where(code == 3, Pe * self._pe_scale, xp.where(code == 5, Vt, 0.0)))
 
     def _limit_inputs(self, u1, u2):
         """Input limits (none in PSS2A)."""
@@ -199,13 +205,13 @@ class DualInputPSS(MachineControl):
         x[self.sl(3)] = u2
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         s = ctx.sig
         f = ctx.f
         sl = self._sls
         X = [ctx.x[..., k] for k in sl]
-        omega, Pe, Vt = s["omega"][..., m], s["Pe"][..., m], s["Vt"][..., m]
+        omega, Pe, Vt = take(xp, s["omega"], m), take(xp, s["Pe"], m), take(xp, s["Vt"], m)
         r1 = self._signal(p["ICS1"], omega, Pe, Vt)
         r2 = self._signal(p["ICS2"], omega, Pe, Vt)
         u1, u2 = self._limit_inputs(r1, r2)
@@ -233,8 +239,8 @@ class DualInputPSS(MachineControl):
             k = self._k0 + j
             f[..., sl[k]] = LL.deriv(X[k], y)
             y = LL.output(X[k], y)
-        vs = hard_limit(y, p["VSTMIN"], p["VSTMAX"])
-        s["vs"][..., m] = vs
+        vs = hard_limit(y, p["VSTMIN"], p["VSTMAX"], xp)
+        put(xp, s["vs"], m, vs)
         name = self.type_name
         o = ctx.out
         o[f"{name}.sig"], o[f"{name}.sig2"], o[f"{name}.vss"], o[f"{name}.vs"] = r1, r2, y, vs

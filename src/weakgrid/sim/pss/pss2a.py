@@ -21,6 +21,8 @@ class PSS2A(DualInputPSS):
     ``TW1 TW2 T6 TW3 TW4 T7 KS2 KS3 T8 T9 KS1 T1 T2 T3 T4 VSTMAX VSTMIN`` (6 + 17 fields).
     """
 
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
+
     params = BASE_PARAMS + OUT_PARAMS
     LEAD_LAGS = (("T1", "T2"), ("T3", "T4"))
     states = DualInputPSS._HEAD + ("LL1", "LL2")

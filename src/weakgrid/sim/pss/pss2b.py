@@ -8,8 +8,6 @@ PSS2A (:mod:`weakgrid.sim.pss.pss2a`) with input limits — each raw input clipp
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..params import Param
 from ._pss2 import BASE_PARAMS, N_RTF, OUT_PARAMS, PSSE_ICONS, DualInputPSS
 
@@ -32,6 +30,8 @@ class PSS2B(DualInputPSS):
     VSTMAX VSTMIN`` (6 + 23 fields).
     """
 
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
+
     params = BASE_PARAMS + _EXTRA + OUT_PARAMS
     LEAD_LAGS = (("T1", "T2"), ("T3", "T4"), ("T10", "T11"))
     states = DualInputPSS._HEAD + ("LL1", "LL2", "LL3")
@@ -40,6 +40,6 @@ class PSS2B(DualInputPSS):
     assert len(states) == 6 + N_RTF + 3
 
     def _limit_inputs(self, u1, u2):
-        p = self.p
-        return (np.minimum(np.maximum(u1, p["VS1MIN"]), p["VS1MAX"]),
-                np.minimum(np.maximum(u2, p["VS2MIN"]), p["VS2MAX"]))
+        xp, p = self.xp, self.p
+        return (xp.minimum(xp.maximum(u1, p["VS1MIN"]), p["VS1MAX"]),
+                xp.minimum(xp.maximum(u2, p["VS2MIN"]), p["VS2MAX"]))

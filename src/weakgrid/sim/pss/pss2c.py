@@ -13,8 +13,7 @@ and zero-parameter conventions are in :mod:`weakgrid.sim.pss._pss2`.
 
 from __future__ import annotations
 
-import numpy as np
-
+from ..namespace import put, take
 from ..params import Param
 from ._pss2 import BASE_PARAMS, N_RTF, OUT_PARAMS, PSSE_ICONS, DualInputPSS
 from .pss2b import _EXTRA, PSS2B
@@ -39,6 +38,8 @@ class PSS2C(PSS2B):
     VSTMAX VSTMIN T12 T13 PSSON PSSOFF Xcomp Tcomp`` (6 + 29 fields).
     """
 
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
+
     params = BASE_PARAMS + _EXTRA + OUT_PARAMS + _EXTRA_C
     LEAD_LAGS = (("T1", "T2"), ("T3", "T4"), ("T10", "T11"), ("T12", "T13"))
     states = DualInputPSS._HEAD + ("LL1", "LL2", "LL3", "LL4")
@@ -53,17 +54,17 @@ class PSS2C(PSS2B):
         self._on = ~((self.p["PSSON"] >= 0) & (pt0 <= self.p["PSSOFF"]))
 
     def _switch(self, pt):
-        p = self.p
-        on = np.where(pt >= p["PSSON"], True, np.where(pt <= p["PSSOFF"], False, self._on))
-        return np.where(p["PSSON"] < 0, True, on)
+        xp, p = self.xp, self.p
+        on = xp.where(pt >= p["PSSON"], True, xp.where(pt <= p["PSSOFF"], False, self._on))
+        return xp.where(p["PSSON"] < 0, True, on)
 
     def compute(self, ctx):
         super().compute(ctx)
-        m = self._mi
-        on = self._switch(ctx.sig["Pe"][..., m] * self._pe_scale)
-        vs = np.where(on, ctx.sig["vs"][..., m], 0.0)
-        ctx.sig["vs"][..., m] = vs
-        ctx.out["PSS2C.vs"], ctx.out["PSS2C.on"] = vs, on.astype(float)
+        xp, m = self.xp, self._mi
+        on = self._switch(take(xp, ctx.sig["Pe"], m) * self._pe_scale)
+        vs = xp.where(on, take(xp, ctx.sig["vs"], m), 0.0)
+        put(xp, ctx.sig["vs"], m, vs)
+        ctx.out["PSS2C.vs"], ctx.out["PSS2C.on"] = vs, xp.astype(on, xp.float64)
 
     def accept(self, t, ctx):
         """Keep the switch state of the accepted point (hysteresis memory)."""

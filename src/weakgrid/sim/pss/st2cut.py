@@ -24,6 +24,7 @@ import numpy as np
 from ..blocks import Lag, LeadLag, WashoutOrLag, hard_limit
 from ..control_base import MachineControl
 from ..errors import DataError
+from ..namespace import put, take
 from ..params import Param
 
 _MODES = (0, 1, 3, 4, 5)
@@ -32,6 +33,8 @@ _MODES = (0, 1, 3, 4, 5)
 class ST2CUT(MachineControl):
     """Dual-input PSS with cut-off. Parameters: MODE, MODE2; K1, K2 [pu]; T1..T10 [s];
     LSMAX, LSMIN, VCU, VCL [pu]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "pss"
     order = 1
@@ -91,10 +94,11 @@ class ST2CUT(MachineControl):
         self.VCL = np.where(p["VCL"] == 0, -999.0, p["VCL"])
 
     def _signal(self, mode, s, Sb):
-        m = self._mi
-        return np.select([mode == 1, mode == 3, mode == 4, mode == 5],
-                         [s["omega"][..., m] - 1.0, s["Pe"][..., m] * Sb / self.Sn,
-                          s["tm"][..., m] - s["tm0"][..., m], s["Vt"][..., m]], 0.0)
+        xp, m = self.xp, self._mi     # numpy.select's choice in its order, 0 for none
+        return xp.where(mode == 1, take(xp, s["omega"], m) - 1.0,
+                        xp.where(mode == 3, take(xp, s["Pe"], m) * Sb / self.Sn,
+                                 xp.where(mode == 4, take(xp, s["tm"], m) - take(xp, s["tm0"], m),
+                                          xp.where(mode == 5, take(xp, s["Vt"], m), 0.0))))
 
     def init(self, system, x, sig):
         p = self.p
@@ -114,7 +118,7 @@ class ST2CUT(MachineControl):
         x[self.sl(5)] = wo
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         s = ctx.sig
         l1, l2, wo, x1, x2, x3 = (ctx.x[..., k] for k in self._sls)
@@ -133,9 +137,9 @@ class ST2CUT(MachineControl):
         f[..., self._sls[3]] = self.LL1.deriv(x1, y0)
         f[..., self._sls[4]] = self.LL2.deriv(x2, y1)
         f[..., self._sls[5]] = self.LL3.deriv(x3, y2)
-        vss = hard_limit(y3, p["LSMIN"], p["LSMAX"])
-        v = s["Vt"][..., m]
-        vs = np.where((v > self.v0 + self.VCL) & (v < self.v0 + self.VCU), vss, 0.0)
-        s["vs"][..., m] = vs
+        vss = hard_limit(y3, p["LSMIN"], p["LSMAX"], xp)
+        v = take(xp, s["Vt"], m)
+        vs = xp.where((v > self.v0 + self.VCL) & (v < self.v0 + self.VCU), vss, 0.0)
+        put(xp, s["vs"], m, vs)
         o = ctx.out
         o["ST2CUT.sig"], o["ST2CUT.sig2"], o["ST2CUT.vss"] = u1, u2, vss

@@ -20,12 +20,15 @@ from __future__ import annotations
 
 from ..blocks import LeadLag, Washout, hard_limit
 from ..control_base import MachineControl
+from ..namespace import put, take
 from ..params import Param
 
 
 class STAB1(MachineControl):
     """Speed-input PSS. Parameters: KT = K/T [pu]; T, T3, T4 [s]; T1T3 = T1/T3, T2T4 = T2/T4 [-];
     HLIM [pu]."""
+
+    array_api = True      # its evaluation runs on any array namespace (weakgrid.sim.namespace)
 
     kind = "pss"
     order = 1
@@ -58,18 +61,18 @@ class STAB1(MachineControl):
         x[self.sl(2)] = 0.0
 
     def compute(self, ctx):
-        p = self.p
+        xp, p = self.xp, self.p
         m = self._mi
         f = ctx.f
         sl = self._sls
         wo, x1, x2 = (ctx.x[..., k] for k in sl)
-        u = ctx.sig["omega"][..., m] - 1.0
+        u = take(xp, ctx.sig["omega"], m) - 1.0
         y0 = self.WO.output(wo, u)
         y1 = self.LL1.output(x1, y0)
         y2 = self.LL2.output(x2, y1)
         f[..., sl[0]] = self.WO.deriv(wo, u)
         f[..., sl[1]] = self.LL1.deriv(x1, y0)
         f[..., sl[2]] = self.LL2.deriv(x2, y1)
-        vs = hard_limit(y2, -p["HLIM"], p["HLIM"])
-        ctx.sig["vs"][..., m] = vs
+        vs = hard_limit(y2, -p["HLIM"], p["HLIM"], xp)
+        put(xp, ctx.sig["vs"], m, vs)
         ctx.out["STAB1.sig"], ctx.out["STAB1.vss"], ctx.out["STAB1.vs"] = u, y2, vs
