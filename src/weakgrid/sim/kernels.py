@@ -48,7 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import DataError
-from .namespace import NUMPY
+from .namespace import NUMPY, on_arrays_of
 
 __all__ = ["Kernel", "backend", "cache_dir", "choice", "compiled_available", "constants"]
 
@@ -249,12 +249,8 @@ class Kernel:
         of :attr:`scalar_forms` it calls (the same code, another namespace's arrays)."""
         fn = self._on.get(xp)
         if fn is None:
-            def rebound(f, names):
-                return types.FunctionType(f.__code__, dict(f.__globals__, np=xp, **names),
-                                          f.__name__, f.__defaults__, f.__closure__)
-
-            helpers = {a.__name__: rebound(a, {}) for a, _ in self.scalar_forms}
-            fn = self._on[xp] = rebound(self.core, helpers)
+            helpers = {a.__name__: on_arrays_of(a, xp) for a, _ in self.scalar_forms}
+            fn = self._on[xp] = on_arrays_of(self.core, xp, **helpers)
         return fn
 
     def _compiled(self, nsig, flags):

@@ -36,7 +36,8 @@ import numpy as np
 
 from .errors import DataError
 
-__all__ = ["NUMPY", "add_at", "namespace_models", "on_namespace", "put", "take", "to_numpy"]
+__all__ = ["NUMPY", "add_at", "namespace_models", "on_arrays_of", "on_namespace", "put", "take",
+           "to_numpy"]
 
 
 def _numpy_namespace():
@@ -56,6 +57,16 @@ def _numpy_namespace():
 
 #: the namespace of a grid evaluated on NumPy (the default of every component and block)
 NUMPY = _numpy_namespace()
+
+
+@functools.lru_cache(maxsize=None)
+def on_arrays_of(fn, xp, **calls):
+    """The module-level function ``fn`` (written with NumPy's functions, all in the standard)
+    with the name ``np`` in it bound to the namespace ``xp``, and the names ``calls`` to other
+    functions (the same code on another namespace's arrays; cached). A kernel's core runs so
+    (:class:`~weakgrid.sim.kernels.Kernel`), and an array function it calls."""
+    return types.FunctionType(fn.__code__, dict(fn.__globals__, np=xp, **calls), fn.__name__,
+                              fn.__defaults__, fn.__closure__)
 
 
 def take(xp, a, idx):

@@ -17,7 +17,8 @@ The initialization solves ``psi2q*(1 + Se*(xq-xl)/(xd-xl)) = (xq-xq2)*Iq`` with 
 
 from __future__ import annotations
 
-from ..blocks import exp_saturation_coeffs
+from ..blocks import exp_saturation, exp_saturation_coeffs
+from ..namespace import on_arrays_of
 from .gensal import GENSAL
 
 
@@ -39,7 +40,4 @@ class GENSAE(GENSAL):
         return exp_saturation_coeffs(1.0, S10, 1.2, S12)
 
     def _sat(self, x):
-        # blocks.exp_saturation on the namespace: B*x^A for x > 0 (x kept off 0 elsewhere), else 0
-        xp = self.xp
-        x = xp.astype(x, xp.float64, copy=False)
-        return xp.where(x > 0, self.SB * xp.abs(xp.where(x > 0, x, 1.0)) ** self.SA, 0.0)
+        return on_arrays_of(exp_saturation, self.xp)(x, self.SA, self.SB)
