@@ -48,11 +48,27 @@ def _points(system, seed=0):
     return Z
 
 
+def _strict_squares_as_numpy() -> bool:
+    """Whether ``x ** 2`` on array_api_strict gives NumPy's floats: it computes
+    ``numpy.power(x, array(2.0))``, which NumPy 2.0 evaluates by the general power function
+    (5 % of random squares differ in the last bit, measured with NumPy 2.0.2) and later NumPy
+    as the square ``x ** 2`` is."""
+    x = np.random.default_rng(0).uniform(0.0, 3.0, 10_000)
+    return np.array_equal(x ** 2, np.power(x, np.asarray(2.0)))
+
+
+#: bit for bit where the namespaces' arithmetic agrees; else to the last bits of a square
+EXACT = _strict_squares_as_numpy()
+
+
 def _same(a, b, what):
     assert isinstance(b, type(xps.asarray(0.0))), f"{what}: {type(b).__name__}, not a strict array"
     a, b = np.asarray(a), to_numpy(b)
     assert a.shape == b.shape, what
-    assert np.array_equal(a, b, equal_nan=True), f"{what}: {np.max(np.abs(a - b))}"
+    if EXACT:
+        assert np.array_equal(a, b, equal_nan=True), f"{what}: {np.max(np.abs(a - b))}"
+    else:
+        np.testing.assert_allclose(b, a, rtol=1e-13, atol=1e-14, equal_nan=True, err_msg=what)
 
 
 def _check(system, Z):

@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_namespace import _check, _no_numpy_on_strict_arrays, _points  # noqa: F401
+from test_namespace import _check, _no_numpy_on_strict_arrays, _points, _same  # noqa: F401
 
-from weakgrid.sim.namespace import namespace_models, on_namespace, to_numpy
+from weakgrid.sim.namespace import namespace_models, on_namespace
 from weakgrid.sim.renewables import (ESD1, PVD1, REECA1, REECB1, REGCA1, REPCA1, WTARA1, WTDTA1,
                                      WTPTA1, WTTQA1)
 from weakgrid.sim.sources import InfiniteBus, PVSource
@@ -33,10 +33,6 @@ def star_case(p=(0.5, 0.4, 0.3, 0.2), x_line=0.2):
     branch = [[k + 1, n + 1, 0.01, x_line, 0.0, 0, 0, 0, 0, 0, 1, -360, 360] for k in range(n)]
     branch.append([1, 2, 0.02, 0.3, 0.0, 0, 0, 0, 0, 0, 1, -360, 360])
     return {"baseMVA": 100.0, "bus": bus, "gen": gen, "branch": np.array(branch, dtype=float)}
-
-
-def _strict_equal(a, b, what):
-    assert np.array_equal(np.asarray(a), to_numpy(b), equal_nan=True), what
 
 
 def converters_and_sources():
@@ -170,7 +166,7 @@ def test_the_electrical_controls_holds_evaluate_on_the_strict_namespace_as_on_nu
                         ("REECB1", ("_piq_hold", "_piv_hold", "_s4_hold", "_pord_hold")),
                         ("REPCA1", ("_ehold",))):
         for k in keys:
-            _strict_equal(getattr(system.components[model], k), getattr(other.components[model], k),
+            _same(getattr(system.components[model], k), getattr(other.components[model], k),
                           f"{model}.{k}")
 
 
@@ -182,5 +178,5 @@ def test_regca1_psse_voltage_estimate_accept_on_the_strict_namespace_as_on_numpy
     _, ctxs = other.device_residual(0.0, xps.asarray(Z[1]))
     system.components["REGCA1"].accept(0.0, ctx)
     other.components["REGCA1"].accept(0.0, ctxs)
-    _strict_equal(system.components["REGCA1"]._vest, other.components["REGCA1"]._vest, "_vest")
+    _same(system.components["REGCA1"]._vest, other.components["REGCA1"]._vest, "_vest")
     _check(system, Z)      # the next evaluation with the updated estimate
