@@ -78,9 +78,9 @@ def take(xp, a, idx):
 
 def _scatter(xp, a, idx, v):
     """``a`` with ``a[..., idx]`` replaced by ``v`` (``idx`` unique), by selection."""
-    n = a.shape[-1]
-    where = np.full(n, -1)
-    where[np.asarray(to_numpy(idx))] = np.arange(len(to_numpy(idx)))
+    cols = to_numpy(idx)
+    where = np.full(a.shape[-1], -1)
+    where[cols] = np.arange(len(cols))
     mask = xp.asarray(where >= 0)
     pos = xp.asarray(np.maximum(where, 0))
     v = xp.broadcast_to(xp.asarray(v, dtype=a.dtype), a.shape[:-1] + (int(idx.shape[0]),))
@@ -110,7 +110,7 @@ def add_at(xp, a, idx, v, unique):
         return
     v = xp.broadcast_to(xp.asarray(v, dtype=a.dtype), a.shape[:-1] + (int(idx.shape[0]),))
     order = np.asarray(to_numpy(idx))
-    # the k-th occurrence of each index in one pass each: the order numpy.add.at adds them in
+    # the k-th occurrences of the indices added in the k-th pass: numpy.add.at's order
     rank = np.array([np.count_nonzero(order[:i] == order[i]) for i in range(len(order))], int)
     for r in range(int(rank.max(initial=-1)) + 1):
         sel = np.nonzero(rank == r)[0]
